@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_app_application_h
+#define palpate_app_application_h
+
+#include <iosfwd>
+
+namespace palpate
+{
+  /** Exit statuses of the palpate program. */
+  namespace ExitStatus
+  {
+    /** Everything asked for was done. */
+    constexpr int success = 0;
+    /** An internal error: a bug, or the machine ran out of something. */
+    constexpr int internal_error = 1;
+    /** Bad input: a scene, mesh or command-line problem the user can fix. */
+    constexpr int input_error = 2;
+    /** The scene asks for something this version cannot do yet. */
+    constexpr int not_available = 3;
+  } // namespace ExitStatus
+
+  /**
+   * The palpate command line: everything main() does after setting up the
+   * Environment. Never throws: every error becomes a banner on @p err that
+   * says what failed, in which input, and what to do, plus an exit status
+   * from ExitStatus.
+   */
+  int
+  run_application(int argc, char **argv, std::ostream &out, std::ostream &err);
+} // namespace palpate
+
+#endif

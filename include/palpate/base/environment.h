@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_base_environment_h
+#define palpate_base_environment_h
+
+namespace palpate
+{
+  /**
+   * Process-wide set-up that every palpate program (the application, the
+   * tests, the benchmarks) creates first in main() and keeps alive until it
+   * returns.
+   *
+   * It initialises MPI with MPI_THREAD_MULTIPLE (the direct solvers are MPI
+   * libraries, and solver workers call them from several threads at once),
+   * and it stops the BLAS and OpenMP libraries from starting threads of
+   * their own, so that the number of threads palpate uses is the number the
+   * scene asks for. MPI is finalised when the object is destroyed.
+   */
+  class Environment
+  {
+  public:
+    /** Initialise MPI (if nobody did yet) and the thread settings. */
+    Environment(int &argc, char **&argv);
+
+    /** Finalise MPI if this object initialised it. */
+    ~Environment();
+
+    Environment(const Environment &) = delete;
+    Environment &
+    operator=(const Environment &) = delete;
+
+    /** Whether MPI provides MPI_THREAD_MULTIPLE in this process. */
+    static bool
+    mpi_thread_multiple();
+
+  private:
+    bool finalize_mpi;
+  };
+} // namespace palpate
+
+#endif

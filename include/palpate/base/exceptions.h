@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_base_exceptions_h
+#define palpate_base_exceptions_h
+
+#include <stdexcept>
+#include <string>
+
+namespace palpate
+{
+  /**
+   * An error in what the user gave us: a scene file, a mesh file, a command
+   * line. It always says where (file and, if known, line), which entry, what
+   * is wrong with it, and what to do about it. `main()` prints it as a banner
+   * and exits with status 2; tests print it verbatim.
+   */
+  class InputError : public std::runtime_error
+  {
+  public:
+    /**
+     * @param file    The file that holds the bad input (scene, mesh, CSV),
+     *                or "command line".
+     * @param line    Line number in @p file, 0 if unknown or not applicable.
+     * @param entry   The entry, e.g. "Material model / Model name", or the
+     *                mesh element, e.g. "element 17".
+     * @param problem One or two sentences: what is wrong.
+     * @param fix     One or two sentences: what the user should do.
+     */
+    InputError(const std::string &file,
+               const unsigned int line,
+               const std::string &entry,
+               const std::string &problem,
+               const std::string &fix);
+
+    /** The file that holds the bad input. */
+    const std::string &
+    file() const
+    {
+      return file_;
+    }
+
+    /** Line number in file(), 0 if unknown. */
+    unsigned int
+    line() const
+    {
+      return line_;
+    }
+
+    /** The entry that is wrong. */
+    const std::string &
+    entry() const
+    {
+      return entry_;
+    }
+
+    /** What is wrong. */
+    const std::string &
+    problem() const
+    {
+      return problem_;
+    }
+
+    /** What to do about it. */
+    const std::string &
+    fix() const
+    {
+      return fix_;
+    }
+
+  private:
+    std::string  file_;
+    unsigned int line_;
+    std::string  entry_;
+    std::string  problem_;
+    std::string  fix_;
+  };
+
+  /**
+   * A capability that a scene asks for but that this version of palpate
+   * does not have yet. Reported like an InputError, but it is not the
+   * user's fault, so the message says which capability and where it is
+   * tracked.
+   */
+  class NotAvailableError : public std::runtime_error
+  {
+  public:
+    /**
+     * @param what  The capability, e.g. "the Mooney-Rivlin solver".
+     * @param where What the user can do instead.
+     */
+    NotAvailableError(const std::string &what, const std::string &where);
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_base_utilities_h
+#define palpate_base_utilities_h
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  /**
+   * Small string and geometry helpers shared by every part of palpate. They
+   * depend on the standard library only, so the real-time side may use them.
+   */
+  namespace Utilities
+  {
+    /** A point or vector in 3-D space, in metres unless stated otherwise. */
+    using Point3 = std::array<double, 3>;
+
+    /** @p s without leading and trailing white space. */
+    std::string
+    trim(const std::string &s);
+
+    /** @p s split at @p separator, each piece trimmed; empty pieces kept. */
+    std::vector<std::string>
+    split(const std::string &s, const char separator);
+
+    /** Levenshtein edit distance between @p a and @p b, case-insensitive. */
+    unsigned int
+    edit_distance(const std::string &a, const std::string &b);
+
+    /**
+     * The candidate closest to @p word by edit distance, or "" if none is
+     * close enough to be a plausible typo (distance more than a third of the
+     * word's length, at least 3).
+     */
+    std::string
+    closest_match(const std::string &word, const std::vector<std::string> &candidates);
+
+    /** Euclidean norm of @p v. */
+    double
+    norm(const Point3 &v);
+
+    /** Euclidean distance between @p a and @p b. */
+    double
+    distance(const Point3 &a, const Point3 &b);
+
+    /** Format @p p as "x, y, z" with @p precision significant digits. */
+    std::string
+    to_string(const Point3 &p, const unsigned int precision = 6);
+
+    /**
+     * Parse "x, y, z" (three numbers separated by commas) into a Point3.
+     * Throws std::invalid_argument with a readable message otherwise.
+     */
+    Point3
+    parse_point(const std::string &text);
+  } // namespace Utilities
+} // namespace palpate
+
+#endif

@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_mesh_node_selection_h
+#define palpate_mesh_node_selection_h
+
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  class Mesh;
+  class Scene;
+
+  /**
+   * The nodes a scene constrains: the fixed ones (zero displacement) and
+   * the active one (follows the haptic interaction point).
+   */
+  struct NodeSelection
+  {
+    /** Fixed vertices, sorted, without repetitions. */
+    std::vector<unsigned int> fixed_vertices;
+    /** The active vertex. */
+    unsigned int active_vertex = 0;
+    /** Distance from the scene's Point to the active node, metres (0 for
+     * Selection = node id). */
+    double active_distance = 0;
+    /** One line describing how the fixed nodes were chosen. */
+    std::string fixed_description;
+
+    /**
+     * Select the nodes a scene asks for on @p mesh. Throws an InputError,
+     * naming the scene entry, if the fixed region selects no node, if the
+     * fixed nodes cannot hold the body (they all lie on one line, so it
+     * could rotate about it), if a node number does not exist, or if the
+     * active node is fixed or not on the surface.
+     */
+    static NodeSelection
+    create(const Scene &scene, const Mesh &mesh);
+  };
+} // namespace palpate
+
+#endif

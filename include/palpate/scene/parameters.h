@@ -1,0 +1,324 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_scene_parameters_h
+#define palpate_scene_parameters_h
+
+#include <palpate/base/utilities.h>
+
+#include <string>
+#include <vector>
+
+namespace dealii
+{
+  class ParameterHandler;
+}
+
+/**
+ * The scene: everything a `.prm` file says. One struct per subsection, each
+ * with `declare_parameters()` (the single place where names, defaults,
+ * patterns and documentation live) and `parse_parameters()`, as in step-44.
+ * The structs hold plain values only, so any part of palpate can include
+ * this header without pulling in deal.II.
+ */
+namespace palpate
+{
+  namespace Parameters
+  {
+    using Utilities::Point3;
+
+    /** `subsection Mesh`: where the body's tetrahedral mesh comes from. */
+    struct Mesh
+    {
+      /** "file", "beam" or "blob". */
+      std::string source;
+      /** Mesh file (.msh Gmsh 2.2 or v1, .vtk, .vtu) as written in the scene. */
+      std::string file_name;
+      /** Metres per mesh-file length unit. */
+      double scale_factor;
+
+      /** Beam generator: edge lengths in metres and subdivisions. */
+      double       beam_length, beam_width, beam_height;
+      unsigned int beam_subdivisions_length, beam_subdivisions_width,
+        beam_subdivisions_height;
+
+      /** Blob generator: semi-axes in metres and refinement count. */
+      Point3       blob_semi_axes;
+      unsigned int blob_refinements;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Boundary conditions / subsection Fixed nodes`. */
+    struct FixedNodes
+    {
+      /** "boundary id", "box", "half-space" or "node list". */
+      std::string selection;
+      /** Boundary ids whose faces' nodes are fixed. */
+      std::vector<unsigned int> boundary_ids;
+      /** Axis-aligned box, in metres (scaled mesh coordinates). */
+      Point3 box_lower_corner, box_upper_corner;
+      /** Half-space {x : (x - point) . normal >= 0}, metres. */
+      Point3 half_space_point, half_space_normal;
+      /** Node numbers as the mesh file numbers them. */
+      std::vector<long> node_ids;
+      /** Whether only surface nodes inside the region are fixed. */
+      bool surface_nodes_only;
+      /** "elimination" or "multipliers". */
+      std::string treatment;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Boundary conditions / subsection Active node`. */
+    struct ActiveNode
+    {
+      /** "nearest surface node" or "node id". */
+      std::string selection;
+      /** The point the active node is nearest to, metres. */
+      Point3 point;
+      /** Node number as the mesh file numbers it. */
+      long node_id;
+      /** Displacement of the active node for a static solve, metres. */
+      Point3 prescribed_displacement;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Boundary conditions`. */
+    struct BoundaryConditions
+    {
+      FixedNodes fixed_nodes;
+      ActiveNode active_node;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Material model`: the constitutive law and its data. */
+    struct MaterialModel
+    {
+      /** "St.Venant-Kirchhoff", "Neo-Hookean" or "Mooney-Rivlin". */
+      std::string model_name;
+      /** Mass density, kg/m^3 (used by gravity only). */
+      double density;
+
+      /** St.Venant-Kirchhoff: Young's modulus (Pa), Poisson's ratio. */
+      double stvk_youngs_modulus, stvk_poissons_ratio;
+      /** Compressible neo-Hookean: Young's modulus (Pa), Poisson's ratio. */
+      double nh_youngs_modulus, nh_poissons_ratio;
+      /** Mooney-Rivlin coefficients C10, C01 and bulk modulus, Pa. */
+      double mr_c10, mr_c01, mr_bulk_modulus;
+      /** Mooney-Rivlin incompressibility: "exact" or "penalty". */
+      std::string mr_incompressibility;
+      /** Mooney-Rivlin element pair: "P1-P1" or "Taylor-Hood". */
+      std::string mr_element;
+      /** Pressure stabilisation for P1-P1: "none" or "Brezzi-Pitkaranta". */
+      std::string mr_stabilization;
+      /** Dimensionless factor of the pressure stabilisation. */
+      double mr_stabilization_factor;
+
+      /** Whether the model imposes incompressibility (adds pressure DoFs). */
+      bool
+      incompressible() const;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Discretization`: finite element and quadrature. */
+    struct Discretization
+    {
+      /** Polynomial degree of the displacement (1 or 2). */
+      unsigned int polynomial_degree;
+      /** Points per direction of the simplex Gauss rule; 0 = exact default. */
+      unsigned int quadrature_order;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Effects`: what the scene simulates; all off by default. */
+    struct Effects
+    {
+      /** Body force rho*g. */
+      bool   gravity;
+      Point3 gravitational_acceleration;
+      /** Shape (whole displacement field) interpolation for rendering. */
+      bool   shape_output;
+      double shape_output_rate;
+      /** VTU export of computed states. */
+      bool vtu_export;
+      /** CSV log of the force at the active node. */
+      bool force_log;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Nonlinear solver`: staging, Newton, line search. */
+    struct NonlinearSolver
+    {
+      unsigned int n_increments;
+      double       max_increment_length;
+      unsigned int max_newton_iterations;
+      double       residual_tolerance;
+      double       increment_tolerance;
+      bool         line_search;
+      unsigned int max_line_search_steps;
+      unsigned int max_cutbacks;
+      unsigned int assembly_threads;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Linear solver`: the sparse direct solver. */
+    struct LinearSolver
+    {
+      /** "MUMPS", "UMFPACK", "KLU", "Amesos MUMPS" or "Amesos KLU". */
+      std::string solver;
+      /** MUMPS fill-reducing ordering: "METIS", "AMD", "AMF", "QAMD",
+       * "PORD", "SCOTCH" or "automatic". */
+      std::string ordering;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection State space`: the regular grid of active-node positions. */
+    struct StateSpace
+    {
+      /** Distance between neighbouring grid points, metres. */
+      double grid_spacing;
+      /** Half-width of the grid along each axis, metres. */
+      double extent;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Scheduler`: the cloud of states kept around the HIP. */
+    struct Scheduler
+    {
+      double cloud_radius;
+      double rate;
+      double look_ahead_time;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Engine`: who computes states. */
+    struct Engine
+    {
+      /** "threads" or "mpi". */
+      std::string  type;
+      unsigned int workers;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Haptics / subsection Trajectory`: the simulated device. */
+    struct Trajectory
+    {
+      /** "straight line", "circle", "smooth random" or "replay". */
+      std::string  type;
+      Point3       direction;
+      double       speed;
+      double       duration;
+      double       radius;
+      unsigned int seed;
+      std::string  file_name;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Haptics`: the real-time loop and the device. */
+    struct Haptics
+    {
+      double      loop_rate;
+      std::string device;
+      double      force_limit;
+      double      max_force_change;
+      Trajectory  trajectory;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /** `subsection Output`. */
+    struct Output
+    {
+      /** Directory for all files palpate writes, relative to the cwd. */
+      std::string directory;
+      /** Machine-readable run summary formats: subset of {csv, json}. */
+      std::vector<std::string> summary_formats;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
+    /**
+     * All parameters of a scene (step-44's AllParameters). The single
+     * place where the top-level subsections are declared and parsed.
+     */
+    struct AllParameters
+    {
+      Mesh               mesh;
+      BoundaryConditions boundary_conditions;
+      MaterialModel      material_model;
+      Discretization     discretization;
+      Effects            effects;
+      NonlinearSolver    nonlinear_solver;
+      LinearSolver       linear_solver;
+      StateSpace         state_space;
+      Scheduler          scheduler;
+      Engine             engine;
+      Haptics            haptics;
+      Output             output;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+  } // namespace Parameters
+} // namespace palpate
+
+#endif

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_scene_scene_h
+#define palpate_scene_scene_h
+
+#include <palpate/base/exceptions.h>
+#include <palpate/scene/parameters.h>
+
+#include <iosfwd>
+#include <map>
+#include <string>
+
+namespace palpate
+{
+  /**
+   * A scene as read from a `.prm` file: its parameters, plus where each one
+   * came from, so that any later check (a missing mesh file, a region that
+   * selects no node) can point at the file, the line and the entry.
+   */
+  class Scene
+  {
+  public:
+    /** A scene with every parameter at its declared default. */
+    Scene();
+
+    /**
+     * Read, check and parse a scene file. Every problem (unknown
+     * subsection or entry, a value that does not match the entry's pattern,
+     * unbalanced subsections, a value that is allowed by its pattern but
+     * makes no sense, like nu = 0.5) is reported as an InputError naming the
+     * file, line, entry and a fix, with a "did you mean" suggestion for
+     * misspelled names.
+     */
+    static Scene
+    read(const std::string &filename);
+
+    /** The parameters. */
+    Parameters::AllParameters parameters;
+
+    /** The scene file as given by the user ("" for the defaults). */
+    const std::string &
+    file() const
+    {
+      return file_;
+    }
+
+    /**
+     * A path written in the scene, resolved against the scene file's
+     * directory if it is relative (so a scene can be run from anywhere).
+     */
+    std::string
+    resolve_path(const std::string &path) const;
+
+    /**
+     * The line that sets @p entry ("Material model/Model name"), or 0 if
+     * the scene file does not set it (the default applies).
+     */
+    unsigned int
+    line_of(const std::string &entry) const;
+
+    /**
+     * An InputError about @p entry of this scene: the file and line are
+     * filled in, and the entry is shown as "A / B / name = value" when the
+     * file sets it, or as "A / B / name (default 'value')" when not.
+     */
+    InputError
+    error(const std::string &entry,
+          const std::string &problem,
+          const std::string &fix) const;
+
+    /** Check relations between parameters that no single pattern can. */
+    void
+    validate() const;
+
+  private:
+    std::string                         file_;
+    std::string                         directory_;
+    std::map<std::string, unsigned int> entry_lines_;
+    std::map<std::string, std::string>  entry_values_;
+  };
+
+  /** Output formats for print_parameters(). */
+  enum class ParameterFormat
+  {
+    /** A complete `.prm` file with every entry at its default, documented. */
+    prm,
+    /** The Markdown reference in doc/parameters.md. */
+    markdown
+  };
+
+  /** Print every declared parameter with its default and documentation. */
+  void
+  print_parameters(std::ostream &out, const ParameterFormat format);
+} // namespace palpate
+
+#endif

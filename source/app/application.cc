@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/app/application.h>
+#include <palpate/app/scene_report.h>
+#include <palpate/base/exceptions.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
+
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  namespace
+  {
+    const char *const usage =
+      "palpate: touch a non-linear finite element model through a haptic "
+      "device.\n"
+      "\n"
+      "Usage:\n"
+      "  palpate SCENE.prm               set up the scene and run it\n"
+      "  palpate --print-parameters [prm|markdown]\n"
+      "                                  print every scene parameter with its\n"
+      "                                  default and documentation\n"
+      "  palpate --help                  this text\n"
+      "  palpate --version               the version\n"
+      "\n"
+      "Scenes are deal.II parameter files; parameters/ holds examples\n"
+      "(default.prm, liver-stvk.prm, liver-mooney-rivlin.prm, beam.prm) and\n"
+      "doc/parameters.md documents every entry.\n";
+
+    /** Set up a scene: read it, build the mesh, select the nodes. */
+    int
+    run_scene(const std::string &filename, std::ostream &out)
+    {
+      const Scene         scene = Scene::read(filename);
+      const Mesh          mesh  = Mesh::create(scene);
+      const NodeSelection nodes = NodeSelection::create(scene, mesh);
+      print_scene_report(out, scene, mesh, nodes);
+      out << "\nSolving is not available yet: this version sets up and checks "
+             "the scene only.\nThe hyperelastic solver that computes states "
+             "and forces is the next capability to land.\n";
+      return ExitStatus::success;
+    }
+
+    int
+    dispatch(const std::vector<std::string> &args, std::ostream &out)
+    {
+      if (args.empty() || args[0] == "--help" || args[0] == "-h")
+        {
+          out << usage;
+          return args.empty() ? ExitStatus::input_error : ExitStatus::success;
+        }
+      if (args[0] == "--version")
+        {
+          out << "palpate " << PALPATE_VERSION << "\n";
+          return ExitStatus::success;
+        }
+      if (args[0] == "--print-parameters")
+        {
+          const std::string format = args.size() > 1 ? args[1] : "prm";
+          if (format != "prm" && format != "markdown")
+            throw InputError("command line",
+                             0,
+                             "--print-parameters " + format,
+                             "unknown format '" + format + "'",
+                             "use 'prm' (default) or 'markdown'.");
+          print_parameters(out,
+                           format == "prm" ? ParameterFormat::prm :
+                                             ParameterFormat::markdown);
+          return ExitStatus::success;
+        }
+      if (args[0].size() > 1 && args[0][0] == '-')
+        throw InputError("command line",
+                         0,
+                         args[0],
+                         "unknown option '" + args[0] + "'",
+                         "run 'palpate --help' for the options.");
+      if (args.size() > 1)
+        throw InputError("command line",
+                         0,
+                         args[1],
+                         "unexpected argument '" + args[1] + "'",
+                         "run 'palpate --help' for the usage.");
+      return run_scene(args[0], out);
+    }
+  } // namespace
+
+
+
+  int
+  run_application(int argc, char **argv, std::ostream &out, std::ostream &err)
+  {
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    try
+      {
+        return dispatch(args, out);
+      }
+    catch (const InputError &e)
+      {
+        out.flush();
+        err << "\npalpate: the input has a problem, " << e.what() << "\n";
+        return ExitStatus::input_error;
+      }
+    catch (const NotAvailableError &e)
+      {
+        out.flush();
+        err << "\npalpate: " << e.what() << "\n";
+        return ExitStatus::not_available;
+      }
+    catch (const std::exception &e)
+      {
+        out.flush();
+        err << "\npalpate: internal error: " << e.what()
+            << "\n  This is a bug or the machine ran out of a resource. "
+               "Please report it with the scene file and this message.\n";
+        return ExitStatus::internal_error;
+      }
+    catch (...)
+      {
+        out.flush();
+        err << "\npalpate: internal error of unknown type.\n";
+        return ExitStatus::internal_error;
+      }
+  }
+} // namespace palpate

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/environment.h>
+
+#include <deal.II/base/multithread_info.h>
+
+#include <mpi.h>
+
+#include <cstdlib>
+
+namespace palpate
+{
+  namespace
+  {
+    bool thread_multiple = false;
+  }
+
+
+
+  Environment::Environment(int &argc, char **&argv)
+    : finalize_mpi(false)
+  {
+    // One thread per BLAS/OpenMP call: palpate decides how many threads run
+    // (solver workers, assembly threads), and nested thread pools inside a
+    // direct solver would only compete with them for the cores.
+    setenv("OMP_NUM_THREADS", "1", 0);
+    setenv("OPENBLAS_NUM_THREADS", "1", 0);
+
+    int initialized = 0;
+    MPI_Initialized(&initialized);
+    if (!initialized)
+      {
+        int provided = 0;
+        MPI_Init_thread(&argc, &argv, MPI_THREAD_MULTIPLE, &provided);
+        thread_multiple = (provided >= MPI_THREAD_MULTIPLE);
+        finalize_mpi    = true;
+      }
+    else
+      {
+        int provided = 0;
+        MPI_Query_thread(&provided);
+        thread_multiple = (provided >= MPI_THREAD_MULTIPLE);
+      }
+
+    // deal.II's own task-based parallelism (used by a few library calls
+    // during set-up) gets the cores too; palpate's assembly uses explicit
+    // task arenas with the scene's thread count.
+    dealii::MultithreadInfo::set_thread_limit();
+  }
+
+
+
+  Environment::~Environment()
+  {
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (finalize_mpi && !finalized)
+      MPI_Finalize();
+  }
+
+
+
+  bool
+  Environment::mpi_thread_multiple()
+  {
+    return thread_multiple;
+  }
+} // namespace palpate

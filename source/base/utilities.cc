@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/utilities.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace palpate
+{
+  namespace Utilities
+  {
+    std::string
+    trim(const std::string &s)
+    {
+      const auto first = s.find_first_not_of(" \t\r\n");
+      if (first == std::string::npos)
+        return "";
+      const auto last = s.find_last_not_of(" \t\r\n");
+      return s.substr(first, last - first + 1);
+    }
+
+
+
+    std::vector<std::string>
+    split(const std::string &s, const char separator)
+    {
+      std::vector<std::string> pieces;
+      std::string::size_type   begin = 0;
+      while (true)
+        {
+          const auto end = s.find(separator, begin);
+          pieces.push_back(trim(s.substr(begin, end - begin)));
+          if (end == std::string::npos)
+            break;
+          begin = end + 1;
+        }
+      return pieces;
+    }
+
+
+
+    unsigned int
+    edit_distance(const std::string &a, const std::string &b)
+    {
+      std::vector<unsigned int> previous(b.size() + 1), current(b.size() + 1);
+      for (unsigned int j = 0; j <= b.size(); ++j)
+        previous[j] = j;
+      for (unsigned int i = 1; i <= a.size(); ++i)
+        {
+          current[0] = i;
+          for (unsigned int j = 1; j <= b.size(); ++j)
+            {
+              const bool same =
+                std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                std::tolower(static_cast<unsigned char>(b[j - 1]));
+              current[j] = std::min({previous[j] + 1,
+                                     current[j - 1] + 1,
+                                     previous[j - 1] + (same ? 0 : 1)});
+            }
+          std::swap(previous, current);
+        }
+      return previous[b.size()];
+    }
+
+
+
+    std::string
+    closest_match(const std::string &             word,
+                  const std::vector<std::string> &candidates)
+    {
+      std::string  best;
+      unsigned int best_distance = static_cast<unsigned int>(-1);
+      for (const auto &c : candidates)
+        {
+          const unsigned int d = edit_distance(word, c);
+          if (d < best_distance)
+            {
+              best          = c;
+              best_distance = d;
+            }
+        }
+      const unsigned int allowed =
+        std::max<unsigned int>(3, static_cast<unsigned int>(word.size() / 3));
+      return (best_distance <= allowed) ? best : std::string();
+    }
+
+
+
+    double
+    norm(const Point3 &v)
+    {
+      return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    }
+
+
+
+    double
+    distance(const Point3 &a, const Point3 &b)
+    {
+      return norm({{a[0] - b[0], a[1] - b[1], a[2] - b[2]}});
+    }
+
+
+
+    std::string
+    to_string(const Point3 &p, const unsigned int precision)
+    {
+      std::ostringstream s;
+      s << std::setprecision(precision) << p[0] << ", " << p[1] << ", "
+        << p[2];
+      return s.str();
+    }
+
+
+
+    Point3
+    parse_point(const std::string &text)
+    {
+      const std::vector<std::string> pieces = split(text, ',');
+      if (pieces.size() != 3)
+        throw std::invalid_argument("'" + text +
+                                    "' is not three numbers separated by "
+                                    "commas (x, y, z)");
+      Point3 p;
+      for (unsigned int d = 0; d < 3; ++d)
+        {
+          std::size_t used = 0;
+          try
+            {
+              p[d] = std::stod(pieces[d], &used);
+            }
+          catch (const std::exception &)
+            {
+              used = 0;
+            }
+          if (used == 0 || used != pieces[d].size() || !std::isfinite(p[d]))
+            throw std::invalid_argument("'" + pieces[d] +
+                                        "' in '" + text +
+                                        "' is not a finite number");
+        }
+      return p;
+    }
+  } // namespace Utilities
+} // namespace palpate

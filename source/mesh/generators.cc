@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/mesh/generators.h>
+
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/tria.h>
+
+#include <cmath>
+
+namespace palpate
+{
+  namespace
+  {
+    /** The raw description of a simplex triangulation. */
+    MeshData
+    to_mesh_data(const dealii::Triangulation<3> &tria, const std::string &format)
+    {
+      MeshData data;
+      data.format = format;
+      for (unsigned int v = 0; v < tria.n_vertices(); ++v)
+        {
+          const auto &p = tria.get_vertices()[v];
+          data.nodes.push_back({{p[0], p[1], p[2]}});
+          data.node_ids.push_back(v);
+        }
+      for (const auto &cell : tria.active_cell_iterators())
+        {
+          std::array<unsigned int, 4> t;
+          for (unsigned int i = 0; i < 4; ++i)
+            t[i] = cell->vertex_index(i);
+          // deal.II stores some generated tetrahedra with negative
+          // orientation; the raw description follows the usual convention
+          // (positive volume), which Mesh checks.
+          const auto &x = data.nodes;
+          const auto  e = [&](unsigned int a, unsigned int d) {
+            return x[t[a]][d] - x[t[0]][d];
+          };
+          const double det =
+            e(1, 0) * (e(2, 1) * e(3, 2) - e(2, 2) * e(3, 1)) -
+            e(1, 1) * (e(2, 0) * e(3, 2) - e(2, 2) * e(3, 0)) +
+            e(1, 2) * (e(2, 0) * e(3, 1) - e(2, 1) * e(3, 0));
+          if (det < 0)
+            std::swap(t[2], t[3]);
+          data.tetrahedra.push_back(t);
+          data.tetrahedron_material_ids.push_back(cell->material_id());
+          data.tetrahedron_lines.push_back(0);
+          data.tetrahedron_ids.push_back(cell->active_cell_index());
+          for (const unsigned int f : cell->face_indices())
+            if (cell->face(f)->at_boundary())
+              {
+                const auto face = cell->face(f);
+                data.triangles.push_back({{face->vertex_index(0),
+                                           face->vertex_index(1),
+                                           face->vertex_index(2)}});
+                data.triangle_boundary_ids.push_back(face->boundary_id());
+                data.triangle_lines.push_back(0);
+              }
+        }
+      return data;
+    }
+  } // namespace
+
+
+
+  MeshData
+  generate_beam(const Parameters::Mesh &p)
+  {
+    dealii::Triangulation<3> tria;
+    dealii::GridGenerator::subdivided_hyper_rectangle_with_simplices(
+      tria,
+      {p.beam_subdivisions_length,
+       p.beam_subdivisions_width,
+       p.beam_subdivisions_height},
+      dealii::Point<3>(0, -p.beam_width / 2, -p.beam_height / 2),
+      dealii::Point<3>(p.beam_length, p.beam_width / 2, p.beam_height / 2));
+
+    // deal.II 9.4 cannot colorize simplex rectangles; set the ids by the
+    // position of each boundary face's centre.
+    const double half[3] = {p.beam_length / 2, p.beam_width / 2, p.beam_height / 2};
+    const double centre[3] = {p.beam_length / 2, 0, 0};
+    for (const auto &cell : tria.active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->at_boundary())
+          {
+            const auto c = cell->face(f)->center();
+            for (unsigned int d = 0; d < 3; ++d)
+              {
+                const double t = (c[d] - centre[d]) / half[d];
+                if (std::abs(t + 1) < 1e-10)
+                  cell->face(f)->set_boundary_id(2 * d);
+                else if (std::abs(t - 1) < 1e-10)
+                  cell->face(f)->set_boundary_id(2 * d + 1);
+              }
+          }
+    return to_mesh_data(tria, "beam generator");
+  }
+
+
+
+  MeshData
+  generate_blob(const Parameters::Mesh &p)
+  {
+    dealii::Triangulation<3> ball;
+    dealii::GridGenerator::hyper_ball(ball, dealii::Point<3>(), 1.0, true);
+    ball.refine_global(p.blob_refinements);
+
+    dealii::Triangulation<3> tria;
+    dealii::GridGenerator::convert_hypercube_to_simplex_mesh(ball, tria);
+    tria.reset_all_manifolds();
+    tria.set_all_manifold_ids(dealii::numbers::flat_manifold_id);
+
+    // Map the unit ball onto a liver-like shape: an ellipsoid whose +x lobe
+    // is thicker and wider than the -x lobe, with a flatter underside. The
+    // map is smooth and its Jacobian stays positive on the ball (all
+    // factors are within [0.75, 1.25]).
+    const auto a = p.blob_semi_axes;
+    dealii::GridTools::transform(
+      [a](const dealii::Point<3> &x) {
+        const double lobe   = 1.0 + 0.25 * x[0];
+        const double flat   = 0.15 * (1.0 - x[0] * x[0] - x[1] * x[1]);
+        const double z      = x[2] < 0 ? x[2] * (1.0 - flat) : x[2];
+        return dealii::Point<3>(a[0] * x[0],
+                                a[1] * x[1] * (1.0 + 0.15 * x[0]),
+                                a[2] * z * lobe);
+      },
+      tria);
+    for (const auto &cell : tria.active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->at_boundary())
+          cell->face(f)->set_boundary_id(0);
+    return to_mesh_data(tria, "blob generator");
+  }
+} // namespace palpate

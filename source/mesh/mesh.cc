@@ -1,0 +1,481 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/exceptions.h>
+#include <palpate/mesh/generators.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/scene/scene.h>
+
+#include <deal.II/grid/tria.h>
+#include <deal.II/grid/tria_description.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+namespace palpate
+{
+  struct Mesh::Impl
+  {
+    dealii::Triangulation<3>                 tria;
+    std::vector<Utilities::Point3>           vertices;
+    std::vector<long>                        node_ids;
+    std::unordered_map<long, unsigned int>   vertex_of_id;
+    std::vector<std::array<unsigned int, 4>> cells;
+    std::vector<SurfaceFace>                 surface_faces;
+    std::vector<bool>                        on_surface;
+    unsigned int                             n_surface_vertices = 0;
+    double                                   volume             = 0;
+    double                                   min_volume         = 0;
+    Utilities::Point3                        lower, upper;
+    std::string                              description;
+    unsigned int                             n_dropped = 0;
+  };
+
+  namespace
+  {
+    double
+    signed_volume(const Utilities::Point3 &a,
+                  const Utilities::Point3 &b,
+                  const Utilities::Point3 &c,
+                  const Utilities::Point3 &d)
+    {
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+      return (u[0] * (v[1] * w[2] - v[2] * w[1]) -
+              u[1] * (v[0] * w[2] - v[2] * w[0]) +
+              u[2] * (v[0] * w[1] - v[1] * w[0])) /
+             6.0;
+    }
+
+    using FaceKey = std::array<unsigned int, 3>;
+
+    FaceKey
+    sorted(std::array<unsigned int, 3> f)
+    {
+      std::sort(f.begin(), f.end());
+      return f;
+    }
+
+    /** Union-find root with path halving. */
+    unsigned int
+    root(std::vector<unsigned int> &parent, unsigned int i)
+    {
+      while (parent[i] != i)
+        {
+          parent[i] = parent[parent[i]];
+          i         = parent[i];
+        }
+      return i;
+    }
+
+    std::string
+    element_name(const MeshData &data, const unsigned int c)
+    {
+      if (data.tetrahedron_lines[c] > 0)
+        return "element " + std::to_string(data.tetrahedron_ids[c]);
+      return "tetrahedron " + std::to_string(c);
+    }
+  } // namespace
+
+
+
+  Mesh::Mesh(const MeshData &data, const double scale, const std::string &file)
+    : impl(std::make_unique<Impl>())
+  {
+    const auto error = [&](const unsigned int  line,
+                           const std::string &entry,
+                           const std::string &problem,
+                           const std::string &fix) {
+      return InputError(file, line, entry, problem, fix);
+    };
+
+    if (data.tetrahedra.empty())
+      throw error(0,
+                  "mesh file",
+                  "the mesh has no tetrahedra",
+                  "palpate needs a volume mesh of linear tetrahedra; a "
+                  "surface mesh must first be meshed, e.g. with TetGen.");
+
+    // Keep only the nodes that tetrahedra use, in file order.
+    std::vector<int> new_index(data.nodes.size(), -1);
+    for (const auto &t : data.tetrahedra)
+      for (const unsigned int v : t)
+        new_index[v] = 0;
+    for (unsigned int i = 0; i < data.nodes.size(); ++i)
+      if (new_index[i] == 0)
+        {
+          new_index[i] = impl->vertices.size();
+          impl->vertices.push_back({{scale * data.nodes[i][0],
+                                     scale * data.nodes[i][1],
+                                     scale * data.nodes[i][2]}});
+          impl->node_ids.push_back(data.node_ids[i]);
+          impl->vertex_of_id[data.node_ids[i]] = new_index[i];
+        }
+      else
+        ++impl->n_dropped;
+
+    // Bounding box and length scale.
+    impl->lower = impl->upper = impl->vertices[0];
+    for (const auto &x : impl->vertices)
+      for (unsigned int d = 0; d < 3; ++d)
+        {
+          impl->lower[d] = std::min(impl->lower[d], x[d]);
+          impl->upper[d] = std::max(impl->upper[d], x[d]);
+        }
+    const double diameter = Utilities::distance(impl->lower, impl->upper);
+
+    // Every tetrahedron must have four distinct nodes and a positive
+    // volume. deal.II would silently re-orient inverted ones; we do not,
+    // because an inverted element in a file means a broken mesher or a
+    // wrong node-order convention, and the user must know.
+    impl->min_volume = std::numeric_limits<double>::max();
+    for (unsigned int c = 0; c < data.tetrahedra.size(); ++c)
+      {
+        std::array<unsigned int, 4> t;
+        for (unsigned int i = 0; i < 4; ++i)
+          t[i] = new_index[data.tetrahedra[c][i]];
+        std::array<unsigned int, 4> s = t;
+        std::sort(s.begin(), s.end());
+        if (std::adjacent_find(s.begin(), s.end()) != s.end())
+          throw error(data.tetrahedron_lines[c],
+                      element_name(data, c),
+                      "the tetrahedron uses the same node twice",
+                      "the mesh is broken; regenerate it (TetGen, Gmsh).");
+        const double v = signed_volume(impl->vertices[t[0]],
+                                       impl->vertices[t[1]],
+                                       impl->vertices[t[2]],
+                                       impl->vertices[t[3]]);
+        std::ostringstream nodes;
+        nodes << data.node_ids[data.tetrahedra[c][0]] << ", "
+              << data.node_ids[data.tetrahedra[c][1]] << ", "
+              << data.node_ids[data.tetrahedra[c][2]] << ", "
+              << data.node_ids[data.tetrahedra[c][3]];
+        if (std::abs(v) <= 1e-14 * diameter * diameter * diameter)
+          throw error(data.tetrahedron_lines[c],
+                      element_name(data, c) + " (nodes " + nodes.str() + ")",
+                      "the tetrahedron is degenerate: its four nodes are "
+                      "(nearly) in one plane, volume " +
+                        std::to_string(v) + " m^3",
+                      "remesh with a quality bound (TetGen -q, Gmsh "
+                      "optimisation) so that no element is flat.");
+        if (v < 0)
+          throw error(data.tetrahedron_lines[c],
+                      element_name(data, c) + " (nodes " + nodes.str() + ")",
+                      "the tetrahedron is inverted: its nodes are ordered "
+                      "so that its volume is negative (" +
+                        std::to_string(v) + " m^3)",
+                      "write the nodes of every tetrahedron in the standard "
+                      "order ((n1-n0) x (n2-n0)) . (n3-n0) > 0, e.g. swap "
+                      "its last two nodes; TetGen and Gmsh do this when the "
+                      "mesh is regenerated.");
+        impl->cells.push_back(t);
+        impl->volume += v;
+        impl->min_volume = std::min(impl->min_volume, v);
+      }
+
+    // Faces: a face of one tetrahedron is on the surface, of two is
+    // interior, of more is a broken (non-manifold) mesh.
+    std::map<FaceKey, std::pair<unsigned int, std::array<unsigned int, 3>>> faces;
+    static const unsigned int face_vertices[4][3] = {{1, 2, 3},
+                                                     {0, 3, 2},
+                                                     {0, 1, 3},
+                                                     {0, 2, 1}};
+    for (unsigned int c = 0; c < impl->cells.size(); ++c)
+      for (const auto &fv : face_vertices)
+        {
+          const std::array<unsigned int, 3> f = {{impl->cells[c][fv[0]],
+                                                  impl->cells[c][fv[1]],
+                                                  impl->cells[c][fv[2]]}};
+          auto &entry = faces[sorted(f)];
+          if (++entry.first == 1)
+            entry.second = f; // outward orientation from its cell
+          if (entry.first > 2)
+            throw error(data.tetrahedron_lines[c],
+                        element_name(data, c),
+                        "a face of this tetrahedron is shared by more than "
+                        "two tetrahedra (overlapping elements)",
+                        "the mesh is broken; regenerate it.");
+        }
+
+    // Boundary ids of surface faces, from the file's triangles.
+    std::map<FaceKey, unsigned int> ids;
+    for (unsigned int k = 0; k < data.triangles.size(); ++k)
+      {
+        std::array<unsigned int, 3> f;
+        for (unsigned int i = 0; i < 3; ++i)
+          {
+            const int v = new_index[data.triangles[k][i]];
+            if (v < 0)
+              throw error(data.triangle_lines[k],
+                          "boundary triangle " + std::to_string(k),
+                          "the triangle uses a node that no tetrahedron "
+                          "uses",
+                          "boundary triangles must be faces of the "
+                          "tetrahedra; export the volume and its surface "
+                          "from the same mesh.");
+            f[i] = v;
+          }
+        const auto it = faces.find(sorted(f));
+        if (it == faces.end())
+          throw error(data.triangle_lines[k],
+                      "boundary triangle " + std::to_string(k),
+                      "the triangle is not a face of any tetrahedron",
+                      "boundary triangles must be faces of the "
+                      "tetrahedra; export the volume and its surface from "
+                      "the same mesh.");
+        if (it->second.first == 1)
+          ids[it->first] = data.triangle_boundary_ids[k];
+        // Triangles on interior faces (e.g. between two materials) carry
+        // no boundary condition and are ignored.
+      }
+
+    impl->on_surface.assign(impl->vertices.size(), false);
+    for (const auto &[key, entry] : faces)
+      if (entry.first == 1)
+        {
+          const auto it = ids.find(key);
+          impl->surface_faces.push_back(
+            {entry.second, it == ids.end() ? 0u : it->second});
+          for (const unsigned int v : entry.second)
+            impl->on_surface[v] = true;
+        }
+    impl->n_surface_vertices =
+      std::count(impl->on_surface.begin(), impl->on_surface.end(), true);
+
+    // A body in several pieces cannot be held by one set of fixed nodes.
+    std::vector<unsigned int> parent(impl->vertices.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const auto &t : impl->cells)
+      for (unsigned int i = 1; i < 4; ++i)
+        parent[root(parent, t[i])] = root(parent, t[0]);
+    std::map<unsigned int, unsigned int> pieces;
+    for (unsigned int v = 0; v < parent.size(); ++v)
+      ++pieces[root(parent, v)];
+    if (pieces.size() > 1)
+      throw error(0,
+                  "mesh file",
+                  "the body consists of " + std::to_string(pieces.size()) +
+                    " disconnected pieces; every piece not held by fixed "
+                    "nodes would float away (singular system)",
+                  "mesh one connected body, or remove the extra pieces.");
+
+    // Hand the checked mesh to deal.II.
+    std::vector<dealii::Point<3>> points;
+    for (const auto &x : impl->vertices)
+      points.emplace_back(x[0], x[1], x[2]);
+    std::vector<dealii::CellData<3>> cells(impl->cells.size());
+    for (unsigned int c = 0; c < impl->cells.size(); ++c)
+      {
+        cells[c].vertices.assign(impl->cells[c].begin(), impl->cells[c].end());
+        cells[c].material_id = data.tetrahedron_material_ids[c];
+      }
+    dealii::SubCellData boundary;
+    for (const auto &face : impl->surface_faces)
+      if (face.boundary_id != 0)
+        {
+          dealii::CellData<2> quad;
+          quad.vertices.assign(face.vertices.begin(), face.vertices.end());
+          quad.boundary_id = face.boundary_id;
+          boundary.boundary_quads.push_back(quad);
+        }
+    try
+      {
+        impl->tria.create_triangulation(points, cells, boundary);
+      }
+    catch (const std::exception &e)
+      {
+        throw error(0,
+                    "mesh file",
+                    std::string("deal.II cannot build a triangulation from "
+                                "the mesh: ") +
+                      e.what(),
+                    "check the mesh with the mesher's own tools.");
+      }
+    impl->description = data.tetrahedron_lines[0] == 0 && data.format.find("generator") != std::string::npos ?
+                          "the " + data.format :
+                          "'" + file + "' (" + data.format + ")";
+  }
+
+
+
+  Mesh::Mesh(Mesh &&) noexcept = default;
+  Mesh::~Mesh()                = default;
+
+
+
+  Mesh
+  Mesh::create(const Scene &scene)
+  {
+    const auto &p = scene.parameters.mesh;
+    if (p.source == "beam")
+      return Mesh(generate_beam(p), 1.0, "the beam generator");
+    if (p.source == "blob")
+      return Mesh(generate_blob(p), 1.0, "the blob generator");
+
+    const std::string path = scene.resolve_path(p.file_name);
+    if (!std::filesystem::exists(path))
+      throw scene.error(
+        "Mesh/File name",
+        "the mesh file '" + path + "' does not exist",
+        "a relative path is relative to the directory of the scene file. "
+        "The shared liver meshes are in ../shared/meshes next to the "
+        "project (see its README); or use Source = blob, which needs no "
+        "file.");
+    try
+      {
+        // Errors about the file's content name the file as the scene
+        // writes it (and the report shows it that way too).
+        Mesh mesh(read_mesh_file(path), p.scale_factor, p.file_name);
+        return mesh;
+      }
+    catch (const InputError &e)
+      {
+        // Say which scene asked for this file, so the user knows where to
+        // point it elsewhere.
+        throw InputError(e.file(),
+                         e.line(),
+                         e.entry(),
+                         e.problem(),
+                         e.fix() + " (The scene '" + scene.file() +
+                           "' reads this file through Mesh / File name.)");
+      }
+  }
+
+
+
+  const dealii::Triangulation<3, 3> &
+  Mesh::triangulation() const
+  {
+    return impl->tria;
+  }
+
+
+
+  unsigned int
+  Mesh::n_vertices() const
+  {
+    return impl->vertices.size();
+  }
+
+
+
+  unsigned int
+  Mesh::n_cells() const
+  {
+    return impl->cells.size();
+  }
+
+
+
+  const std::vector<Utilities::Point3> &
+  Mesh::vertices() const
+  {
+    return impl->vertices;
+  }
+
+
+
+  const std::vector<std::array<unsigned int, 4>> &
+  Mesh::cells() const
+  {
+    return impl->cells;
+  }
+
+
+
+  const std::vector<SurfaceFace> &
+  Mesh::surface_faces() const
+  {
+    return impl->surface_faces;
+  }
+
+
+
+  const std::vector<bool> &
+  Mesh::on_surface() const
+  {
+    return impl->on_surface;
+  }
+
+
+
+  unsigned int
+  Mesh::n_surface_vertices() const
+  {
+    return impl->n_surface_vertices;
+  }
+
+
+
+  long
+  Mesh::node_id(const unsigned int v) const
+  {
+    return impl->node_ids[v];
+  }
+
+
+
+  std::optional<unsigned int>
+  Mesh::vertex_of_node_id(const long id) const
+  {
+    const auto it = impl->vertex_of_id.find(id);
+    if (it == impl->vertex_of_id.end())
+      return std::nullopt;
+    return it->second;
+  }
+
+
+
+  double
+  Mesh::volume() const
+  {
+    return impl->volume;
+  }
+
+
+
+  double
+  Mesh::min_cell_volume() const
+  {
+    return impl->min_volume;
+  }
+
+
+
+  std::pair<Utilities::Point3, Utilities::Point3>
+  Mesh::bounding_box() const
+  {
+    return {impl->lower, impl->upper};
+  }
+
+
+
+  double
+  Mesh::diameter() const
+  {
+    return Utilities::distance(impl->lower, impl->upper);
+  }
+
+
+
+  const std::string &
+  Mesh::description() const
+  {
+    return impl->description;
+  }
+
+
+
+  unsigned int
+  Mesh::n_dropped_nodes() const
+  {
+    return impl->n_dropped;
+  }
+} // namespace palpate

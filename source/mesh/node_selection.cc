@@ -1,0 +1,235 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+
+namespace palpate
+{
+  namespace
+  {
+    using Utilities::Point3;
+
+    Point3
+    minus(const Point3 &a, const Point3 &b)
+    {
+      return {{a[0] - b[0], a[1] - b[1], a[2] - b[2]}};
+    }
+
+    double
+    dot(const Point3 &a, const Point3 &b)
+    {
+      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    }
+
+    Point3
+    cross(const Point3 &a, const Point3 &b)
+    {
+      return {{a[1] * b[2] - a[2] * b[1],
+               a[2] * b[0] - a[0] * b[2],
+               a[0] * b[1] - a[1] * b[0]}};
+    }
+
+    /**
+     * Whether the points span at least a plane. Points on one line (or a
+     * single point) leave a rotation free: the stiffness matrix is
+     * singular and no state can be computed.
+     */
+    bool
+    holds_body(const std::vector<Point3> &points, const double length_scale)
+    {
+      if (points.size() < 3)
+        return false;
+      // The two points farthest apart define a line; some point must be
+      // off it by more than round-off.
+      unsigned int a = 0, b = 0;
+      double       best = -1;
+      for (unsigned int i = 0; i < points.size(); ++i)
+        {
+          const double d = Utilities::distance(points[0], points[i]);
+          if (d > best)
+            best = d, a = i;
+        }
+      best = -1;
+      for (unsigned int i = 0; i < points.size(); ++i)
+        {
+          const double d = Utilities::distance(points[a], points[i]);
+          if (d > best)
+            best = d, b = i;
+        }
+      const Point3 axis = minus(points[b], points[a]);
+      if (Utilities::norm(axis) <= 1e-9 * length_scale)
+        return false;
+      for (const auto &p : points)
+        if (Utilities::norm(cross(axis, minus(p, points[a]))) /
+              Utilities::norm(axis) >
+            1e-6 * length_scale)
+          return true;
+      return false;
+    }
+  } // namespace
+
+
+
+  NodeSelection
+  NodeSelection::create(const Scene &scene, const Mesh &mesh)
+  {
+    const auto &f = scene.parameters.boundary_conditions.fixed_nodes;
+    const auto &a = scene.parameters.boundary_conditions.active_node;
+    const auto &x = mesh.vertices();
+    const auto &surface = mesh.on_surface();
+
+    NodeSelection      selection;
+    std::set<unsigned int> fixed;
+    std::string        region_entry;
+    unsigned int       in_region = 0; // nodes in the region, surface or not
+    std::ostringstream description;
+
+    if (f.selection == "boundary id")
+      {
+        region_entry = "Boundary conditions/Fixed nodes/Boundary ids";
+        const std::set<unsigned int> ids(f.boundary_ids.begin(), f.boundary_ids.end());
+        for (const auto &face : mesh.surface_faces())
+          if (ids.count(face.boundary_id))
+            fixed.insert(face.vertices.begin(), face.vertices.end());
+        in_region = fixed.size();
+        description << "nodes on boundary faces with id";
+        for (const auto id : f.boundary_ids)
+          description << " " << id;
+      }
+    else if (f.selection == "box" || f.selection == "half-space")
+      {
+        const bool box = f.selection == "box";
+        region_entry   = box ? "Boundary conditions/Fixed nodes/Box lower corner" :
+                               "Boundary conditions/Fixed nodes/Half-space point";
+        for (unsigned int v = 0; v < x.size(); ++v)
+          {
+            bool inside = true;
+            if (box)
+              {
+                for (unsigned int d = 0; d < 3; ++d)
+                  inside = inside && x[v][d] >= f.box_lower_corner[d] &&
+                           x[v][d] <= f.box_upper_corner[d];
+              }
+            else
+              inside = dot(minus(x[v], f.half_space_point),
+                           f.half_space_normal) >= 0;
+            if (inside)
+              {
+                ++in_region;
+                if (!f.surface_nodes_only || surface[v])
+                  fixed.insert(v);
+              }
+          }
+        if (box)
+          description << "nodes in the box [" << Utilities::to_string(f.box_lower_corner, 4)
+                      << "] - [" << Utilities::to_string(f.box_upper_corner, 4) << "] m";
+        else
+          description << "nodes x with (x - (" << Utilities::to_string(f.half_space_point, 4)
+                      << ")) . (" << Utilities::to_string(f.half_space_normal, 4)
+                      << ") >= 0";
+        if (f.surface_nodes_only)
+          description << ", surface only";
+      }
+    else // node list
+      {
+        region_entry = "Boundary conditions/Fixed nodes/Node ids";
+        for (const long id : f.node_ids)
+          {
+            const auto v = mesh.vertex_of_node_id(id);
+            if (!v)
+              throw scene.error(region_entry,
+                                "the mesh has no node " + std::to_string(id),
+                                "use node numbers as the mesh file numbers "
+                                "them (Gmsh node tags, VTK point indices "
+                                "from 0); the VTU output shows them as "
+                                "'node id'.");
+            fixed.insert(*v);
+          }
+        in_region = fixed.size();
+        description << "node list (" << fixed.size() << " nodes)";
+      }
+
+    if (fixed.empty())
+      {
+        std::string problem = "the fixed-node selection (" +
+                              description.str() + ") selects no node";
+        if (in_region > 0)
+          problem += ": the region holds " + std::to_string(in_region) +
+                     " nodes, but none on the surface";
+        const auto box = mesh.bounding_box();
+        throw scene.error(region_entry,
+                          problem + ", so nothing holds the body",
+                          "move the region onto the body, whose bounding box "
+                          "is [" +
+                            Utilities::to_string(box.first, 4) + "] - [" +
+                            Utilities::to_string(box.second, 4) +
+                            "] m, or set Surface nodes only = false.");
+      }
+
+    selection.fixed_vertices.assign(fixed.begin(), fixed.end());
+    {
+      std::vector<Point3> points;
+      for (const unsigned int v : selection.fixed_vertices)
+        points.push_back(x[v]);
+      if (!holds_body(points, mesh.diameter()))
+        throw scene.error(region_entry,
+                          "the " + std::to_string(points.size()) +
+                            " fixed node(s) lie on one line, so the body "
+                            "could still rotate about it: no equilibrium "
+                            "state is unique",
+                          "fix at least three nodes that are not on one "
+                          "line, e.g. by enlarging the region.");
+    }
+    selection.fixed_description = description.str();
+
+    // The active node.
+    if (a.selection == "node id")
+      {
+        const auto v = mesh.vertex_of_node_id(a.node_id);
+        if (!v)
+          throw scene.error("Boundary conditions/Active node/Node id",
+                            "the mesh has no node " + std::to_string(a.node_id),
+                            "use a node number as the mesh file numbers it, or "
+                            "Selection = nearest surface node.");
+        if (!surface[*v])
+          throw scene.error("Boundary conditions/Active node/Node id",
+                            "node " + std::to_string(a.node_id) +
+                              " is inside the body, not on its surface",
+                            "the haptic probe touches the surface: choose a "
+                            "surface node, or Selection = nearest surface "
+                            "node with a Point on the skin.");
+        selection.active_vertex = *v;
+      }
+    else
+      {
+        double best = std::numeric_limits<double>::max();
+        for (unsigned int v = 0; v < x.size(); ++v)
+          if (surface[v] && Utilities::distance(x[v], a.point) < best)
+            {
+              best                    = Utilities::distance(x[v], a.point);
+              selection.active_vertex = v;
+            }
+        selection.active_distance = best;
+      }
+    if (fixed.count(selection.active_vertex))
+      throw scene.error(a.selection == "node id" ?
+                          "Boundary conditions/Active node/Node id" :
+                          "Boundary conditions/Active node/Point",
+                        "the active node (node " +
+                          std::to_string(mesh.node_id(selection.active_vertex)) +
+                          " at " +
+                          Utilities::to_string(x[selection.active_vertex], 4) +
+                          " m) is also a fixed node, so it cannot move",
+                        "choose an active node outside the fixed region, or "
+                        "shrink the region.");
+    return selection;
+  }
+} // namespace palpate

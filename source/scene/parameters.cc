@@ -1,0 +1,986 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/scene/parameters.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <sstream>
+
+namespace palpate
+{
+  namespace Parameters
+  {
+    using namespace dealii;
+
+    namespace
+    {
+      /** Pattern of a 3-vector entry "x, y, z". */
+      Patterns::List
+      point_pattern()
+      {
+        return Patterns::List(Patterns::Double(), 3, 3, ",");
+      }
+
+      Point3
+      get_point(ParameterHandler &prm, const std::string &name)
+      {
+        return Utilities::parse_point(prm.get(name));
+      }
+
+      template <typename T>
+      std::vector<T>
+      get_list(ParameterHandler &prm, const std::string &name)
+      {
+        std::vector<T> values;
+        for (const auto &piece : Utilities::split(prm.get(name), ','))
+          if (!piece.empty())
+            values.push_back(static_cast<T>(std::stol(piece)));
+        return values;
+      }
+    } // namespace
+
+
+
+    void
+    Mesh::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Mesh");
+      {
+        prm.declare_entry("Source",
+                          "blob",
+                          Patterns::Selection("file|beam|blob"),
+                          "Where the tetrahedral mesh of the body comes from: "
+                          "a mesh file, or one of the built-in generators "
+                          "(a rectangular beam, an organ-like blob). The "
+                          "generators need no external data.");
+        prm.declare_entry(
+          "File name",
+          "",
+          Patterns::FileName(),
+          "Mesh file read when Source = file: Gmsh .msh (format 2.2 or "
+          "v1, ASCII), legacy VTK .vtk (ASCII UNSTRUCTURED_GRID) or "
+          ".vtu (ASCII or base64 binary, uncompressed). Only linear "
+          "tetrahedra form the body; triangles set boundary ids. A relative "
+          "path is relative to the directory of the scene file.");
+        prm.declare_entry("Scale factor",
+                          "1",
+                          Patterns::Double(0.),
+                          "Metres per length unit of the mesh file: every "
+                          "coordinate is multiplied by it (m/unit). The "
+                          "generators produce metres and ignore it.");
+
+        prm.enter_subsection("Beam");
+        {
+          prm.declare_entry("Length",
+                            "0.1",
+                            Patterns::Double(0.),
+                            "Length of the beam along x (m). The beam spans "
+                            "[0, Length] x [-Width/2, Width/2] x "
+                            "[-Height/2, Height/2].");
+          prm.declare_entry("Width",
+                            "0.02",
+                            Patterns::Double(0.),
+                            "Width of the beam along y (m).");
+          prm.declare_entry("Height",
+                            "0.02",
+                            Patterns::Double(0.),
+                            "Height of the beam along z (m).");
+          prm.declare_entry("Subdivisions",
+                            "10, 2, 2",
+                            Patterns::List(Patterns::Integer(1), 3, 3, ","),
+                            "Number of hexahedral blocks along x, y, z; each "
+                            "block is split into tetrahedra (dimensionless).");
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Blob");
+        {
+          prm.declare_entry("Semi-axes",
+                            "0.125, 0.09, 0.07",
+                            point_pattern(),
+                            "Semi-axes of the ellipsoid the organ-like blob is "
+                            "built from, along x, y, z (m). The default gives "
+                            "a liver-sized body, 25 cm long.");
+          prm.declare_entry("Refinements",
+                            "1",
+                            Patterns::Integer(0, 3),
+                            "Number of uniform refinements of the coarse "
+                            "ball mesh before it is split into tetrahedra "
+                            "(dimensionless). 1 gives about 1300 tetrahedra.");
+        }
+        prm.leave_subsection();
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Mesh::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Mesh");
+      {
+        source       = prm.get("Source");
+        file_name    = prm.get("File name");
+        scale_factor = prm.get_double("Scale factor");
+
+        prm.enter_subsection("Beam");
+        {
+          beam_length      = prm.get_double("Length");
+          beam_width       = prm.get_double("Width");
+          beam_height      = prm.get_double("Height");
+          const auto sub   = get_list<unsigned int>(prm, "Subdivisions");
+          beam_subdivisions_length = sub[0];
+          beam_subdivisions_width  = sub[1];
+          beam_subdivisions_height = sub[2];
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Blob");
+        {
+          blob_semi_axes   = get_point(prm, "Semi-axes");
+          blob_refinements = prm.get_integer("Refinements");
+        }
+        prm.leave_subsection();
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    FixedNodes::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Fixed nodes");
+      {
+        prm.declare_entry(
+          "Selection",
+          "half-space",
+          Patterns::Selection("boundary id|box|half-space|node list"),
+          "How the nodes held at zero displacement (homogeneous Dirichlet) "
+          "are chosen: all nodes on boundary faces with given ids, the nodes "
+          "inside an axis-aligned box, the nodes in a half-space, or an "
+          "explicit list of node numbers.");
+        prm.declare_entry("Boundary ids",
+                          "1",
+                          Patterns::List(Patterns::Integer(0), 1),
+                          "Boundary ids whose faces' nodes are fixed, for "
+                          "Selection = boundary id (dimensionless). Gmsh "
+                          "files set them with physical tags of triangles.");
+        prm.declare_entry("Box lower corner",
+                          "-1, -1, -1",
+                          point_pattern(),
+                          "Lower corner of the box for Selection = box, in "
+                          "scaled mesh coordinates (m).");
+        prm.declare_entry("Box upper corner",
+                          "1, 1, 1",
+                          point_pattern(),
+                          "Upper corner of the box for Selection = box, in "
+                          "scaled mesh coordinates (m).");
+        prm.declare_entry("Half-space point",
+                          "0, 0, -0.04",
+                          point_pattern(),
+                          "A point on the plane bounding the half-space for "
+                          "Selection = half-space, in scaled mesh "
+                          "coordinates (m).");
+        prm.declare_entry("Half-space normal",
+                          "0, 0, -1",
+                          point_pattern(),
+                          "Direction pointing into the fixed half-space: "
+                          "nodes x with (x - point) . normal >= 0 are fixed "
+                          "(dimensionless, need not be normalised).");
+        prm.declare_entry("Node ids",
+                          "",
+                          Patterns::List(Patterns::Integer(0), 0),
+                          "Node numbers for Selection = node list, as the "
+                          "mesh file numbers them: Gmsh node tags, VTK/VTU "
+                          "point indices (from 0), generator vertex indices. "
+                          "The VTU output shows them as 'node id'.");
+        prm.declare_entry("Surface nodes only",
+                          "true",
+                          Patterns::Bool(),
+                          "If true, only nodes on the surface of the body "
+                          "inside the region are fixed (the body is held by "
+                          "its skin, as by a ligament); if false, interior "
+                          "nodes in the region are fixed as well.");
+        prm.declare_entry(
+          "Treatment",
+          "elimination",
+          Patterns::Selection("elimination|multipliers"),
+          "How the zero displacement of fixed nodes enters the system: by "
+          "eliminating their unknowns (smaller system), or by Lagrange "
+          "multipliers as in the paper (their values are the reactions, N). "
+          "Both give the same state.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    FixedNodes::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Fixed nodes");
+      {
+        selection          = prm.get("Selection");
+        boundary_ids       = get_list<unsigned int>(prm, "Boundary ids");
+        box_lower_corner   = get_point(prm, "Box lower corner");
+        box_upper_corner   = get_point(prm, "Box upper corner");
+        half_space_point   = get_point(prm, "Half-space point");
+        half_space_normal  = get_point(prm, "Half-space normal");
+        node_ids           = get_list<long>(prm, "Node ids");
+        surface_nodes_only = prm.get_bool("Surface nodes only");
+        treatment          = prm.get("Treatment");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    ActiveNode::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Active node");
+      {
+        prm.declare_entry("Selection",
+                          "nearest surface node",
+                          Patterns::Selection("nearest surface node|node id"),
+                          "How the active node (the surface node that follows "
+                          "the haptic interaction point) is chosen.");
+        prm.declare_entry("Point",
+                          "0, 0, 0.07",
+                          point_pattern(),
+                          "For Selection = nearest surface node: the surface "
+                          "node closest to this point becomes active, in "
+                          "scaled mesh coordinates (m).");
+        prm.declare_entry("Node id",
+                          "0",
+                          Patterns::Integer(0),
+                          "For Selection = node id: the node number as the "
+                          "mesh file numbers it (see Fixed nodes / Node ids).");
+        prm.declare_entry(
+          "Prescribed displacement",
+          "0, 0, 0",
+          point_pattern(),
+          "Displacement of the active node from its rest position for a "
+          "static solve (`palpate solve`, or `palpate scene.prm` when it is "
+          "non-zero), in metres; `palpate solve --to x,y,z` overrides it.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    ActiveNode::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Active node");
+      {
+        selection               = prm.get("Selection");
+        point                   = get_point(prm, "Point");
+        node_id                 = prm.get_integer("Node id");
+        prescribed_displacement = get_point(prm, "Prescribed displacement");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    BoundaryConditions::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Boundary conditions");
+      {
+        FixedNodes::declare_parameters(prm);
+        ActiveNode::declare_parameters(prm);
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    BoundaryConditions::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Boundary conditions");
+      {
+        fixed_nodes.parse_parameters(prm);
+        active_node.parse_parameters(prm);
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    bool
+    MaterialModel::incompressible() const
+    {
+      return model_name == "Mooney-Rivlin" && mr_incompressibility == "exact";
+    }
+
+
+
+    void
+    MaterialModel::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Material model");
+      {
+        prm.declare_entry(
+          "Model name",
+          "St.Venant-Kirchhoff",
+          Patterns::Selection("St.Venant-Kirchhoff|Neo-Hookean|Mooney-Rivlin"),
+          "The hyperelastic constitutive law: St.Venant-Kirchhoff (linear "
+          "in the Green strain; softens and may invert under strong "
+          "compression), compressible Neo-Hookean, or incompressible "
+          "Mooney-Rivlin (pressure multiplier field).");
+        prm.declare_entry("Density",
+                          "1060",
+                          Patterns::Double(0.),
+                          "Mass density of the tissue in the reference "
+                          "configuration (kg/m^3); used only when the "
+                          "gravity effect is on. 1060 is liver tissue.");
+
+        prm.enter_subsection("St.Venant-Kirchhoff");
+        {
+          prm.declare_entry("Young's modulus",
+                            "15465",
+                            Patterns::Double(0.),
+                            "Young's modulus E (Pa). The Lame parameters are "
+                            "lambda = E nu/((1+nu)(1-2nu)), mu = E/(2(1+nu)).");
+          prm.declare_entry("Poisson's ratio",
+                            "0.49",
+                            Patterns::Double(-1., 0.5),
+                            "Poisson's ratio nu (dimensionless), -1 < nu < "
+                            "0.5.");
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Neo-Hookean");
+        {
+          prm.declare_entry("Young's modulus",
+                            "15465",
+                            Patterns::Double(0.),
+                            "Young's modulus E of the small-strain limit (Pa). "
+                            "W = mu/2 (tr C - 3) - mu ln J + lambda/2 (ln J)^2 "
+                            "with the Lame parameters of E and nu.");
+          prm.declare_entry("Poisson's ratio",
+                            "0.49",
+                            Patterns::Double(-1., 0.5),
+                            "Poisson's ratio nu of the small-strain limit "
+                            "(dimensionless), -1 < nu < 0.5.");
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Mooney-Rivlin");
+        {
+          prm.declare_entry("C10",
+                            "2148",
+                            Patterns::Double(0.),
+                            "Coefficient of (I1 - 3) in the strain energy "
+                            "(Pa). The shear modulus is mu = 2 (C10 + C01); "
+                            "the defaults give mu = E/3 for the paper's "
+                            "E = 15465 Pa with C01/C10 = 0.2.");
+          prm.declare_entry("C01",
+                            "429.6",
+                            Patterns::Double(0.),
+                            "Coefficient of (I2 - 3) in the strain energy "
+                            "(Pa).");
+          prm.declare_entry("Incompressibility",
+                            "exact",
+                            Patterns::Selection("exact|penalty"),
+                            "exact: J = 1 is imposed by a pressure field that "
+                            "acts as a Lagrange multiplier (mixed u-p "
+                            "elements, as in the paper); penalty: nearly "
+                            "incompressible with the bulk modulus below.");
+          prm.declare_entry("Bulk modulus",
+                            "1e6",
+                            Patterns::Double(0.),
+                            "Bulk modulus kappa of the volumetric energy "
+                            "kappa/2 (J - 1)^2 for Incompressibility = "
+                            "penalty (Pa).");
+          prm.declare_entry("Element",
+                            "P1-P1",
+                            Patterns::Selection("P1-P1|Taylor-Hood"),
+                            "Displacement-pressure element pair for exact "
+                            "incompressibility: P1-P1 (the paper's, one "
+                            "pressure per node, not inf-sup stable) or "
+                            "Taylor-Hood P2-P1 (stable).");
+          prm.declare_entry("Stabilization",
+                            "Brezzi-Pitkaranta",
+                            Patterns::Selection("none|Brezzi-Pitkaranta"),
+                            "Pressure stabilisation for P1-P1: none, or the "
+                            "Brezzi-Pitkaranta term -alpha h^2/mu (grad p, "
+                            "grad q) that suppresses checkerboard pressure.");
+          prm.declare_entry("Stabilization factor",
+                            "0.05",
+                            Patterns::Double(0.),
+                            "alpha of the Brezzi-Pitkaranta term "
+                            "(dimensionless).");
+        }
+        prm.leave_subsection();
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    MaterialModel::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Material model");
+      {
+        model_name = prm.get("Model name");
+        density    = prm.get_double("Density");
+
+        prm.enter_subsection("St.Venant-Kirchhoff");
+        {
+          stvk_youngs_modulus = prm.get_double("Young's modulus");
+          stvk_poissons_ratio = prm.get_double("Poisson's ratio");
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Neo-Hookean");
+        {
+          nh_youngs_modulus = prm.get_double("Young's modulus");
+          nh_poissons_ratio = prm.get_double("Poisson's ratio");
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Mooney-Rivlin");
+        {
+          mr_c10                  = prm.get_double("C10");
+          mr_c01                  = prm.get_double("C01");
+          mr_incompressibility    = prm.get("Incompressibility");
+          mr_bulk_modulus         = prm.get_double("Bulk modulus");
+          mr_element              = prm.get("Element");
+          mr_stabilization        = prm.get("Stabilization");
+          mr_stabilization_factor = prm.get_double("Stabilization factor");
+        }
+        prm.leave_subsection();
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Discretization::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Discretization");
+      {
+        prm.declare_entry("Polynomial degree",
+                          "1",
+                          Patterns::Integer(1, 2),
+                          "Degree of the Lagrange elements for the "
+                          "displacement: 1 (linear tetrahedra, the paper's) "
+                          "or 2 (quadratic, 10 nodes).");
+        prm.declare_entry(
+          "Quadrature order",
+          "0",
+          Patterns::Integer(0, 4),
+          "Number of Gauss points per direction of the simplex quadrature "
+          "rule (QGaussSimplex). 0 picks the rule that is exact for "
+          "St.Venant-Kirchhoff: 1 point for linear, 3 for quadratic "
+          "elements.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Discretization::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Discretization");
+      {
+        polynomial_degree = prm.get_integer("Polynomial degree");
+        quadrature_order  = prm.get_integer("Quadrature order");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Effects::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Effects");
+      {
+        prm.declare_entry("Gravity",
+                          "false",
+                          Patterns::Bool(),
+                          "Whether the body carries its weight, the body "
+                          "force rho g (rho from Material model / Density). "
+                          "Off: no body-force term is assembled at all.");
+        prm.declare_entry("Gravitational acceleration",
+                          "0, 0, -9.81",
+                          point_pattern(),
+                          "Gravitational acceleration vector g (m/s^2).");
+        prm.declare_entry("Shape output",
+                          "false",
+                          Patterns::Bool(),
+                          "Whether the whole displacement field is "
+                          "interpolated for rendering during an interaction "
+                          "(the shape interpolator) and written as VTU/PVD "
+                          "frames. Off: the shape interpolator does not run.");
+        prm.declare_entry("Shape output rate",
+                          "30",
+                          Patterns::Double(0.),
+                          "Rate of the shape interpolator (Hz).");
+        prm.declare_entry("VTU export",
+                          "false",
+                          Patterns::Bool(),
+                          "Whether computed states (deformed mesh, "
+                          "displacement, fixed and active nodes) are written "
+                          "as VTU files for ParaView.");
+        prm.declare_entry("Force log",
+                          "false",
+                          Patterns::Bool(),
+                          "Whether the force at the active node is logged to "
+                          "a CSV file (time s, position m, force N).");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Effects::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Effects");
+      {
+        gravity                    = prm.get_bool("Gravity");
+        gravitational_acceleration = get_point(prm, "Gravitational acceleration");
+        shape_output               = prm.get_bool("Shape output");
+        shape_output_rate          = prm.get_double("Shape output rate");
+        vtu_export                 = prm.get_bool("VTU export");
+        force_log                  = prm.get_bool("Force log");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    NonlinearSolver::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Nonlinear solver");
+      {
+        prm.declare_entry("Number of increments",
+                          "1",
+                          Patterns::Integer(1),
+                          "Minimum number n of equal increments the path "
+                          "x_a -> x_b of the active node is split into "
+                          "(incremental staging, dimensionless).");
+        prm.declare_entry("Maximum increment length",
+                          "0.01",
+                          Patterns::Double(0.),
+                          "Longest increment of the active node's path (m); "
+                          "a longer path gets more increments. 0 means no "
+                          "limit.");
+        prm.declare_entry("Maximum Newton iterations",
+                          "25",
+                          Patterns::Integer(1),
+                          "Newton iterations allowed per increment before "
+                          "the state is declared a failure point.");
+        prm.declare_entry(
+          "Residual tolerance",
+          "1e-8",
+          Patterns::Double(0.),
+          "Newton converges when the Euclidean norm of the force residual is "
+          "below this times the force scale max(|f_int|, |reactions|, "
+          "1e-6 E L^2) (dimensionless), and the increment test holds.");
+        prm.declare_entry(
+          "Increment tolerance",
+          "1e-8",
+          Patterns::Double(0.),
+          "Newton converges when the largest displacement correction is "
+          "below this times the body's diameter L (dimensionless), and the "
+          "residual test holds.");
+        prm.declare_entry("Line search",
+                          "true",
+                          Patterns::Bool(),
+                          "Whether each Newton step is shortened by a "
+                          "backtracking line search on the residual norm "
+                          "(and to keep every element's det F > 0).");
+        prm.declare_entry("Maximum line search steps",
+                          "8",
+                          Patterns::Integer(1),
+                          "Backtracking steps of the line search before the "
+                          "smallest step is accepted (dimensionless).");
+        prm.declare_entry(
+          "Maximum cutbacks",
+          "0",
+          Patterns::Integer(0),
+          "How often an increment that fails to converge is halved and "
+          "retried before the state becomes a failure point. 0 is the "
+          "paper's fixed staging.");
+        prm.declare_entry("Assembly threads",
+                          "1",
+                          Patterns::Integer(1),
+                          "Threads that assemble one state's residual and "
+                          "tangent (dimensionless). Independent states run "
+                          "on different workers (Engine / Workers).");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    NonlinearSolver::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Nonlinear solver");
+      {
+        n_increments          = prm.get_integer("Number of increments");
+        max_increment_length  = prm.get_double("Maximum increment length");
+        max_newton_iterations = prm.get_integer("Maximum Newton iterations");
+        residual_tolerance    = prm.get_double("Residual tolerance");
+        increment_tolerance   = prm.get_double("Increment tolerance");
+        line_search           = prm.get_bool("Line search");
+        max_line_search_steps = prm.get_integer("Maximum line search steps");
+        max_cutbacks          = prm.get_integer("Maximum cutbacks");
+        assembly_threads      = prm.get_integer("Assembly threads");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    LinearSolver::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Linear solver");
+      {
+        prm.declare_entry(
+          "Solver",
+          "MUMPS",
+          Patterns::Selection("MUMPS|UMFPACK|KLU|Amesos MUMPS|Amesos KLU"),
+          "Sparse direct solver for the linearised systems. MUMPS is "
+          "called through its C interface with the symmetric indefinite "
+          "LDL^T factorisation; UMFPACK and KLU through SuiteSparse; the "
+          "Amesos variants through Trilinos Amesos, for comparison. All "
+          "analyse the sparsity pattern once per solver.");
+        prm.declare_entry(
+          "Ordering",
+          "METIS",
+          Patterns::Selection("METIS|AMD|AMF|QAMD|PORD|SCOTCH|automatic"),
+          "Fill-reducing ordering MUMPS uses in its analysis (ICNTL(7)).");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    LinearSolver::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Linear solver");
+      {
+        solver   = prm.get("Solver");
+        ordering = prm.get("Ordering");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    StateSpace::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("State space");
+      {
+        prm.declare_entry("Grid spacing",
+                          "0.005",
+                          Patterns::Double(0.),
+                          "Distance h between neighbouring points of the "
+                          "regular grid of active-node positions (m).");
+        prm.declare_entry("Extent",
+                          "0.1",
+                          Patterns::Double(0.),
+                          "Half-width of the grid along each axis, centred "
+                          "on the active node's rest position (m).");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    StateSpace::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("State space");
+      {
+        grid_spacing = prm.get_double("Grid spacing");
+        extent       = prm.get_double("Extent");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Scheduler::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Scheduler");
+      {
+        prm.declare_entry("Cloud radius",
+                          "0.025",
+                          Patterns::Double(0.),
+                          "Radius R of the spherical cloud of grid states "
+                          "kept computed around the haptic interaction point "
+                          "(m).");
+        prm.declare_entry("Rate",
+                          "100",
+                          Patterns::Double(0.),
+                          "Rate at which the scheduler updates the cloud "
+                          "(Hz).");
+        prm.declare_entry("Look-ahead time",
+                          "0.2",
+                          Patterns::Double(0.),
+                          "The cloud is centred on the point the HIP will "
+                          "reach after this time at its current velocity "
+                          "(s); 0 is the paper's cloud around the HIP.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Scheduler::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Scheduler");
+      {
+        cloud_radius    = prm.get_double("Cloud radius");
+        rate            = prm.get_double("Rate");
+        look_ahead_time = prm.get_double("Look-ahead time");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Engine::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Engine");
+      {
+        prm.declare_entry("Type",
+                          "threads",
+                          Patterns::Selection("threads|mpi"),
+                          "Where states are computed: solver workers as "
+                          "threads of this process, or MPI solver servers.");
+        prm.declare_entry("Workers",
+                          "2",
+                          Patterns::Integer(1),
+                          "Number of solver workers, each computing one "
+                          "state at a time with its own FE solver "
+                          "(dimensionless).");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Engine::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Engine");
+      {
+        type    = prm.get("Type");
+        workers = prm.get_integer("Workers");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Trajectory::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Trajectory");
+      {
+        prm.declare_entry(
+          "Type",
+          "straight line",
+          Patterns::Selection("straight line|circle|smooth random|replay"),
+          "Motion of the simulated device's HIP, relative to the active "
+          "node's rest position: a straight line at constant speed, a "
+          "circle, a smooth random walk, or replay of a CSV file.");
+        prm.declare_entry("Direction",
+                          "0, 0, -1",
+                          point_pattern(),
+                          "Direction of the straight line; the circle lies "
+                          "in the plane normal to it (dimensionless).");
+        prm.declare_entry("Speed",
+                          "0.01",
+                          Patterns::Double(0.),
+                          "Speed of the HIP along the trajectory (m/s).");
+        prm.declare_entry("Duration",
+                          "2",
+                          Patterns::Double(0.),
+                          "Duration of the motion (s).");
+        prm.declare_entry("Radius",
+                          "0.01",
+                          Patterns::Double(0.),
+                          "Radius of the circle, and the bound of the smooth "
+                          "random walk (m).");
+        prm.declare_entry("Seed",
+                          "1",
+                          Patterns::Integer(0),
+                          "Seed of the smooth random walk (dimensionless).");
+        prm.declare_entry("File name",
+                          "",
+                          Patterns::FileName(),
+                          "CSV file of timed positions for Type = replay: "
+                          "columns t (s), x, y, z (m, relative to the rest "
+                          "position). Relative to the scene file's "
+                          "directory.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Trajectory::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Trajectory");
+      {
+        type      = prm.get("Type");
+        direction = get_point(prm, "Direction");
+        speed     = prm.get_double("Speed");
+        duration  = prm.get_double("Duration");
+        radius    = prm.get_double("Radius");
+        seed      = prm.get_integer("Seed");
+        file_name = prm.get("File name");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Haptics::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Haptics");
+      {
+        prm.declare_entry("Loop rate",
+                          "1000",
+                          Patterns::Double(0.),
+                          "Rate of the haptic loop that interpolates and "
+                          "sends the force (Hz).");
+        prm.declare_entry("Device",
+                          "simulated",
+                          Patterns::Selection("simulated"),
+                          "The haptic device: a simulated one that follows "
+                          "the trajectory below.");
+        prm.declare_entry("Force limit",
+                          "8",
+                          Patterns::Double(0.),
+                          "Largest force magnitude sent to the device (N).");
+        prm.declare_entry("Maximum force change",
+                          "0.05",
+                          Patterns::Double(0.),
+                          "Largest change of the force vector from one "
+                          "haptic tick to the next (N).");
+        Trajectory::declare_parameters(prm);
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Haptics::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Haptics");
+      {
+        loop_rate        = prm.get_double("Loop rate");
+        device           = prm.get("Device");
+        force_limit      = prm.get_double("Force limit");
+        max_force_change = prm.get_double("Maximum force change");
+        trajectory.parse_parameters(prm);
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Output::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Output");
+      {
+        prm.declare_entry("Directory",
+                          "output",
+                          Patterns::DirectoryName(),
+                          "Directory for every file palpate writes (VTU, "
+                          "logs, summaries), relative to the current "
+                          "working directory; created if missing.");
+        prm.declare_entry("Summary formats",
+                          "",
+                          Patterns::MultipleSelection("csv|json"),
+                          "Machine-readable copies of the run summary, "
+                          "besides the screen: any of csv, json.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Output::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Output");
+      {
+        directory = prm.get("Directory");
+        summary_formats.clear();
+        for (const auto &f : Utilities::split(prm.get("Summary formats"), ','))
+          if (!f.empty())
+            summary_formats.push_back(f);
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    AllParameters::declare_parameters(ParameterHandler &prm)
+    {
+      Mesh::declare_parameters(prm);
+      BoundaryConditions::declare_parameters(prm);
+      MaterialModel::declare_parameters(prm);
+      Discretization::declare_parameters(prm);
+      Effects::declare_parameters(prm);
+      NonlinearSolver::declare_parameters(prm);
+      LinearSolver::declare_parameters(prm);
+      StateSpace::declare_parameters(prm);
+      Scheduler::declare_parameters(prm);
+      Engine::declare_parameters(prm);
+      Haptics::declare_parameters(prm);
+      Output::declare_parameters(prm);
+    }
+
+
+
+    void
+    AllParameters::parse_parameters(ParameterHandler &prm)
+    {
+      mesh.parse_parameters(prm);
+      boundary_conditions.parse_parameters(prm);
+      material_model.parse_parameters(prm);
+      discretization.parse_parameters(prm);
+      effects.parse_parameters(prm);
+      nonlinear_solver.parse_parameters(prm);
+      linear_solver.parse_parameters(prm);
+      state_space.parse_parameters(prm);
+      scheduler.parse_parameters(prm);
+      engine.parse_parameters(prm);
+      haptics.parse_parameters(prm);
+      output.parse_parameters(prm);
+    }
+  } // namespace Parameters
+} // namespace palpate

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// palpate's test header (Debian's deal.II does not install deal.II's own
+// tests.h). Tests write their results with deallog after initlog(); the
+// deal.II harness compares the file "output" with the test's .output file
+// using numdiff.
+
+#ifndef palpate_tests_h
+#define palpate_tests_h
+
+#include <palpate/base/environment.h>
+
+#include <deal.II/base/logstream.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+using dealii::deallog;
+
+/** The project's source tree, the shared data and the palpate program. */
+static const std::string palpate_source_dir = PALPATE_SOURCE_DIR;
+static const std::string palpate_shared_dir = PALPATE_SHARED_DIR;
+static const std::string palpate_executable = PALPATE_EXECUTABLE;
+
+/** Send deallog to the file "output", with @p precision digits. */
+inline void
+initlog(const unsigned int precision = 6)
+{
+  static std::ofstream logfile("output");
+  deallog.attach(logfile, false);
+  deallog.depth_console(0);
+  deallog << std::setprecision(precision);
+  logfile << std::setprecision(precision);
+}
+
+/** What running the palpate program produced. */
+struct ProgramRun
+{
+  int         exit_status;
+  std::string output; // stdout and stderr, interleaved
+};
+
+/** Run `palpate ARGS` in the current directory and capture everything. */
+inline ProgramRun
+run_palpate(const std::string &arguments)
+{
+  const std::string command = palpate_executable + " " + arguments + " 2>&1";
+  FILE *            pipe    = popen(command.c_str(), "r");
+  ProgramRun        run{-1, ""};
+  if (pipe == nullptr)
+    return run;
+  std::array<char, 4096> buffer;
+  std::size_t            n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  run.exit_status  = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+/** Write @p text to the file @p name. */
+inline void
+write_file(const std::string &name, const std::string &text)
+{
+  std::ofstream(name) << text;
+}
+
+#endif
