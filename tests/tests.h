@@ -13,13 +13,14 @@
 
 #include <deal.II/base/logstream.h>
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 using dealii::deallog;
 
@@ -51,7 +52,7 @@ inline ProgramRun
 run_palpate(const std::string &arguments)
 {
   const std::string command = palpate_executable + " " + arguments + " 2>&1";
-  FILE *            pipe    = popen(command.c_str(), "r");
+  FILE             *pipe    = popen(command.c_str(), "r");
   ProgramRun        run{-1, ""};
   if (pipe == nullptr)
     return run;

@@ -27,13 +27,13 @@ namespace palpate
 
 
   void
-  print_scene_report(std::ostream &       out,
-                     const Scene &        scene,
-                     const Mesh &         mesh,
+  print_scene_report(std::ostream        &out,
+                     const Scene         &scene,
+                     const Mesh          &mesh,
                      const NodeSelection &nodes)
   {
-    const auto &p = scene.parameters;
-    const auto  box = mesh.bounding_box();
+    const auto        &p   = scene.parameters;
+    const auto         box = mesh.bounding_box();
     std::ostringstream s;
     s << std::setprecision(4);
 
@@ -44,6 +44,8 @@ namespace palpate
         << std::setprecision(4) << " m/unit";
     s << "\n  nodes:         " << mesh.n_vertices() << " ("
       << mesh.n_surface_vertices() << " on the surface)";
+    if (mesh.n_merged_nodes() > 0)
+      s << "; " << mesh.n_merged_nodes() << " repeated nodes merged";
     if (mesh.n_dropped_nodes() > 0)
       s << "; " << mesh.n_dropped_nodes() << " unused nodes dropped";
     s << "\n  tetrahedra:    " << mesh.n_cells() << ", volume " << mesh.volume()
@@ -53,26 +55,27 @@ namespace palpate
       << box.second[0] - box.first[0] << " x " << box.second[1] - box.first[1]
       << " x " << box.second[2] - box.first[2] << " m\n";
 
-    const auto &f = p.boundary_conditions.fixed_nodes;
-    const auto &a = p.boundary_conditions.active_node;
+    const auto &f  = p.boundary_conditions.fixed_nodes;
+    const auto &a  = p.boundary_conditions.active_node;
     const auto &xa = mesh.vertices()[nodes.active_vertex];
     s << "Boundary conditions\n"
       << "  fixed nodes:   " << nodes.fixed_vertices.size() << " ("
       << nodes.fixed_description << "), by " << f.treatment << "\n"
-      << "  active node:   node " << mesh.node_id(nodes.active_vertex) << " at ("
-      << Utilities::to_string(xa, 4) << ") m";
+      << "  active node:   node " << mesh.node_id(nodes.active_vertex)
+      << " at (" << Utilities::to_string(xa, 4) << ") m";
     if (a.selection == "nearest surface node")
       s << ", the surface node nearest to (" << Utilities::to_string(a.point, 4)
         << ") m, " << 1000 * nodes.active_distance << " mm away";
     s << "\n";
 
     const auto &m = p.material_model;
-    s << "Material\n  model:         " << m.model_name;
+    s << "Material\n  model:         " << m.model_name << std::setprecision(6);
     if (m.model_name == "St.Venant-Kirchhoff")
       s << ", E = " << m.stvk_youngs_modulus
         << " Pa, nu = " << m.stvk_poissons_ratio;
     else if (m.model_name == "Neo-Hookean")
-      s << ", E = " << m.nh_youngs_modulus << " Pa, nu = " << m.nh_poissons_ratio;
+      s << ", E = " << m.nh_youngs_modulus
+        << " Pa, nu = " << m.nh_poissons_ratio;
     else
       {
         s << ", C10 = " << m.mr_c10 << " Pa, C01 = " << m.mr_c01 << " Pa, ";
@@ -87,9 +90,9 @@ namespace palpate
     std::vector<std::string> on, off;
     (p.effects.gravity ? on : off).push_back("gravity");
     (m.incompressible() ? on : off)
-      .push_back(m.incompressible() ? "incompressibility (implied by " +
-                                        m.model_name + ")" :
-                                      "incompressibility");
+      .push_back(m.incompressible() ?
+                   "incompressibility (implied by " + m.model_name + ")" :
+                   "incompressibility");
     (p.effects.shape_output ? on : off).push_back("shape output");
     (p.effects.vtu_export ? on : off).push_back("VTU export");
     (p.effects.force_log ? on : off).push_back("force log");

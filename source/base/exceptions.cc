@@ -45,8 +45,9 @@ namespace palpate
 
   NotAvailableError::NotAvailableError(const std::string &what,
                                        const std::string &where)
-    : std::runtime_error(what + " is not available in this version of palpate."
-                                "\n  " +
+    : std::runtime_error(what +
+                         " is not available in this version of palpate."
+                         "\n  " +
                          where)
   {}
 } // namespace palpate

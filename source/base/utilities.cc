@@ -70,7 +70,7 @@ namespace palpate
 
 
     std::string
-    closest_match(const std::string &             word,
+    closest_match(const std::string              &word,
                   const std::vector<std::string> &candidates)
     {
       std::string  best;
@@ -108,11 +108,20 @@ namespace palpate
 
 
     std::string
+    to_string(const double x, const unsigned int precision)
+    {
+      std::ostringstream s;
+      s << std::setprecision(precision) << x;
+      return s.str();
+    }
+
+
+
+    std::string
     to_string(const Point3 &p, const unsigned int precision)
     {
       std::ostringstream s;
-      s << std::setprecision(precision) << p[0] << ", " << p[1] << ", "
-        << p[2];
+      s << std::setprecision(precision) << p[0] << ", " << p[1] << ", " << p[2];
       return s.str();
     }
 
@@ -139,8 +148,7 @@ namespace palpate
               used = 0;
             }
           if (used == 0 || used != pieces[d].size() || !std::isfinite(p[d]))
-            throw std::invalid_argument("'" + pieces[d] +
-                                        "' in '" + text +
+            throw std::invalid_argument("'" + pieces[d] + "' in '" + text +
                                         "' is not a finite number");
         }
       return p;

@@ -15,7 +15,8 @@ namespace palpate
   {
     /** The raw description of a simplex triangulation. */
     MeshData
-    to_mesh_data(const dealii::Triangulation<3> &tria, const std::string &format)
+    to_mesh_data(const dealii::Triangulation<3> &tria,
+                 const std::string              &format)
     {
       MeshData data;
       data.format = format;
@@ -37,10 +38,9 @@ namespace palpate
           const auto  e = [&](unsigned int a, unsigned int d) {
             return x[t[a]][d] - x[t[0]][d];
           };
-          const double det =
-            e(1, 0) * (e(2, 1) * e(3, 2) - e(2, 2) * e(3, 1)) -
-            e(1, 1) * (e(2, 0) * e(3, 2) - e(2, 2) * e(3, 0)) +
-            e(1, 2) * (e(2, 0) * e(3, 1) - e(2, 1) * e(3, 0));
+          const double det = e(1, 0) * (e(2, 1) * e(3, 2) - e(2, 2) * e(3, 1)) -
+                             e(1, 1) * (e(2, 0) * e(3, 2) - e(2, 2) * e(3, 0)) +
+                             e(1, 2) * (e(2, 0) * e(3, 1) - e(2, 1) * e(3, 0));
           if (det < 0)
             std::swap(t[2], t[3]);
           data.tetrahedra.push_back(t);
@@ -78,7 +78,9 @@ namespace palpate
 
     // deal.II 9.4 cannot colorize simplex rectangles; set the ids by the
     // position of each boundary face's centre.
-    const double half[3] = {p.beam_length / 2, p.beam_width / 2, p.beam_height / 2};
+    const double half[3]   = {p.beam_length / 2,
+                              p.beam_width / 2,
+                              p.beam_height / 2};
     const double centre[3] = {p.beam_length / 2, 0, 0};
     for (const auto &cell : tria.active_cell_iterators())
       for (const unsigned int f : cell->face_indices())
@@ -118,9 +120,9 @@ namespace palpate
     const auto a = p.blob_semi_axes;
     dealii::GridTools::transform(
       [a](const dealii::Point<3> &x) {
-        const double lobe   = 1.0 + 0.25 * x[0];
-        const double flat   = 0.15 * (1.0 - x[0] * x[0] - x[1] * x[1]);
-        const double z      = x[2] < 0 ? x[2] * (1.0 - flat) : x[2];
+        const double lobe = 1.0 + 0.25 * x[0];
+        const double flat = 0.15 * (1.0 - x[0] * x[0] - x[1] * x[1]);
+        const double z    = x[2] < 0 ? x[2] * (1.0 - flat) : x[2];
         return dealii::Point<3>(a[0] * x[0],
                                 a[1] * x[1] * (1.0 + 0.15 * x[0]),
                                 a[2] * z * lobe);

@@ -35,6 +35,7 @@ namespace palpate
     Utilities::Point3                        lower, upper;
     std::string                              description;
     unsigned int                             n_dropped = 0;
+    unsigned int                             n_merged  = 0;
   };
 
   namespace
@@ -89,7 +90,7 @@ namespace palpate
   Mesh::Mesh(const MeshData &data, const double scale, const std::string &file)
     : impl(std::make_unique<Impl>())
   {
-    const auto error = [&](const unsigned int  line,
+    const auto error = [&](const unsigned int line,
                            const std::string &entry,
                            const std::string &problem,
                            const std::string &fix) {
@@ -103,11 +104,26 @@ namespace palpate
                   "palpate needs a volume mesh of linear tetrahedra; a "
                   "surface mesh must first be meshed, e.g. with TetGen.");
 
+    // Nodes with identical coordinates are one node: files written cell by
+    // cell (deal.II's GridOut and DataOut, some VTU exporters) repeat every
+    // vertex once per cell.
+    std::vector<unsigned int> canonical(data.nodes.size());
+    {
+      std::map<Utilities::Point3, unsigned int> first_at;
+      for (unsigned int i = 0; i < data.nodes.size(); ++i)
+        {
+          const auto it = first_at.emplace(data.nodes[i], i).first;
+          canonical[i]  = it->second;
+          if (it->second != i)
+            ++impl->n_merged;
+        }
+    }
+
     // Keep only the nodes that tetrahedra use, in file order.
     std::vector<int> new_index(data.nodes.size(), -1);
     for (const auto &t : data.tetrahedra)
       for (const unsigned int v : t)
-        new_index[v] = 0;
+        new_index[canonical[v]] = 0;
     for (unsigned int i = 0; i < data.nodes.size(); ++i)
       if (new_index[i] == 0)
         {
@@ -118,8 +134,10 @@ namespace palpate
           impl->node_ids.push_back(data.node_ids[i]);
           impl->vertex_of_id[data.node_ids[i]] = new_index[i];
         }
-      else
+      else if (canonical[i] == i)
         ++impl->n_dropped;
+    for (unsigned int i = 0; i < data.nodes.size(); ++i)
+      new_index[i] = new_index[canonical[i]];
 
     // Bounding box and length scale.
     impl->lower = impl->upper = impl->vertices[0];
@@ -148,7 +166,7 @@ namespace palpate
                       element_name(data, c),
                       "the tetrahedron uses the same node twice",
                       "the mesh is broken; regenerate it (TetGen, Gmsh).");
-        const double v = signed_volume(impl->vertices[t[0]],
+        const double       v = signed_volume(impl->vertices[t[0]],
                                        impl->vertices[t[1]],
                                        impl->vertices[t[2]],
                                        impl->vertices[t[3]]);
@@ -162,7 +180,7 @@ namespace palpate
                       element_name(data, c) + " (nodes " + nodes.str() + ")",
                       "the tetrahedron is degenerate: its four nodes are "
                       "(nearly) in one plane, volume " +
-                        std::to_string(v) + " m^3",
+                        Utilities::to_string(v, 3) + " m^3",
                       "remesh with a quality bound (TetGen -q, Gmsh "
                       "optimisation) so that no element is flat.");
         if (v < 0)
@@ -170,7 +188,7 @@ namespace palpate
                       element_name(data, c) + " (nodes " + nodes.str() + ")",
                       "the tetrahedron is inverted: its nodes are ordered "
                       "so that its volume is negative (" +
-                        std::to_string(v) + " m^3)",
+                        Utilities::to_string(v, 3) + " m^3)",
                       "write the nodes of every tetrahedron in the standard "
                       "order ((n1-n0) x (n2-n0)) . (n3-n0) > 0, e.g. swap "
                       "its last two nodes; TetGen and Gmsh do this when the "
@@ -182,7 +200,8 @@ namespace palpate
 
     // Faces: a face of one tetrahedron is on the surface, of two is
     // interior, of more is a broken (non-manifold) mesh.
-    std::map<FaceKey, std::pair<unsigned int, std::array<unsigned int, 3>>> faces;
+    std::map<FaceKey, std::pair<unsigned int, std::array<unsigned int, 3>>>
+                              faces;
     static const unsigned int face_vertices[4][3] = {{1, 2, 3},
                                                      {0, 3, 2},
                                                      {0, 1, 3},
@@ -190,10 +209,10 @@ namespace palpate
     for (unsigned int c = 0; c < impl->cells.size(); ++c)
       for (const auto &fv : face_vertices)
         {
-          const std::array<unsigned int, 3> f = {{impl->cells[c][fv[0]],
-                                                  impl->cells[c][fv[1]],
-                                                  impl->cells[c][fv[2]]}};
-          auto &entry = faces[sorted(f)];
+          const std::array<unsigned int, 3> f     = {{impl->cells[c][fv[0]],
+                                                      impl->cells[c][fv[1]],
+                                                      impl->cells[c][fv[2]]}};
+          auto                             &entry = faces[sorted(f)];
           if (++entry.first == 1)
             entry.second = f; // outward orientation from its cell
           if (entry.first > 2)
@@ -298,7 +317,8 @@ namespace palpate
                       e.what(),
                     "check the mesh with the mesher's own tools.");
       }
-    impl->description = data.tetrahedron_lines[0] == 0 && data.format.find("generator") != std::string::npos ?
+    impl->description = data.tetrahedron_lines[0] == 0 &&
+                            data.format.find("generator") != std::string::npos ?
                           "the " + data.format :
                           "'" + file + "' (" + data.format + ")";
   }
@@ -477,5 +497,13 @@ namespace palpate
   Mesh::n_dropped_nodes() const
   {
     return impl->n_dropped;
+  }
+
+
+
+  unsigned int
+  Mesh::n_merged_nodes() const
+  {
+    return impl->n_merged;
   }
 } // namespace palpate

@@ -126,7 +126,7 @@ namespace palpate
 
     /** Index of a node tag; error if the tag was never defined. */
     unsigned int
-    node_index(LineReader &                       reader,
+    node_index(LineReader                         &reader,
                const std::map<long, unsigned int> &tags,
                const long                          tag)
     {
@@ -161,11 +161,13 @@ namespace palpate
             throw reader.error("the $MeshFormat line should read "
                                "'version file-type data-size'",
                                "export the mesh again as Gmsh 2.2 ASCII.");
-          const double version = parse_number<double>(reader, header[0], "version");
+          const double version =
+            parse_number<double>(reader, header[0], "version");
           if (version >= 3.0)
             throw reader.error(
-              "this is a Gmsh " + header[0] + " file; palpate reads the "
-              "formats 2.2 and 1",
+              "this is a Gmsh " + header[0] +
+                " file; palpate reads the "
+                "formats 2.2 and 1",
               "convert it: 'gmsh -save -format msh22 -o out.msh " + filename +
                 "', or in Gmsh: File > Export, Version 2 ASCII.");
           if (header[1] != "0")
@@ -193,8 +195,8 @@ namespace palpate
       bool                         have_nodes = false, have_elements = false;
       const std::string            nodes_begin = legacy ? "$NOD" : "$Nodes";
       const std::string            nodes_end = legacy ? "$ENDNOD" : "$EndNodes";
-      const std::string elements_begin = legacy ? "$ELM" : "$Elements";
-      const std::string elements_end   = legacy ? "$ENDELM" : "$EndElements";
+      const std::string elements_begin       = legacy ? "$ELM" : "$Elements";
+      const std::string elements_end = legacy ? "$ENDELM" : "$EndElements";
 
       bool first = legacy; // the legacy header line is the $NOD line
       while (first || reader.next(line))
@@ -212,7 +214,8 @@ namespace palpate
                     throw reader.error("a node line needs 'number x y z'",
                                        "the file is damaged; export it "
                                        "again.");
-                  const long tag = parse_number<long>(reader, t[0], "node number");
+                  const long tag =
+                    parse_number<long>(reader, t[0], "node number");
                   Utilities::Point3 x;
                   for (unsigned int d = 0; d < 3; ++d)
                     x[d] = parse_number<double>(reader, t[d + 1], "coordinate");
@@ -225,8 +228,7 @@ namespace palpate
                   data.node_ids.push_back(tag);
                 }
               if (reader.expect(nodes_end) != nodes_end)
-                throw reader.error("expected " + nodes_end +
-                                     " after the nodes",
+                throw reader.error("expected " + nodes_end + " after the nodes",
                                    "the node count does not match the "
                                    "nodes; export the file again.");
               have_nodes = true;
@@ -236,17 +238,20 @@ namespace palpate
               if (!have_nodes)
                 throw reader.error("the elements come before the nodes",
                                    "export the file again.");
-              const long n = parse_number<long>(reader,
-                                                reader.expect("the element count"),
-                                                "element count");
+              const long n =
+                parse_number<long>(reader,
+                                   reader.expect("the element count"),
+                                   "element count");
               for (long i = 0; i < n; ++i)
                 {
                   const auto t = tokens_of(reader.expect("an element"));
                   if (t.size() < 3)
                     throw reader.error("an element line is too short",
                                        "the file is damaged.");
-                  const long id = parse_number<long>(reader, t[0], "element number");
-                  const int type = parse_number<int>(reader, t[1], "element type");
+                  const long id =
+                    parse_number<long>(reader, t[0], "element number");
+                  const int type =
+                    parse_number<int>(reader, t[1], "element type");
                   const auto type_it = gmsh_types().find(type);
                   if (type_it == gmsh_types().end())
                     throw reader.error("element " + std::to_string(id) +
@@ -262,7 +267,9 @@ namespace palpate
                       if (t.size() < 5)
                         throw reader.error("an element line is too short",
                                            "the file is damaged.");
-                      physical = parse_number<unsigned int>(reader, t[2], "physical tag");
+                      physical   = parse_number<unsigned int>(reader,
+                                                            t[2],
+                                                            "physical tag");
                       first_node = 5;
                     }
                   else
@@ -271,15 +278,16 @@ namespace palpate
                       const unsigned int n_tags =
                         parse_number<unsigned int>(reader, t[2], "tag count");
                       if (n_tags > 0 && t.size() > 3)
-                        physical = parse_number<unsigned int>(reader, t[3], "physical tag");
+                        physical = parse_number<unsigned int>(reader,
+                                                              t[3],
+                                                              "physical tag");
                       first_node = 3 + n_tags;
                     }
                   const GmshType &gt = type_it->second;
                   if (t.size() != first_node + gt.n_nodes)
                     throw reader.error("element " + std::to_string(id) + " (" +
                                          gt.name + ") should list " +
-                                         std::to_string(gt.n_nodes) +
-                                         " nodes",
+                                         std::to_string(gt.n_nodes) + " nodes",
                                        "the file is damaged; export it "
                                        "again.");
                   std::vector<unsigned int> v(gt.n_nodes);
@@ -389,18 +397,18 @@ namespace palpate
         return parse_number<T>(reader, next(what), what);
       }
 
-      LineReader &             reader;
+      LineReader              &reader;
       std::vector<std::string> tokens;
       unsigned int             position = 0;
     };
 
     /** Turn VTK cells (type + node list) into tetrahedra and triangles. */
     void
-    add_vtk_cells(LineReader &                            reader,
-                  const std::vector<std::vector<long>> &  cells,
-                  const std::vector<int> &                types,
-                  const std::vector<unsigned int> &       lines,
-                  MeshData &                              data)
+    add_vtk_cells(LineReader                           &reader,
+                  const std::vector<std::vector<long>> &cells,
+                  const std::vector<int>               &types,
+                  const std::vector<unsigned int>      &lines,
+                  MeshData                             &data)
     {
       for (unsigned int c = 0; c < cells.size(); ++c)
         {
@@ -411,17 +419,15 @@ namespace palpate
                                "mesh file, cell " + std::to_string(c),
                                "cell " + std::to_string(c) + " has " +
                                  std::to_string(cells[c].size()) +
-                                 " points, its type needs " +
-                                 std::to_string(n),
+                                 " points, its type needs " + std::to_string(n),
                                "the file is damaged; write it again.");
             for (const long p : cells[c])
               if (p < 0 || p >= static_cast<long>(data.nodes.size()))
                 throw InputError(reader.filename,
                                  lines[c],
                                  "mesh file, cell " + std::to_string(c),
-                                 "cell " + std::to_string(c) +
-                                   " uses point " + std::to_string(p) +
-                                   ", but there are only " +
+                                 "cell " + std::to_string(c) + " uses point " +
+                                   std::to_string(p) + ", but there are only " +
                                    std::to_string(data.nodes.size()),
                                  "the file is damaged; write it again.");
           };
@@ -429,19 +435,21 @@ namespace palpate
             {
               case 10: // VTK_TETRA
                 check(4);
-                data.tetrahedra.push_back({{static_cast<unsigned int>(cells[c][0]),
-                                            static_cast<unsigned int>(cells[c][1]),
-                                            static_cast<unsigned int>(cells[c][2]),
-                                            static_cast<unsigned int>(cells[c][3])}});
+                data.tetrahedra.push_back(
+                  {{static_cast<unsigned int>(cells[c][0]),
+                    static_cast<unsigned int>(cells[c][1]),
+                    static_cast<unsigned int>(cells[c][2]),
+                    static_cast<unsigned int>(cells[c][3])}});
                 data.tetrahedron_material_ids.push_back(0);
                 data.tetrahedron_lines.push_back(lines[c]);
                 data.tetrahedron_ids.push_back(c);
                 break;
               case 5: // VTK_TRIANGLE
                 check(3);
-                data.triangles.push_back({{static_cast<unsigned int>(cells[c][0]),
-                                           static_cast<unsigned int>(cells[c][1]),
-                                           static_cast<unsigned int>(cells[c][2])}});
+                data.triangles.push_back(
+                  {{static_cast<unsigned int>(cells[c][0]),
+                    static_cast<unsigned int>(cells[c][1]),
+                    static_cast<unsigned int>(cells[c][2])}});
                 data.triangle_boundary_ids.push_back(0);
                 data.triangle_lines.push_back(lines[c]);
                 break;
@@ -548,7 +556,7 @@ namespace palpate
               else
                 for (long c = 0; c < n; ++c)
                   {
-                    const long k = tokens.number<long>("cell size");
+                    const long        k = tokens.number<long>("cell size");
                     std::vector<long> cell(k);
                     for (auto &p : cell)
                       p = tokens.number<long>("point index");
@@ -618,7 +626,8 @@ namespace palpate
           if (bits >= 8)
             {
               bits -= 8;
-              out.push_back(static_cast<unsigned char>((buffer >> bits) & 0xff));
+              out.push_back(
+                static_cast<unsigned char>((buffer >> bits) & 0xff));
             }
         }
       return out;
@@ -638,9 +647,9 @@ namespace palpate
     struct VtuContext
     {
       std::string filename;
-      bool        header_64   = false;
-      bool        compressed  = false;
-      std::string appended;          // raw bytes, or base64 text
+      bool        header_64  = false;
+      bool        compressed = false;
+      std::string appended; // raw bytes, or base64 text
       bool        appended_base64 = false;
     };
 
@@ -664,26 +673,31 @@ namespace palpate
      * that follow it.
      */
     std::vector<unsigned char>
-    decode_block_data(const VtuContext &                ctx,
+    decode_block_data(const VtuContext                 &ctx,
                       const std::vector<unsigned char> &header,
                       const std::vector<unsigned char> &payload,
-                      const std::string &               name)
+                      const std::string                &name)
     {
       const std::size_t hs = ctx.header_64 ? 8 : 4;
       if (!ctx.compressed)
         {
-          const std::uint64_t n = read_header_value(header.data(), ctx.header_64);
+          const std::uint64_t n =
+            read_header_value(header.data(), ctx.header_64);
           if (payload.size() < n)
             throw InputError(ctx.filename,
                              0,
                              "DataArray " + name,
                              "the array is shorter than its header says",
                              "the file is damaged; write it again.");
-          return std::vector<unsigned char>(payload.begin(), payload.begin() + n);
+          return std::vector<unsigned char>(payload.begin(),
+                                            payload.begin() + n);
         }
-      const std::uint64_t n_blocks = read_header_value(header.data(), ctx.header_64);
-      const std::uint64_t block    = read_header_value(header.data() + hs, ctx.header_64);
-      const std::uint64_t last     = read_header_value(header.data() + 2 * hs, ctx.header_64);
+      const std::uint64_t n_blocks =
+        read_header_value(header.data(), ctx.header_64);
+      const std::uint64_t block =
+        read_header_value(header.data() + hs, ctx.header_64);
+      const std::uint64_t last =
+        read_header_value(header.data() + 2 * hs, ctx.header_64);
       std::vector<unsigned char> out;
       std::size_t                offset = 0;
       for (std::uint64_t b = 0; b < n_blocks; ++b)
@@ -711,7 +725,8 @@ namespace palpate
 
     /** Header length in bytes, given the first header value(s). */
     std::size_t
-    header_length(const VtuContext &ctx, const std::vector<unsigned char> &first)
+    header_length(const VtuContext                 &ctx,
+                  const std::vector<unsigned char> &first)
     {
       const std::size_t hs = ctx.header_64 ? 8 : 4;
       if (!ctx.compressed)
@@ -721,7 +736,7 @@ namespace palpate
 
     /** The raw bytes of a binary (inline base64) or appended data array. */
     std::vector<unsigned char>
-    binary_array_bytes(const VtuContext & ctx,
+    binary_array_bytes(const VtuContext  &ctx,
                        const std::string &encoded, // inline: base64 text
                        const bool         is_inline,
                        const std::size_t  appended_offset,
@@ -736,24 +751,30 @@ namespace palpate
           // writers differ otherwise: try "separately" first, then
           // "together".
           const std::size_t first_chars = 4 * ((hs + 2) / 3);
-          auto first = base64_decode(text, start, std::min(text.size(), start + first_chars));
+          auto              first =
+            base64_decode(text,
+                          start,
+                          std::min(text.size(), start + first_chars));
           if (first.size() < hs)
             throw InputError(ctx.filename,
                              0,
                              "DataArray " + name,
                              "the binary array is empty",
                              "the file is damaged; write it again.");
-          const std::size_t hl = header_length(ctx, first);
+          const std::size_t hl           = header_length(ctx, first);
           const std::size_t header_chars = 4 * ((hl + 2) / 3);
           // Appended base64 arrays follow each other; decoding stops at
           // the padding of this array's data, and the header says how many
           // bytes are this array's.
           const std::size_t end = text.size();
-          const auto header =
-            base64_decode(text, start, std::min(text.size(), start + header_chars));
+          const auto        header =
+            base64_decode(text,
+                          start,
+                          std::min(text.size(), start + header_chars));
           if (header.size() >= hl)
             {
-              const auto payload = base64_decode(text, start + header_chars, end);
+              const auto payload =
+                base64_decode(text, start + header_chars, end);
               try
                 {
                   auto bytes = decode_block_data(ctx, header, payload, name);
@@ -778,7 +799,8 @@ namespace palpate
             name);
         }
       // raw appended data
-      const auto *p = reinterpret_cast<const unsigned char *>(ctx.appended.data());
+      const auto *p =
+        reinterpret_cast<const unsigned char *>(ctx.appended.data());
       if (appended_offset + hs > ctx.appended.size())
         throw InputError(ctx.filename,
                          0,
@@ -787,7 +809,7 @@ namespace palpate
                          "the file is damaged; write it again.");
       const std::vector<unsigned char> first(p + appended_offset,
                                              p + appended_offset + hs);
-      const std::size_t hl = header_length(ctx, first);
+      const std::size_t                hl = header_length(ctx, first);
       const std::vector<unsigned char> header(p + appended_offset,
                                               p + appended_offset + hl);
       const std::vector<unsigned char> payload(p + appended_offset + hl,
@@ -811,7 +833,7 @@ namespace palpate
 
     /** The values of one <DataArray>, whatever its format, as doubles. */
     std::vector<double>
-    data_array_values(const VtuContext & ctx,
+    data_array_values(const VtuContext  &ctx,
                       const std::string &tag,
                       const std::string &content)
     {
@@ -838,11 +860,8 @@ namespace palpate
       if (format == "binary")
         bytes = binary_array_bytes(ctx, strip_space(content), true, 0, name);
       else if (format == "appended")
-        bytes = binary_array_bytes(ctx,
-                                   "",
-                                   false,
-                                   std::stoul(attribute(tag, "offset")),
-                                   name);
+        bytes = binary_array_bytes(
+          ctx, "", false, std::stoul(attribute(tag, "offset")), name);
       else
         throw InputError(ctx.filename,
                          0,
@@ -898,7 +917,8 @@ namespace palpate
                          "check the file name and extension (.msh, .vtk, "
                          ".vtu).");
       const std::string file_tag =
-        text.substr(file_tag_begin, text.find('>', file_tag_begin) - file_tag_begin);
+        text.substr(file_tag_begin,
+                    text.find('>', file_tag_begin) - file_tag_begin);
       if (attribute(file_tag, "type") != "UnstructuredGrid")
         throw InputError(filename,
                          1,
@@ -932,7 +952,8 @@ namespace palpate
       if (appended_tag != std::string::npos)
         {
           const std::string tag =
-            text.substr(appended_tag, text.find('>', appended_tag) - appended_tag);
+            text.substr(appended_tag,
+                        text.find('>', appended_tag) - appended_tag);
           ctx.appended_base64 = attribute(tag, "encoding") == "base64";
           const auto start    = text.find('_', appended_tag) + 1;
           const auto end      = text.rfind("</AppendedData>");
@@ -949,9 +970,12 @@ namespace palpate
                          "mesh file",
                          "the file has no <Piece>",
                          "write the mesh again.");
-      const std::string piece_tag = text.substr(piece, text.find('>', piece) - piece);
-      const long n_points = std::stol("0" + attribute(piece_tag, "NumberOfPoints"));
-      const long n_cells  = std::stol("0" + attribute(piece_tag, "NumberOfCells"));
+      const std::string piece_tag =
+        text.substr(piece, text.find('>', piece) - piece);
+      const long n_points =
+        std::stol("0" + attribute(piece_tag, "NumberOfPoints"));
+      const long n_cells =
+        std::stol("0" + attribute(piece_tag, "NumberOfCells"));
 
       // Collect the data arrays of the <Points> and <Cells> sections.
       std::map<std::string, std::vector<double>> arrays;
@@ -971,15 +995,15 @@ namespace palpate
               const auto a = text.find("<DataArray", pos);
               if (a == std::string::npos || a > end)
                 break;
-              const auto tag_end = text.find('>', a);
-              const std::string tag = text.substr(a, tag_end - a);
-              std::string content;
-              std::size_t next = tag_end + 1;
+              const auto        tag_end = text.find('>', a);
+              const std::string tag     = text.substr(a, tag_end - a);
+              std::string       content;
+              std::size_t       next = tag_end + 1;
               if (text[tag_end - 1] != '/')
                 {
                   const auto close = text.find("</DataArray>", tag_end);
-                  content          = text.substr(tag_end + 1, close - tag_end - 1);
-                  next             = close;
+                  content = text.substr(tag_end + 1, close - tag_end - 1);
+                  next    = close;
                 }
               const std::string key =
                 section == "Points" ? "points" : attribute(tag, "Name");
@@ -987,7 +1011,8 @@ namespace palpate
               pos         = next;
             }
         }
-      for (const std::string key : {"points", "connectivity", "offsets", "types"})
+      for (const std::string key :
+           {"points", "connectivity", "offsets", "types"})
         if (arrays.count(key) == 0)
           throw InputError(filename,
                            1,
@@ -1005,7 +1030,8 @@ namespace palpate
                          "write the mesh again with 3-D points.");
       for (long i = 0; i < n_points; ++i)
         {
-          data.nodes.push_back({{points[3 * i], points[3 * i + 1], points[3 * i + 2]}});
+          data.nodes.push_back(
+            {{points[3 * i], points[3 * i + 1], points[3 * i + 2]}});
           data.node_ids.push_back(i);
         }
       const auto &connectivity = arrays["connectivity"];
@@ -1038,11 +1064,8 @@ namespace palpate
           begin = end;
         }
       LineReader reader(filename);
-      add_vtk_cells(reader,
-                    cells,
-                    types,
-                    std::vector<unsigned int>(cells.size(), 0),
-                    data);
+      add_vtk_cells(
+        reader, cells, types, std::vector<unsigned int>(cells.size(), 0), data);
       return data;
     }
   } // namespace
@@ -1053,11 +1076,8 @@ namespace palpate
   read_mesh_file(const std::string &filename)
   {
     if (!std::filesystem::exists(filename))
-      throw InputError(filename,
-                       0,
-                       "mesh file",
-                       "the file does not exist",
-                       "check the path.");
+      throw InputError(
+        filename, 0, "mesh file", "the file does not exist", "check the path.");
     if (std::filesystem::is_directory(filename))
       throw InputError(filename,
                        0,
@@ -1073,7 +1093,8 @@ namespace palpate
                          "the file cannot be read (permissions?)",
                          "make it readable.");
     }
-    const std::string extension = std::filesystem::path(filename).extension().string();
+    const std::string extension =
+      std::filesystem::path(filename).extension().string();
     if (extension == ".msh")
       return read_gmsh(filename);
     if (extension == ".vtk")

@@ -81,21 +81,22 @@ namespace palpate
   NodeSelection
   NodeSelection::create(const Scene &scene, const Mesh &mesh)
   {
-    const auto &f = scene.parameters.boundary_conditions.fixed_nodes;
-    const auto &a = scene.parameters.boundary_conditions.active_node;
-    const auto &x = mesh.vertices();
+    const auto &f       = scene.parameters.boundary_conditions.fixed_nodes;
+    const auto &a       = scene.parameters.boundary_conditions.active_node;
+    const auto &x       = mesh.vertices();
     const auto &surface = mesh.on_surface();
 
-    NodeSelection      selection;
+    NodeSelection          selection;
     std::set<unsigned int> fixed;
-    std::string        region_entry;
-    unsigned int       in_region = 0; // nodes in the region, surface or not
-    std::ostringstream description;
+    std::string            region_entry;
+    unsigned int           in_region = 0; // nodes in the region, surface or not
+    std::ostringstream     description;
 
     if (f.selection == "boundary id")
       {
         region_entry = "Boundary conditions/Fixed nodes/Boundary ids";
-        const std::set<unsigned int> ids(f.boundary_ids.begin(), f.boundary_ids.end());
+        const std::set<unsigned int> ids(f.boundary_ids.begin(),
+                                         f.boundary_ids.end());
         for (const auto &face : mesh.surface_faces())
           if (ids.count(face.boundary_id))
             fixed.insert(face.vertices.begin(), face.vertices.end());
@@ -107,8 +108,9 @@ namespace palpate
     else if (f.selection == "box" || f.selection == "half-space")
       {
         const bool box = f.selection == "box";
-        region_entry   = box ? "Boundary conditions/Fixed nodes/Box lower corner" :
-                               "Boundary conditions/Fixed nodes/Half-space point";
+        region_entry   = box ?
+                           "Boundary conditions/Fixed nodes/Box lower corner" :
+                           "Boundary conditions/Fixed nodes/Half-space point";
         for (unsigned int v = 0; v < x.size(); ++v)
           {
             bool inside = true;
@@ -119,8 +121,8 @@ namespace palpate
                            x[v][d] <= f.box_upper_corner[d];
               }
             else
-              inside = dot(minus(x[v], f.half_space_point),
-                           f.half_space_normal) >= 0;
+              inside =
+                dot(minus(x[v], f.half_space_point), f.half_space_normal) >= 0;
             if (inside)
               {
                 ++in_region;
@@ -129,11 +131,13 @@ namespace palpate
               }
           }
         if (box)
-          description << "nodes in the box [" << Utilities::to_string(f.box_lower_corner, 4)
-                      << "] - [" << Utilities::to_string(f.box_upper_corner, 4) << "] m";
+          description << "nodes in the box ["
+                      << Utilities::to_string(f.box_lower_corner, 4) << "] - ["
+                      << Utilities::to_string(f.box_upper_corner, 4) << "] m";
         else
-          description << "nodes x with (x - (" << Utilities::to_string(f.half_space_point, 4)
-                      << ")) . (" << Utilities::to_string(f.half_space_normal, 4)
+          description << "nodes x with (x - ("
+                      << Utilities::to_string(f.half_space_point, 4) << ")) . ("
+                      << Utilities::to_string(f.half_space_normal, 4)
                       << ") >= 0";
         if (f.surface_nodes_only)
           description << ", surface only";
@@ -159,8 +163,8 @@ namespace palpate
 
     if (fixed.empty())
       {
-        std::string problem = "the fixed-node selection (" +
-                              description.str() + ") selects no node";
+        std::string problem = "the fixed-node selection (" + description.str() +
+                              ") selects no node";
         if (in_region > 0)
           problem += ": the region holds " + std::to_string(in_region) +
                      " nodes, but none on the surface";
@@ -220,16 +224,15 @@ namespace palpate
         selection.active_distance = best;
       }
     if (fixed.count(selection.active_vertex))
-      throw scene.error(a.selection == "node id" ?
-                          "Boundary conditions/Active node/Node id" :
-                          "Boundary conditions/Active node/Point",
-                        "the active node (node " +
-                          std::to_string(mesh.node_id(selection.active_vertex)) +
-                          " at " +
-                          Utilities::to_string(x[selection.active_vertex], 4) +
-                          " m) is also a fixed node, so it cannot move",
-                        "choose an active node outside the fixed region, or "
-                        "shrink the region.");
+      throw scene.error(
+        a.selection == "node id" ? "Boundary conditions/Active node/Node id" :
+                                   "Boundary conditions/Active node/Point",
+        "the active node (node " +
+          std::to_string(mesh.node_id(selection.active_vertex)) + " at " +
+          Utilities::to_string(x[selection.active_vertex], 4) +
+          " m) is also a fixed node, so it cannot move",
+        "choose an active node outside the fixed region, or "
+        "shrink the region.");
     return selection;
   }
 } // namespace palpate

@@ -127,10 +127,10 @@ namespace palpate
 
         prm.enter_subsection("Beam");
         {
-          beam_length      = prm.get_double("Length");
-          beam_width       = prm.get_double("Width");
-          beam_height      = prm.get_double("Height");
-          const auto sub   = get_list<unsigned int>(prm, "Subdivisions");
+          beam_length    = prm.get_double("Length");
+          beam_width     = prm.get_double("Width");
+          beam_height    = prm.get_double("Height");
+          const auto sub = get_list<unsigned int>(prm, "Subdivisions");
           beam_subdivisions_length = sub[0];
           beam_subdivisions_width  = sub[1];
           beam_subdivisions_height = sub[2];
@@ -550,12 +550,13 @@ namespace palpate
     {
       prm.enter_subsection("Effects");
       {
-        gravity                    = prm.get_bool("Gravity");
-        gravitational_acceleration = get_point(prm, "Gravitational acceleration");
-        shape_output               = prm.get_bool("Shape output");
-        shape_output_rate          = prm.get_double("Shape output rate");
-        vtu_export                 = prm.get_bool("VTU export");
-        force_log                  = prm.get_bool("Force log");
+        gravity = prm.get_bool("Gravity");
+        gravitational_acceleration =
+          get_point(prm, "Gravitational acceleration");
+        shape_output      = prm.get_bool("Shape output");
+        shape_output_rate = prm.get_double("Shape output rate");
+        vtu_export        = prm.get_bool("VTU export");
+        force_log         = prm.get_bool("Force log");
       }
       prm.leave_subsection();
     }

@@ -81,7 +81,8 @@ namespace palpate
             std::isxdigit(static_cast<unsigned char>(name[i + 1])) &&
             std::isxdigit(static_cast<unsigned char>(name[i + 2])))
           {
-            s += static_cast<char>(std::stoi(name.substr(i + 1, 2), nullptr, 16));
+            s +=
+              static_cast<char>(std::stoi(name.substr(i + 1, 2), nullptr, 16));
             i += 2;
           }
         else
@@ -182,16 +183,19 @@ namespace palpate
         }
       if (std::regex_match(description,
                            m,
-                           std::regex(R"(\[Integer range (\S+)\.\.\.(\S+) .*\])")))
+                           std::regex(
+                             R"(\[Integer range (\S+)\.\.\.(\S+) .*\])")))
         {
           if (m[2].str() == "2147483647")
             return "a whole number >= " + m[1].str();
           return "a whole number from " + m[1].str() + " to " + m[2].str();
         }
       if (std::regex_search(description,
-                            std::regex(R"(^\[List of <\[Double.*of length 3\.\.\.3)")))
+                            std::regex(
+                              R"(^\[List of <\[Double.*of length 3\.\.\.3)")))
         return "three numbers separated by commas (x, y, z)";
-      if (std::regex_search(description, std::regex(R"(^\[List of <\[Integer)")))
+      if (std::regex_search(description,
+                            std::regex(R"(^\[List of <\[Integer)")))
         return "whole numbers separated by commas";
       return description;
     }
@@ -256,7 +260,7 @@ namespace palpate
     bool
     starts_with_keyword(const std::string &line,
                         const std::string &keyword,
-                        std::string &      rest)
+                        std::string       &rest)
     {
       if (line.size() < keyword.size())
         return false;
@@ -299,9 +303,8 @@ namespace palpate
   Scene::read(const std::string &filename)
   {
     Scene scene;
-    scene.file_ = filename;
-    scene.directory_ =
-      std::filesystem::path(filename).parent_path().string();
+    scene.file_      = filename;
+    scene.directory_ = std::filesystem::path(filename).parent_path().string();
 
     std::ifstream in(filename);
     if (!in)
@@ -317,10 +320,10 @@ namespace palpate
 
     // First pass: check every line against the declared parameters, so
     // that errors can name the line, the entry and a likely fix.
-    const DeclaredSection &                root = declared_tree();
-    std::vector<const DeclaredSection *>   stack{&root};
-    std::vector<std::string>               path;
-    std::vector<unsigned int>              opened_at;
+    const DeclaredSection               &root = declared_tree();
+    std::vector<const DeclaredSection *> stack{&root};
+    std::vector<std::string>             path;
+    std::vector<unsigned int>            opened_at;
     for (const LogicalLine &line : read_logical_lines(in))
       {
         std::string rest;
@@ -367,14 +370,14 @@ namespace palpate
             const std::string value = Utilities::trim(rest.substr(equal + 1));
             const DeclaredEntry *entry = stack.back()->find_entry(name);
             if (entry == nullptr)
-              throw InputError(
-                filename,
-                line.number,
-                path_to_string(path) + " / " + name,
-                "there is no entry '" + name + "' in " + path_to_string(path),
-                suggestion(name, stack.back()->entry_names()) +
-                  "The entries here are: " +
-                  join(stack.back()->entry_names(), ", ") + ".");
+              throw InputError(filename,
+                               line.number,
+                               path_to_string(path) + " / " + name,
+                               "there is no entry '" + name + "' in " +
+                                 path_to_string(path),
+                               suggestion(name, stack.back()->entry_names()) +
+                                 "The entries here are: " +
+                                 join(stack.back()->entry_names(), ", ") + ".");
             if (!matches(entry->pattern_description, value))
               {
                 std::string hint;
@@ -387,10 +390,10 @@ namespace palpate
                                  line.number,
                                  path_to_string(path) + " / " + name + " = " +
                                    value,
-                                 "'" + value + "' is not allowed here: the "
-                                 "entry takes " +
-                                   describe_pattern(
-                                     entry->pattern_description),
+                                 "'" + value +
+                                   "' is not allowed here: the "
+                                   "entry takes " +
+                                   describe_pattern(entry->pattern_description),
                                  hint + "Set " + name +
                                    " to such a value (its default is '" +
                                    entry->default_value + "').");
@@ -450,7 +453,9 @@ namespace palpate
     if (path.empty() || std::filesystem::path(path).is_absolute() ||
         directory_.empty())
       return path;
-    return (std::filesystem::path(directory_) / path).lexically_normal().string();
+    return (std::filesystem::path(directory_) / path)
+      .lexically_normal()
+      .string();
   }
 
 
@@ -469,9 +474,8 @@ namespace palpate
                const std::string &problem,
                const std::string &fix) const
   {
-    std::string shown =
-      std::regex_replace(entry, std::regex("/"), " / ");
-    const auto value = entry_values_.find(entry);
+    std::string shown = std::regex_replace(entry, std::regex("/"), " / ");
+    const auto  value = entry_values_.find(entry);
     if (value != entry_values_.end())
       shown += " = " + value->second;
     else
@@ -537,7 +541,8 @@ namespace palpate
                       "lower corner in every coordinate",
                       "make each coordinate of Box upper corner larger than "
                       "that of Box lower corner.");
-    if (f.selection == "half-space" && Utilities::norm(f.half_space_normal) == 0)
+    if (f.selection == "half-space" &&
+        Utilities::norm(f.half_space_normal) == 0)
       throw error("Boundary conditions/Fixed nodes/Half-space normal",
                   "the normal is the zero vector",
                   "give the direction pointing into the fixed half-space, "
@@ -570,13 +575,14 @@ namespace palpate
                   "make Extent at least Grid spacing (typically 0.1 m, the "
                   "paper's largest displacement).");
     if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
-      throw error("Scheduler/Cloud radius",
-                  "the cloud cannot hold all 8 corners of the cell the HIP "
-                  "is in: it must reach at least sqrt(3) h = " +
-                    std::to_string(std::sqrt(3.) * p.state_space.grid_spacing) +
-                    " m",
-                  "increase Cloud radius or decrease State space / Grid "
-                  "spacing.");
+      throw error(
+        "Scheduler/Cloud radius",
+        "the cloud cannot hold all 8 corners of the cell the HIP "
+        "is in: it must reach at least sqrt(3) h = " +
+          Utilities::to_string(std::sqrt(3.) * p.state_space.grid_spacing, 4) +
+          " m",
+        "increase Cloud radius or decrease State space / Grid "
+        "spacing.");
     if (p.scheduler.rate <= 0)
       throw error("Scheduler/Rate", "the rate must be positive", "use 100 Hz.");
 
@@ -631,13 +637,14 @@ namespace palpate
     }
 
     void
-    print_markdown_section(std::ostream &                  out,
-                           const DeclaredSection &         section,
+    print_markdown_section(std::ostream                   &out,
+                           const DeclaredSection          &section,
                            const std::vector<std::string> &path)
     {
       if (!section.entries.empty())
         {
-          out << "\n" << std::string(std::min<std::size_t>(path.size(), 3) + 1, '#')
+          out << "\n"
+              << std::string(std::min<std::size_t>(path.size(), 3) + 1, '#')
               << " `" << join(path, " / ") << "`\n\n"
               << "| Entry | Default | Allowed values | Meaning |\n"
               << "|---|---|---|---|\n";
@@ -648,7 +655,8 @@ namespace palpate
                 << " | " << markdown_escape(entry.documentation) << " |\n";
         }
       else
-        out << "\n" << std::string(std::min<std::size_t>(path.size(), 3) + 1, '#')
+        out << "\n"
+            << std::string(std::min<std::size_t>(path.size(), 3) + 1, '#')
             << " `" << join(path, " / ") << "`\n";
       for (const auto &[name, sub] : section.subsections)
         {

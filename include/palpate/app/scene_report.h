@@ -18,9 +18,9 @@ namespace palpate
    * the first thing `palpate scene.prm` prints.
    */
   void
-  print_scene_report(std::ostream &       out,
-                     const Scene &        scene,
-                     const Mesh &         mesh,
+  print_scene_report(std::ostream        &out,
+                     const Scene         &scene,
+                     const Mesh          &mesh,
                      const NodeSelection &nodes);
 } // namespace palpate
 

@@ -37,7 +37,8 @@ namespace palpate
      * word's length, at least 3).
      */
     std::string
-    closest_match(const std::string &word, const std::vector<std::string> &candidates);
+    closest_match(const std::string              &word,
+                  const std::vector<std::string> &candidates);
 
     /** Euclidean norm of @p v. */
     double
@@ -46,6 +47,11 @@ namespace palpate
     /** Euclidean distance between @p a and @p b. */
     double
     distance(const Point3 &a, const Point3 &b);
+
+    /** Format @p x with @p precision significant digits (no trailing
+     * zeros, scientific notation for very small or large numbers). */
+    std::string
+    to_string(const double x, const unsigned int precision = 6);
 
     /** Format @p p as "x, y, z" with @p precision significant digits. */
     std::string

@@ -39,8 +39,9 @@ namespace palpate
    * the element: inverted or degenerate tetrahedra, tetrahedra with repeated
    * nodes, faces shared by more than two tetrahedra, a body in several
    * disconnected pieces (one of them would float), and boundary triangles
-   * that are not faces of the surface. Nodes no tetrahedron uses are
-   * dropped.
+   * that are not faces of the surface. Nodes with identical coordinates
+   * are merged (files written cell by cell repeat them); nodes no
+   * tetrahedron uses are dropped.
    *
    * Vertex index v of this class is vertex v of triangulation().
    */
@@ -51,7 +52,9 @@ namespace palpate
      * Check @p data, scale it by @p scale_factor (metres per file unit) and
      * build the triangulation. @p file names the source in error messages.
      */
-    Mesh(const MeshData &data, const double scale_factor, const std::string &file);
+    Mesh(const MeshData    &data,
+         const double       scale_factor,
+         const std::string &file);
 
     Mesh(Mesh &&) noexcept;
     ~Mesh();
@@ -127,6 +130,11 @@ namespace palpate
     /** Number of nodes of the source that no tetrahedron uses (dropped). */
     unsigned int
     n_dropped_nodes() const;
+
+    /** Number of nodes of the source that repeat another node's
+     * coordinates and were merged with it. */
+    unsigned int
+    n_merged_nodes() const;
 
   private:
     struct Impl;

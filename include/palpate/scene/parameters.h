@@ -32,7 +32,8 @@ namespace palpate
     {
       /** "file", "beam" or "blob". */
       std::string source;
-      /** Mesh file (.msh Gmsh 2.2 or v1, .vtk, .vtu) as written in the scene. */
+      /** Mesh file (.msh Gmsh 2.2 or v1, .vtk, .vtu) as written in the scene.
+       */
       std::string file_name;
       /** Metres per mesh-file length unit. */
       double scale_factor;

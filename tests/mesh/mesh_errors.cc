@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// Broken mesh files are refused with the file, the line and a fix, never a
+// crash and never a silently repaired mesh: an inverted tetrahedron, a
+// degenerate one, a repeated node, an undefined node, a hexahedron, a
+// second-order tetrahedron, a Gmsh 4 file, a binary file, a truncated
+// file, two disconnected bodies, a boundary triangle that is no face, and
+// an unknown extension.
+
+#include <palpate/base/exceptions.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/mesh_file.h>
+
+#include "../tests.h"
+
+namespace
+{
+  const std::string nodes = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                            "$Nodes\n5\n"
+                            "1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n"
+                            "$EndNodes\n";
+
+  std::string
+  elements(const std::vector<std::string> &lines)
+  {
+    std::string s = "$Elements\n" + std::to_string(lines.size()) + "\n";
+    for (const auto &l : lines)
+      s += l + "\n";
+    return s + "$EndElements\n";
+  }
+
+  void
+  check(const std::string &what,
+        const std::string &file,
+        const std::string &text)
+  {
+    write_file(file, text);
+    try
+      {
+        const palpate::Mesh mesh(palpate::read_mesh_file(file), 1.0, file);
+        deallog << what << ": accepted, " << mesh.n_cells() << " tetrahedra"
+                << std::endl;
+      }
+    catch (const palpate::InputError &e)
+      {
+        deallog << what << ": refused" << std::endl << e.what() << std::endl;
+      }
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  check("a valid tetrahedron",
+        "good.msh",
+        nodes + elements({"1 4 2 1 1 1 2 3 4"}));
+  check("an inverted tetrahedron",
+        "inverted.msh",
+        nodes + elements({"7 4 2 1 1 1 2 4 3"}));
+  check("a degenerate tetrahedron",
+        "flat.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n"
+        "3 0 1 0\n4 1 1 0\n$EndNodes\n" +
+          elements({"1 4 2 1 1 1 2 3 4"}));
+  check("a repeated node",
+        "repeated.msh",
+        nodes + elements({"1 4 2 1 1 1 2 2 4"}));
+  check("an undefined node",
+        "undefined.msh",
+        nodes + elements({"1 4 2 1 1 1 2 3 9"}));
+  check("a hexahedron",
+        "hex.msh",
+        nodes + elements({"1 5 2 1 1 1 2 3 4 5 1 2 3"}));
+  check("a 10-node tetrahedron",
+        "tet10.msh",
+        nodes + elements({"1 11 2 1 1 1 2 3 4 5 1 2 3 4 5"}));
+  check("a Gmsh 4 file", "v4.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+  check("a binary Gmsh file",
+        "binary.msh",
+        "$MeshFormat\n2.2 1 8\n$EndMeshFormat\n");
+  check("a truncated file",
+        "truncated.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n");
+  check(
+    "a bad coordinate",
+    "coordinate.msh",
+    "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 zero 0\n$EndNodes\n");
+  check("two disconnected tetrahedra",
+        "pieces.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n"
+        "3 0 1 0\n4 0 0 1\n5 5 0 0\n6 6 0 0\n7 5 1 0\n8 5 0 1\n$EndNodes\n" +
+          elements({"1 4 2 1 1 1 2 3 4", "2 4 2 1 1 5 6 7 8"}));
+  check("a boundary triangle that is not a face",
+        "triangle.msh",
+        nodes + elements({"1 2 2 3 3 1 2 5", "2 4 2 1 1 1 2 3 4"}));
+  check("a surface mesh only",
+        "surface.msh",
+        nodes + elements({"1 2 2 3 3 1 2 3"}));
+  check("a legacy VTK file in binary",
+        "binary.vtk",
+        "# vtk DataFile Version 3.0\nx\nBINARY\n");
+  check("a VTK file that is not a grid",
+        "polydata.vtk",
+        "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\n");
+  check("an unknown extension", "mesh.stl", "solid x\n");
+  try
+    {
+      palpate::read_mesh_file("does-not-exist.msh");
+    }
+  catch (const palpate::InputError &e)
+    {
+      deallog << "a missing file: refused" << std::endl
+              << e.what() << std::endl;
+    }
+}
