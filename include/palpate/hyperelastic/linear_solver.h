@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_hyperelastic_linear_solver_h
+#define palpate_hyperelastic_linear_solver_h
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  /**
+   * A square sparse matrix pattern in compressed row storage with sorted
+   * column indices. palpate's systems are symmetric, so the pattern is
+   * symmetric too and serves as compressed column storage as well.
+   */
+  struct SparsityCSR
+  {
+    unsigned int              n_rows = 0;
+    std::vector<unsigned int> row_start; // n_rows + 1 entries
+    std::vector<unsigned int> column;    // row_start[n_rows] entries
+
+    /** Number of stored entries. */
+    std::size_t
+    n_nonzeros() const
+    {
+      return column.size();
+    }
+
+    /** Position of entry (i, j) in the value array, or -1 if not stored. */
+    long
+    position(const unsigned int i, const unsigned int j) const;
+  };
+
+  /**
+   * A sparse direct solver for the symmetric (indefinite) linearised
+   * systems of the Newton method. The sparsity pattern is fixed for the
+   * lifetime of the solver: analyze() runs the symbolic analysis (ordering,
+   * elimination tree) once; factorize() then computes only the numbers, at
+   * every Newton iteration.
+   *
+   * No method throws on a numerical failure: factorize() and solve() return
+   * false (with message() set), so that the Newton solver can report a
+   * failure point instead of dying. Each instance is used by one thread at a
+   * time; different instances may run concurrently.
+   */
+  class LinearSolver
+  {
+  public:
+    virtual ~LinearSolver() = default;
+
+    /** Symbolic analysis of @p pattern (kept by reference: it must outlive
+     * the solver). */
+    virtual void
+    analyze(const SparsityCSR &pattern) = 0;
+
+    /** Numerical factorisation of the matrix with @p values (in the order
+     * of the pattern's entries). */
+    virtual bool
+    factorize(const std::vector<double> &values) = 0;
+
+    /** Solve A x = b in place: @p rhs holds b on entry, x on return. */
+    virtual bool
+    solve(std::vector<double> &rhs) = 0;
+
+    /** The solver's name and settings, e.g. "MUMPS (LDL^T, METIS)". */
+    virtual std::string
+    name() const = 0;
+
+    /** Size and cost of the last factorisation, e.g. "factor 2.1e5
+     * entries, 3.4e7 flops", where the solver reports them. */
+    virtual std::string
+    statistics() const
+    {
+      return "";
+    }
+
+    /** What went wrong in the last failed call. */
+    const std::string &
+    message() const
+    {
+      return message_;
+    }
+
+    /**
+     * A solver by scene name: "MUMPS", "UMFPACK", "KLU", "Amesos MUMPS" or
+     * "Amesos KLU"; @p ordering is MUMPS's fill-reducing ordering.
+     */
+    static std::unique_ptr<LinearSolver>
+    create(const std::string &name, const std::string &ordering);
+
+  protected:
+    std::string message_;
+  };
+} // namespace palpate
+
+#endif

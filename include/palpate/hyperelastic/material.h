@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_hyperelastic_material_h
+#define palpate_hyperelastic_material_h
+
+#include <palpate/scene/parameters.h>
+
+#include <deal.II/base/tensor.h>
+
+#include <memory>
+#include <string>
+
+namespace palpate
+{
+  using dealii::Tensor;
+
+  /**
+   * A hyperelastic material in the total Lagrangian setting: a strain
+   * energy density W(F) per unit reference volume (J/m^3 = Pa), its first
+   * Piola-Kirchhoff stress P = dW/dF (Pa) and the tangent A = dP/dF (Pa),
+   * A[i][J][k][L] = d P[i][J] / d F[k][L].
+   *
+   * The FE module calls evaluate() at every quadrature point; implementations
+   * must be thread-safe (const, no state).
+   */
+  class Material
+  {
+  public:
+    virtual ~Material() = default;
+
+    /**
+     * Energy, stress and (if @p tangent is not null) tangent at the
+     * deformation gradient @p F. Returns W(F).
+     */
+    virtual double
+    evaluate(const Tensor<2, 3> &F,
+             Tensor<2, 3>       &P,
+             Tensor<4, 3>       *tangent) const = 0;
+
+    /**
+     * Whether the energy is defined at F: false if det F <= 0 and the law
+     * needs J > 0 (neo-Hookean). St.Venant-Kirchhoff is defined for every
+     * F, but palpate still treats det F <= 0 as an inverted element.
+     */
+    virtual bool
+    admissible(const Tensor<2, 3> &F) const;
+
+    /** The shear modulus mu of the small-strain limit (Pa). */
+    virtual double
+    shear_modulus() const = 0;
+
+    /** Young's modulus of the small-strain limit (Pa): the stiffness scale. */
+    virtual double
+    youngs_modulus() const = 0;
+
+    /** One line for reports, e.g. "St.Venant-Kirchhoff, E = 15465 Pa". */
+    virtual std::string
+    description() const = 0;
+
+    /**
+     * The compressible material a scene asks for. The incompressible
+     * Mooney-Rivlin model needs a pressure field and is built by the FE
+     * module, not here.
+     */
+    static std::unique_ptr<Material>
+    create(const Parameters::MaterialModel &parameters);
+  };
+
+  /**
+   * St.Venant-Kirchhoff: W = lambda/2 (tr E)^2 + mu tr(E^2) with the Green
+   * strain E = (F^T F - I)/2; S = lambda tr(E) I + 2 mu E, P = F S. The
+   * simplest large-deformation extension of linear elasticity; it softens
+   * under strong compression and admits inverted states.
+   */
+  class StVenantKirchhoff : public Material
+  {
+  public:
+    /** @p youngs_modulus in Pa, @p poissons_ratio dimensionless. */
+    StVenantKirchhoff(const double youngs_modulus, const double poissons_ratio);
+
+    double
+    evaluate(const Tensor<2, 3> &F,
+             Tensor<2, 3>       &P,
+             Tensor<4, 3>       *tangent) const override;
+
+    double
+    shear_modulus() const override;
+
+    double
+    youngs_modulus() const override;
+
+    std::string
+    description() const override;
+
+    /** Lame parameters (Pa). */
+    const double E, nu, lambda, mu;
+  };
+
+  /**
+   * Compressible neo-Hookean: W = mu/2 (tr C - 3) - mu ln J + lambda/2
+   * (ln J)^2; P = mu (F - F^-T) + lambda ln J F^-T. Reduces to linear
+   * elasticity for small strains; W -> infinity as J -> 0, so it never
+   * softens under compression.
+   */
+  class NeoHookean : public Material
+  {
+  public:
+    /** @p youngs_modulus in Pa, @p poissons_ratio dimensionless. */
+    NeoHookean(const double youngs_modulus, const double poissons_ratio);
+
+    double
+    evaluate(const Tensor<2, 3> &F,
+             Tensor<2, 3>       &P,
+             Tensor<4, 3>       *tangent) const override;
+
+    bool
+    admissible(const Tensor<2, 3> &F) const override;
+
+    double
+    shear_modulus() const override;
+
+    double
+    youngs_modulus() const override;
+
+    std::string
+    description() const override;
+
+    /** Lame parameters (Pa). */
+    const double E, nu, lambda, mu;
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,557 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/exceptions.h>
+#include <palpate/hyperelastic/linear_solver.h>
+
+#include <Amesos.h>
+#include <Amesos_BaseSolver.h>
+#include <Epetra_CrsMatrix.h>
+#include <Epetra_LinearProblem.h>
+#include <Epetra_Map.h>
+#include <Epetra_MpiComm.h>
+#include <Epetra_Vector.h>
+#include <dmumps_c.h>
+#include <klu.h>
+#include <metis.h>
+#include <mpi.h>
+#include <umfpack.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+namespace palpate
+{
+  long
+  SparsityCSR::position(const unsigned int i, const unsigned int j) const
+  {
+    const auto begin = column.begin() + row_start[i];
+    const auto end   = column.begin() + row_start[i + 1];
+    const auto it    = std::lower_bound(begin, end, j);
+    return (it != end && *it == j) ? it - column.begin() : -1;
+  }
+
+
+
+  namespace
+  {
+    bool
+    all_finite(const std::vector<double> &v)
+    {
+      for (const double x : v)
+        if (!std::isfinite(x))
+          return false;
+      return true;
+    }
+
+    /**
+     * METIS nested dissection of the matrix graph, as MUMPS's PERM_IN: the
+     * 1-based position of each unknown in the pivot order. METIS compresses
+     * the three DoFs of a node (identical adjacency) by itself.
+     */
+    std::vector<MUMPS_INT>
+    metis_nested_dissection(const SparsityCSR &pattern)
+    {
+      std::vector<idx_t> xadj(1, 0), adjncy;
+      for (unsigned int i = 0; i < pattern.n_rows; ++i)
+        {
+          for (unsigned int k = pattern.row_start[i];
+               k < pattern.row_start[i + 1];
+               ++k)
+            if (pattern.column[k] != i)
+              adjncy.push_back(pattern.column[k]);
+          xadj.push_back(adjncy.size());
+        }
+      idx_t              n = pattern.n_rows;
+      std::vector<idx_t> perm(n), iperm(n);
+      idx_t              options[METIS_NOPTIONS];
+      METIS_SetDefaultOptions(options);
+      options[METIS_OPTION_NUMBERING] = 0;
+      if (METIS_NodeND(&n,
+                       xadj.data(),
+                       adjncy.data(),
+                       nullptr,
+                       options,
+                       perm.data(),
+                       iperm.data()) != METIS_OK)
+        throw std::runtime_error("METIS nested dissection failed");
+      std::vector<MUMPS_INT> position(n);
+      for (idx_t i = 0; i < n; ++i)
+        position[i] = iperm[i] + 1;
+      return position;
+    }
+
+    // ------------------------------------------------------------------
+    // MUMPS through its C interface.
+    //
+    // Why not Trilinos' Amesos_Mumps (which "Amesos MUMPS" below still
+    // offers for comparison): it calls exit() on any MUMPS error, so a
+    // singular tangent at a failure point would kill the solver process;
+    // its "MatrixType = symmetric" setting never reaches MUMPS (a bug in
+    // Amesos 13), so the symmetric LDL^T factorisation, half the work of
+    // LU, is unreachable; and it copies the matrix row by row into triplets
+    // at every factorisation.
+    // ------------------------------------------------------------------
+    class Mumps : public LinearSolver
+    {
+    public:
+      explicit Mumps(const std::string &ordering)
+        : ordering_name(ordering)
+      {
+        // METIS is not compiled into Debian's MUMPS (it would silently
+        // fall back to AMF), so palpate computes the METIS nested
+        // dissection itself and hands it over (ICNTL(7) = 1).
+        static const std::map<std::string, int> icntl7 = {{"AMD", 0},
+                                                          {"METIS", 1},
+                                                          {"AMF", 2},
+                                                          {"SCOTCH", 3},
+                                                          {"PORD", 4},
+                                                          {"QAMD", 6},
+                                                          {"automatic", 7}};
+        const auto                              it     = icntl7.find(ordering);
+        if (it == icntl7.end())
+          throw std::invalid_argument("unknown MUMPS ordering " + ordering);
+        ordering_code = it->second;
+      }
+
+      ~Mumps() override
+      {
+        if (initialized)
+          {
+            id.job = -2;
+            dmumps_c(&id);
+          }
+      }
+
+      void
+      analyze(const SparsityCSR &pattern) override
+      {
+        // Symmetric storage: the upper triangle only, 1-based.
+        for (unsigned int i = 0; i < pattern.n_rows; ++i)
+          for (unsigned int k = pattern.row_start[i];
+               k < pattern.row_start[i + 1];
+               ++k)
+            if (pattern.column[k] >= i)
+              {
+                irn.push_back(i + 1);
+                jcn.push_back(pattern.column[k] + 1);
+                upper.push_back(k);
+              }
+        values.resize(upper.size());
+
+        id.job          = -1; // initialise an instance
+        id.par          = 1;  // this process works
+        id.sym          = 2;  // general symmetric: LDL^T with 2x2 pivots
+        id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(MPI_COMM_SELF));
+        dmumps_c(&id);
+        initialized = true;
+
+        id.icntl[0]  = -1;            // no error messages on a stream
+        id.icntl[1]  = -1;            // no diagnostics
+        id.icntl[2]  = -1;            // no global information
+        id.icntl[3]  = 0;             // print nothing
+        id.icntl[6]  = ordering_code; // ICNTL(7): fill-reducing ordering
+        id.icntl[13] = 40;            // ICNTL(14): workspace margin, %
+
+        id.n   = pattern.n_rows;
+        id.nnz = irn.size();
+        id.irn = irn.data();
+        id.jcn = jcn.data();
+        if (ordering_code == 1)
+          {
+            permutation = metis_nested_dissection(pattern);
+            id.perm_in  = permutation.data();
+          }
+        id.job = 1; // analysis, once
+        dmumps_c(&id);
+        if (id.infog[0] < 0)
+          throw std::runtime_error("MUMPS analysis failed, INFOG(1) = " +
+                                   std::to_string(id.infog[0]));
+        static const std::map<int, std::string> used = {{0, "AMD"},
+                                                        {1, "METIS"},
+                                                        {2, "AMF"},
+                                                        {3, "SCOTCH"},
+                                                        {4, "PORD"},
+                                                        {5, "METIS"},
+                                                        {6, "QAMD"}};
+        const auto u  = used.find(id.infog[6]); // INFOG(7): ordering used
+        ordering_name = (u == used.end()) ? "?" : u->second;
+      }
+
+      bool
+      factorize(const std::vector<double> &matrix) override
+      {
+        for (std::size_t k = 0; k < upper.size(); ++k)
+          values[k] = matrix[upper[k]];
+        if (!all_finite(values))
+          {
+            message_ = "the matrix has NaN or infinite entries";
+            return false;
+          }
+        id.a = values.data();
+        for (unsigned int attempt = 0; attempt < 5; ++attempt)
+          {
+            id.job = 2;
+            dmumps_c(&id);
+            // -8, -9, -14..-20: a workspace was too small; enlarge, retry.
+            if (id.infog[0] == -8 || id.infog[0] == -9 ||
+                (id.infog[0] <= -14 && id.infog[0] >= -20))
+              {
+                id.icntl[13] *= 2;
+                continue;
+              }
+            break;
+          }
+        if (id.infog[0] < 0)
+          {
+            message_ = id.infog[0] == -10 ?
+                         "MUMPS: the tangent matrix is numerically singular" :
+                         "MUMPS factorisation failed, INFOG(1) = " +
+                           std::to_string(id.infog[0]);
+            return false;
+          }
+        return true;
+      }
+
+      bool
+      solve(std::vector<double> &rhs) override
+      {
+        id.rhs = rhs.data();
+        id.job = 3;
+        dmumps_c(&id);
+        if (id.infog[0] < 0)
+          {
+            message_ =
+              "MUMPS solve failed, INFOG(1) = " + std::to_string(id.infog[0]);
+            return false;
+          }
+        if (!all_finite(rhs))
+          {
+            message_ = "MUMPS returned a non-finite solution";
+            return false;
+          }
+        return true;
+      }
+
+      std::string
+      name() const override
+      {
+        return "MUMPS (symmetric LDL^T, " + ordering_name + " ordering)";
+      }
+
+      std::string
+      statistics() const override
+      {
+        // INFOG(29): entries in the factors; RINFOG(3): flops of the
+        // elimination; INFOG(12): negative pivots (the saddle point's).
+        std::ostringstream s;
+        s << std::setprecision(3) << "factor " << double(id.infog[28])
+          << " entries, " << id.rinfog[2] << " flops, " << id.infog[11]
+          << " negative pivots";
+        return s.str();
+      }
+
+    private:
+      DMUMPS_STRUC_C           id          = {};
+      bool                     initialized = false;
+      int                      ordering_code;
+      std::string              ordering_name;
+      std::vector<MUMPS_INT>   irn, jcn, permutation;
+      std::vector<std::size_t> upper;
+      std::vector<double>      values;
+    };
+
+    // ------------------------------------------------------------------
+    // UMFPACK (SuiteSparse): unsymmetric multifrontal LU.
+    // ------------------------------------------------------------------
+    class Umfpack : public LinearSolver
+    {
+    public:
+      ~Umfpack() override
+      {
+        if (numeric)
+          umfpack_di_free_numeric(&numeric);
+        if (symbolic)
+          umfpack_di_free_symbolic(&symbolic);
+      }
+
+      void
+      analyze(const SparsityCSR &pattern) override
+      {
+        umfpack_di_defaults(control);
+        n = pattern.n_rows;
+        // The pattern is symmetric, so its CSR arrays are CSC arrays too.
+        ap.assign(pattern.row_start.begin(), pattern.row_start.end());
+        ai.assign(pattern.column.begin(), pattern.column.end());
+        if (umfpack_di_symbolic(
+              n, n, ap.data(), ai.data(), nullptr, &symbolic, control, info) !=
+            UMFPACK_OK)
+          throw std::runtime_error("UMFPACK symbolic analysis failed");
+        x.resize(n);
+      }
+
+      bool
+      factorize(const std::vector<double> &matrix) override
+      {
+        if (numeric)
+          umfpack_di_free_numeric(&numeric);
+        // The matrix is symmetric: A^T has the same values, CSR = CSC.
+        values           = &matrix;
+        const int status = umfpack_di_numeric(ap.data(),
+                                              ai.data(),
+                                              matrix.data(),
+                                              symbolic,
+                                              &numeric,
+                                              control,
+                                              info);
+        if (status != UMFPACK_OK)
+          {
+            message_ = status == UMFPACK_WARNING_singular_matrix ?
+                         "UMFPACK: the tangent matrix is singular" :
+                         "UMFPACK factorisation failed, status " +
+                           std::to_string(status);
+            return false;
+          }
+        return true;
+      }
+
+      bool
+      solve(std::vector<double> &rhs) override
+      {
+        const int status = umfpack_di_solve(UMFPACK_A,
+                                            ap.data(),
+                                            ai.data(),
+                                            values->data(),
+                                            x.data(),
+                                            rhs.data(),
+                                            numeric,
+                                            control,
+                                            info);
+        if (status != UMFPACK_OK || !all_finite(x))
+          {
+            message_ = "UMFPACK solve failed, status " + std::to_string(status);
+            return false;
+          }
+        rhs.swap(x);
+        x.resize(n);
+        return true;
+      }
+
+      std::string
+      name() const override
+      {
+        return "UMFPACK (LU)";
+      }
+
+    private:
+      int                        n = 0;
+      std::vector<int>           ap, ai;
+      std::vector<double>        x;
+      const std::vector<double> *values   = nullptr;
+      void                      *symbolic = nullptr;
+      void                      *numeric  = nullptr;
+      double                     control[UMFPACK_CONTROL];
+      double                     info[UMFPACK_INFO];
+    };
+
+    // ------------------------------------------------------------------
+    // KLU (SuiteSparse): LU with BTF and AMD; refactorisation reuses the
+    // pivot sequence of the first factorisation while it stays accurate.
+    // ------------------------------------------------------------------
+    class Klu : public LinearSolver
+    {
+    public:
+      ~Klu() override
+      {
+        if (numeric)
+          klu_free_numeric(&numeric, &common);
+        if (symbolic)
+          klu_free_symbolic(&symbolic, &common);
+      }
+
+      void
+      analyze(const SparsityCSR &pattern) override
+      {
+        klu_defaults(&common);
+        n = pattern.n_rows;
+        ap.assign(pattern.row_start.begin(), pattern.row_start.end());
+        ai.assign(pattern.column.begin(), pattern.column.end());
+        symbolic = klu_analyze(n, ap.data(), ai.data(), &common);
+        if (symbolic == nullptr)
+          throw std::runtime_error("KLU analysis failed");
+      }
+
+      bool
+      factorize(const std::vector<double> &matrix) override
+      {
+        values.assign(matrix.begin(), matrix.end());
+        if (numeric != nullptr &&
+            klu_refactor(ap.data(),
+                         ai.data(),
+                         values.data(),
+                         symbolic,
+                         numeric,
+                         &common) &&
+            klu_rcond(symbolic, numeric, &common) && common.rcond > 1e-12)
+          return true;
+        // First factorisation, or the old pivots went bad: pivot anew.
+        if (numeric)
+          klu_free_numeric(&numeric, &common);
+        numeric =
+          klu_factor(ap.data(), ai.data(), values.data(), symbolic, &common);
+        if (numeric == nullptr || common.status != KLU_OK)
+          {
+            message_ = "KLU: the tangent matrix is singular";
+            return false;
+          }
+        return true;
+      }
+
+      bool
+      solve(std::vector<double> &rhs) override
+      {
+        // KLU solves A x = b for CSC A; our CSR of a symmetric matrix is
+        // the same thing.
+        if (!klu_solve(symbolic, numeric, n, 1, rhs.data(), &common) ||
+            !all_finite(rhs))
+          {
+            message_ = "KLU solve failed";
+            return false;
+          }
+        return true;
+      }
+
+      std::string
+      name() const override
+      {
+        return "KLU (LU with refactorisation)";
+      }
+
+    private:
+      int                 n = 0;
+      std::vector<int>    ap, ai;
+      std::vector<double> values;
+      klu_symbolic       *symbolic = nullptr;
+      klu_numeric        *numeric  = nullptr;
+      klu_common          common;
+    };
+
+    // ------------------------------------------------------------------
+    // Trilinos Amesos (Amesos_Mumps, Amesos_Klu), for comparison.
+    // ------------------------------------------------------------------
+    class AmesosSolver : public LinearSolver
+    {
+    public:
+      explicit AmesosSolver(const std::string &type)
+        : type(type)
+        , comm(MPI_COMM_SELF)
+      {}
+
+      void
+      analyze(const SparsityCSR &pattern) override
+      {
+        map = std::make_unique<Epetra_Map>(static_cast<int>(pattern.n_rows),
+                                           0,
+                                           comm);
+        std::vector<int> per_row(pattern.n_rows);
+        for (unsigned int i = 0; i < pattern.n_rows; ++i)
+          per_row[i] = pattern.row_start[i + 1] - pattern.row_start[i];
+        // Column map = row map, so local column indices are ours.
+        matrix = std::make_unique<Epetra_CrsMatrix>(
+          Copy, *map, *map, per_row.data(), true);
+        for (unsigned int i = 0; i < pattern.n_rows; ++i)
+          {
+            std::vector<int> cols(pattern.column.begin() + pattern.row_start[i],
+                                  pattern.column.begin() +
+                                    pattern.row_start[i + 1]);
+            std::vector<double> zeros(cols.size(), 0.0);
+            matrix->InsertMyValues(i, cols.size(), zeros.data(), cols.data());
+          }
+        matrix->FillComplete();
+        x       = std::make_unique<Epetra_Vector>(*map);
+        b       = std::make_unique<Epetra_Vector>(*map);
+        problem = std::make_unique<Epetra_LinearProblem>(matrix.get(),
+                                                         x.get(),
+                                                         b.get());
+        Amesos factory;
+        solver.reset(factory.Create(type, *problem));
+        if (!solver)
+          throw std::runtime_error("Trilinos Amesos has no " + type);
+        row_start = &pattern.row_start;
+        if (solver->SymbolicFactorization() != 0)
+          throw std::runtime_error(type + " symbolic factorisation failed");
+      }
+
+      bool
+      factorize(const std::vector<double> &values) override
+      {
+        for (int i = 0; i < matrix->NumMyRows(); ++i)
+          {
+            int     n;
+            double *v;
+            int    *cols;
+            matrix->ExtractMyRowView(i, n, v, cols);
+            std::copy(values.begin() + (*row_start)[i],
+                      values.begin() + (*row_start)[i + 1],
+                      v);
+          }
+        if (solver->NumericFactorization() != 0)
+          {
+            message_ = type + " numeric factorisation failed";
+            return false;
+          }
+        return true;
+      }
+
+      bool
+      solve(std::vector<double> &rhs) override
+      {
+        std::copy(rhs.begin(), rhs.end(), &(*b)[0]);
+        if (solver->Solve() != 0)
+          {
+            message_ = type + " solve failed";
+            return false;
+          }
+        std::copy(&(*x)[0], &(*x)[0] + rhs.size(), rhs.begin());
+        return all_finite(rhs);
+      }
+
+      std::string
+      name() const override
+      {
+        return "Trilinos " + type;
+      }
+
+    private:
+      std::string                           type;
+      Epetra_MpiComm                        comm;
+      std::unique_ptr<Epetra_Map>           map;
+      std::unique_ptr<Epetra_CrsMatrix>     matrix;
+      std::unique_ptr<Epetra_Vector>        x, b;
+      std::unique_ptr<Epetra_LinearProblem> problem;
+      std::unique_ptr<Amesos_BaseSolver>    solver;
+      const std::vector<unsigned int>      *row_start = nullptr;
+    };
+  } // namespace
+
+
+
+  std::unique_ptr<LinearSolver>
+  LinearSolver::create(const std::string &name, const std::string &ordering)
+  {
+    if (name == "MUMPS")
+      return std::make_unique<Mumps>(ordering);
+    if (name == "UMFPACK")
+      return std::make_unique<Umfpack>();
+    if (name == "KLU")
+      return std::make_unique<Klu>();
+    if (name == "Amesos MUMPS")
+      return std::make_unique<AmesosSolver>("Amesos_Mumps");
+    if (name == "Amesos KLU")
+      return std::make_unique<AmesosSolver>("Amesos_Klu");
+    throw std::invalid_argument("unknown linear solver '" + name + "'");
+  }
+} // namespace palpate
