@@ -10,6 +10,9 @@
 #define palpate_tests_h
 
 #include <palpate/base/environment.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
 
 #include <deal.II/base/logstream.h>
 
@@ -63,6 +66,27 @@ run_palpate(const std::string &arguments)
   const int status = pclose(pipe);
   run.exit_status  = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
+}
+
+/** A scene with its mesh and its fixed and active nodes. */
+struct Body
+{
+  explicit Body(const palpate::Scene &s)
+    : scene(s)
+    , mesh(palpate::Mesh::create(scene))
+    , nodes(palpate::NodeSelection::create(scene, mesh))
+  {}
+
+  palpate::Scene         scene;
+  palpate::Mesh          mesh;
+  palpate::NodeSelection nodes;
+};
+
+/** A shipped scene from parameters/, e.g. "liver-stvk.prm". */
+inline palpate::Scene
+shipped_scene(const std::string &name)
+{
+  return palpate::Scene::read(palpate_source_dir + "/parameters/" + name);
 }
 
 /** Write @p text to the file @p name. */

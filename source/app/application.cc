@@ -3,12 +3,14 @@
 
 #include <palpate/app/application.h>
 #include <palpate/app/scene_report.h>
+#include <palpate/app/static_solve.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,11 @@ namespace palpate
       "\n"
       "Usage:\n"
       "  palpate SCENE.prm               set up the scene and run it\n"
+      "  palpate solve SCENE.prm [--to X,Y,Z]\n"
+      "                                  compute the state with the active node\n"
+      "                                  displaced by X,Y,Z metres from rest\n"
+      "                                  (default: the scene's Prescribed\n"
+      "                                  displacement) and print the force\n"
       "  palpate --print-parameters [prm|markdown]\n"
       "                                  print every scene parameter with its\n"
       "                                  default and documentation\n"
@@ -32,18 +39,34 @@ namespace palpate
       "(default.prm, liver-stvk.prm, liver-mooney-rivlin.prm, beam.prm) and\n"
       "doc/parameters.md documents every entry.\n";
 
-    /** Set up a scene: read it, build the mesh, select the nodes. */
+    /**
+     * Set up a scene (read it, build the mesh, select the nodes), report
+     * it, and solve for the active node's prescribed displacement if it is
+     * not zero or if @p target is given.
+     */
     int
-    run_scene(const std::string &filename, std::ostream &out)
+    run_scene(const std::string               &filename,
+              std::optional<Utilities::Point3> target,
+              std::ostream                    &out)
     {
       const Scene         scene = Scene::read(filename);
       const Mesh          mesh  = Mesh::create(scene);
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
       print_scene_report(out, scene, mesh, nodes);
-      out << "\nSolving is not available yet: this version sets up and checks "
-             "the scene only.\nThe hyperelastic solver that computes states "
-             "and forces is the next capability to land.\n";
-      return ExitStatus::success;
+      const auto &prescribed = scene.parameters.boundary_conditions.active_node
+                                 .prescribed_displacement;
+      if (!target && Utilities::norm(prescribed) > 0)
+        target = prescribed;
+      if (!target)
+        {
+          out << "\nThe active node's prescribed displacement is zero: nothing "
+                 "to solve.\n";
+          return ExitStatus::success;
+        }
+      out << "\n";
+      return run_static_solve(out, scene, mesh, nodes, *target) ?
+               ExitStatus::success :
+               ExitStatus::solve_failed;
     }
 
     int
@@ -79,13 +102,47 @@ namespace palpate
                          args[0],
                          "unknown option '" + args[0] + "'",
                          "run 'palpate --help' for the options.");
+      if (args[0] == "solve")
+        {
+          if (args.size() < 2)
+            throw InputError("command line",
+                             0,
+                             "solve",
+                             "'solve' needs a scene file",
+                             "run 'palpate solve SCENE.prm [--to X,Y,Z]'.");
+          std::optional<Utilities::Point3> target;
+          for (unsigned int i = 2; i < args.size(); ++i)
+            if (args[i] == "--to" && i + 1 < args.size())
+              {
+                try
+                  {
+                    target = Utilities::parse_point(args[++i]);
+                  }
+                catch (const std::invalid_argument &e)
+                  {
+                    throw InputError("command line",
+                                     0,
+                                     "--to " + args[i],
+                                     e.what(),
+                                     "give the displacement in metres as "
+                                     "X,Y,Z, e.g. --to 0,0,-0.02.");
+                  }
+              }
+            else
+              throw InputError("command line",
+                               0,
+                               args[i],
+                               "unexpected argument '" + args[i] + "'",
+                               "run 'palpate --help' for the usage.");
+          return run_scene(args[1], target, out);
+        }
       if (args.size() > 1)
         throw InputError("command line",
                          0,
                          args[1],
                          "unexpected argument '" + args[1] + "'",
                          "run 'palpate --help' for the usage.");
-      return run_scene(args[0], out);
+      return run_scene(args[0], std::nullopt, out);
     }
   } // namespace
 

@@ -196,7 +196,8 @@ namespace palpate
                           "Node numbers for Selection = node list, as the "
                           "mesh file numbers them: Gmsh node tags, VTK/VTU "
                           "point indices (from 0), generator vertex indices. "
-                          "The VTU output shows them as 'node id'.");
+                          "The VTU output shows them as 'node_id'. Surface "
+                          "nodes only does not apply to a list.");
         prm.declare_entry("Surface nodes only",
                           "true",
                           Patterns::Bool(),
@@ -926,6 +927,12 @@ namespace palpate
                           Patterns::MultipleSelection("csv|json"),
                           "Machine-readable copies of the run summary, "
                           "besides the screen: any of csv, json.");
+        prm.declare_entry("Print timings",
+                          "true",
+                          Patterns::Bool(),
+                          "Whether reports include wall-clock times (ms). "
+                          "Turn off for output that is the same on every "
+                          "machine, as the tests do.");
       }
       prm.leave_subsection();
     }
@@ -942,6 +949,7 @@ namespace palpate
         for (const auto &f : Utilities::split(prm.get("Summary formats"), ','))
           if (!f.empty())
             summary_formats.push_back(f);
+        print_timings = prm.get_bool("Print timings");
       }
       prm.leave_subsection();
     }

@@ -19,6 +19,8 @@ namespace palpate
     constexpr int input_error = 2;
     /** The scene asks for something this version cannot do yet. */
     constexpr int not_available = 3;
+    /** A static solve ended in a failure point (no equilibrium found). */
+    constexpr int solve_failed = 4;
   } // namespace ExitStatus
 
   /**

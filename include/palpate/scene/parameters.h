@@ -288,6 +288,8 @@ namespace palpate
       std::string directory;
       /** Machine-readable run summary formats: subset of {csv, json}. */
       std::vector<std::string> summary_formats;
+      /** Whether reports include wall-clock times. */
+      bool print_timings;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);

@@ -1,0 +1,200 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_hyperelastic_hyperelastic_system_h
+#define palpate_hyperelastic_hyperelastic_system_h
+
+#include <palpate/base/utilities.h>
+#include <palpate/hyperelastic/linear_solver.h>
+#include <palpate/hyperelastic/state.h>
+#include <palpate/scene/parameters.h>
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  class Mesh;
+  class Material;
+  struct NodeSelection;
+
+  /**
+   * The discrete non-linear system of one body: the finite element space
+   * (FE_SimplexP of degree 1 or 2, three components), the constraints, and
+   * the assembly of the residual and its tangent.
+   *
+   * The unknowns x are the *equations* of the system:
+   *
+   *   x = [ free displacement DoFs | multipliers ]
+   *
+   * Fixed nodes are either eliminated (their DoFs are not unknowns) or
+   * constrained by multipliers, as the scene says. The active node's three
+   * DoFs are always constrained by multipliers. With the constraint rows
+   * scaled by a stiffness beta (so that all residual rows are forces), the
+   * residual is
+   *
+   *   R_u = f_int(u) - f_ext + beta B^T x_lambda,   R_lambda = beta (B u - g),
+   *
+   * and the physical multipliers are lambda = beta x_lambda. At equilibrium
+   * lambda = f_ext - f_int at the constrained DoFs: the force the body
+   * exerts on whatever holds that DoF — for the active node, on the probe.
+   *
+   * Total Lagrangian formulation: the reference geometry never changes, so
+   * shape-function gradients and JxW are computed once with deal.II's
+   * FEValues and cached; every assembly afterwards is arithmetic on cached
+   * numbers. The sparsity pattern and the position of every local matrix
+   * entry in it are fixed at construction.
+   *
+   * Not thread-safe: each solver worker owns its own instance. Assembly may
+   * itself use several threads (Nonlinear solver / Assembly threads); cells
+   * are coloured so that threads never write to the same entry, and the
+   * summation order is the same for any thread count, so results are
+   * bitwise reproducible.
+   */
+  class HyperelasticSystem
+  {
+  public:
+    /** Set up the system for the scene's material, discretisation and
+     * constraints. */
+    HyperelasticSystem(const Mesh                      &mesh,
+                       const NodeSelection             &nodes,
+                       const Parameters::AllParameters &parameters);
+
+    ~HyperelasticSystem();
+
+    /** Number of DoFs of the finite element space (3 per node for P1). */
+    unsigned int
+    n_dofs() const;
+
+    /** Number of unknowns/equations of the linear systems. */
+    unsigned int
+    n_equations() const;
+
+    /** Number of Lagrange multipliers (3 for the active node, plus 3 per
+     * fixed DoF triple when fixed nodes use multipliers). */
+    unsigned int
+    n_multipliers() const;
+
+    /** The fixed sparsity pattern of the tangent. */
+    const SparsityCSR &
+    sparsity() const;
+
+    /** The material law. */
+    const Material &
+    material() const;
+
+    /** The body's diameter L (m), used to scale displacement tolerances. */
+    double
+    length_scale() const;
+
+    /** The scale beta of the constraint rows (N/m). */
+    double
+    constraint_scale() const;
+
+    /** The DoFs of the active node (x, y, z components). */
+    const std::array<unsigned int, 3> &
+    active_dofs() const;
+
+    /** All fixed DoFs (sorted). */
+    const std::vector<unsigned int> &
+    fixed_dofs() const;
+
+    /**
+     * The reference position of each DoF's node (m): the vertex, or (P2)
+     * the edge midpoint; and the component (0, 1, 2) each DoF displaces.
+     */
+    const std::vector<Utilities::Point3> &
+    dof_positions() const;
+
+    /** The component of each DoF. */
+    const std::vector<unsigned int> &
+    dof_components() const;
+
+    /** Polynomial degree and number of quadrature points per cell. */
+    std::string
+    discretization_description() const;
+
+    /**
+     * Prescribe a displacement (m) at the fixed nodes, as a function of the
+     * reference position. Fixed nodes are held at zero by default; tests
+     * use this for the patch test.
+     */
+    void
+    set_fixed_displacement(
+      const std::function<Utilities::Point3(const Utilities::Point3 &)> &f);
+
+    /** The unknowns of the rest state: all zero. */
+    std::vector<double>
+    rest_unknowns() const;
+
+    /**
+     * Evaluate the residual at unknowns @p x with the active node's
+     * displacement @p target (m), and the tangent (into @p matrix, in the
+     * order of sparsity()) if @p matrix is not null.
+     *
+     * Returns false, without a usable result, if some quadrature point is
+     * not admissible (det F <= 0, or the material undefined there) or a
+     * number is not finite.
+     *
+     * If @p force_scale is not null, it receives the force scale of the
+     * convergence test (N): the largest of the norm of the internal forces
+     * at all DoFs (which includes the reactions), the norm of the
+     * multipliers, and 1e-12 E L^2.
+     */
+    bool
+    assemble(const std::vector<double> &x,
+             const Utilities::Point3   &target,
+             std::vector<double>       &residual,
+             std::vector<double>       *matrix,
+             double                    *force_scale = nullptr) const;
+
+    /** Euclidean norm of the displacement rows of @p residual (N). */
+    double
+    force_residual_norm(const std::vector<double> &residual) const;
+
+    /** Largest violation of a constraint, |B u - g| (m), given the
+     * residual. */
+    double
+    constraint_violation(const std::vector<double> &residual) const;
+
+    /** Largest absolute displacement entry of an update @p dx (m). */
+    double
+    max_displacement(const std::vector<double> &dx) const;
+
+    /** Fill the solution, multipliers and force of @p state from @p x. */
+    void
+    to_state(const std::vector<double> &x, State &state) const;
+
+    /** The unknowns that reproduce @p state. */
+    std::vector<double>
+    from_state(const State &state) const;
+
+    /**
+     * f_int(u) - f_ext at every DoF for a state's displacement (N): zero at
+     * free DoFs in equilibrium, minus the reactions at constrained ones.
+     */
+    std::vector<double>
+    nodal_residual(const std::vector<double> &solution) const;
+
+    /** Strain energy of a state's displacement (J). */
+    double
+    strain_energy(const std::vector<double> &solution) const;
+
+    /**
+     * Write a state as VTU for ParaView: displacement (warp by it to see
+     * the deformed body), node ids as the mesh file numbers them, fixed and
+     * active flags, and the force at the active node as field data.
+     */
+    void
+    write_vtu(const State &state, const std::string &filename) const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl;
+  };
+} // namespace palpate
+
+#endif

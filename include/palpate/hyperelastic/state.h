@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_hyperelastic_state_h
+#define palpate_hyperelastic_state_h
+
+#include <palpate/base/utilities.h>
+
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  /** How the computation of a state ended. */
+  enum class SolveStatus
+  {
+    /** Every increment converged: the state is an equilibrium. */
+    converged,
+    /** An increment did not converge within the iteration limit. */
+    max_iterations,
+    /** Every step the line search tried inverted an element (det F <= 0). */
+    inverted_element,
+    /** A residual or update became NaN or infinite. */
+    not_finite,
+    /** The sparse direct solver failed (singular tangent). */
+    linear_solver_failure
+  };
+
+  /** A short name for @p status, e.g. "max iterations". */
+  std::string
+  to_string(const SolveStatus status);
+
+  /** What one Newton iteration did, and where its time went. */
+  struct NewtonIteration
+  {
+    /** The increment of the staging this iteration belongs to (from 1). */
+    unsigned int increment;
+    /** Force residual relative to the force scale before the iteration. */
+    double residual_before;
+    /** Force residual relative to the force scale after the iteration. */
+    double residual_after;
+    /** Largest constraint violation |B u - g| after the iteration (m). */
+    double constraint_after;
+    /** Largest displacement correction of the step taken (m). */
+    double correction;
+    /** Line search step length taken (1 = full Newton step). */
+    double step_length;
+    /** Wall-clock seconds: residual+tangent assembly, factorisation and
+     * solve, line search (residual evaluations at trial points). */
+    double assembly_time, solve_time, line_search_time;
+  };
+
+  /**
+   * One static equilibrium state of the body with the active node at a
+   * given position: the paper's C = (u, f). A State also records how it was
+   * computed, so the engine and the benchmarks can learn from it.
+   */
+  struct State
+  {
+    /** Prescribed displacement of the active node from rest (m). */
+    Utilities::Point3 active_displacement = {{0, 0, 0}};
+
+    /**
+     * The force the body exerts on the probe at the active node (N): the
+     * Lagrange multiplier of the active node's constraint. This is what the
+     * device renders.
+     */
+    Utilities::Point3 force = {{0, 0, 0}};
+
+    /** Nodal solution in deal.II DoF order (displacements, m). */
+    std::vector<double> solution;
+
+    /** All Lagrange multipliers (N): the active node's three, then those
+     * of the fixed nodes if they are imposed by multipliers. */
+    std::vector<double> multipliers;
+
+    /** Whether this is an equilibrium (status == converged). */
+    bool converged = true;
+
+    /** How the computation ended. */
+    SolveStatus status = SolveStatus::converged;
+
+    /** For failures: what happened, in one sentence. */
+    std::string message;
+
+    /** Increments of the incremental staging (including cutbacks). */
+    unsigned int increments = 0;
+
+    /** Newton iterations over all increments. */
+    unsigned int newton_iterations = 0;
+
+    /** Most Newton iterations one increment needed. */
+    unsigned int max_increment_iterations = 0;
+
+    /** Every Newton iteration, in order. */
+    std::vector<NewtonIteration> history;
+
+    /** Total wall-clock seconds spent computing this state. */
+    double wall_time = 0;
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/app/static_solve.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/state_solver.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <ostream>
+
+namespace palpate
+{
+  bool
+  run_static_solve(std::ostream            &out,
+                   const Scene             &scene,
+                   const Mesh              &mesh,
+                   const NodeSelection     &nodes,
+                   const Utilities::Point3 &target)
+  {
+    const auto &p = scene.parameters;
+    StateSolver solver(mesh, nodes, p);
+    const auto &system = solver.system();
+
+    out << "Static solve\n"
+        << "  discretisation: " << system.discretization_description() << ", "
+        << system.n_dofs() << " DoFs\n"
+        << "  equations:      " << system.n_equations() << " ("
+        << system.n_equations() - system.n_multipliers() << " displacements, "
+        << system.n_multipliers() << " multipliers)\n"
+        << "  linear solver:  " << solver.linear_solver_name() << "\n"
+        << "  active node:    from rest to (" << Utilities::to_string(target, 4)
+        << ") m\n";
+
+    const State state = solver.solve(solver.rest_state(), target);
+
+    out
+      << "  Newton history (force residual relative to the force scale, after\n"
+      << "  each iteration; constraint violation of the active node):\n"
+      << "    incr  iter   residual  constraint [m]   step  correction [m]\n";
+    unsigned int iteration = 0, last_increment = 0;
+    for (const auto &h : state.history)
+      {
+        if (h.increment != last_increment)
+          iteration = 0, last_increment = h.increment;
+        out << "    " << std::setw(4) << h.increment << "  " << std::setw(4)
+            << ++iteration << "  " << std::scientific << std::setprecision(2)
+            << std::setw(9) << h.residual_after << "  " << std::setw(9)
+            << h.constraint_after << "       " << std::defaultfloat
+            << std::setprecision(3) << std::setw(5) << h.step_length << "  "
+            << std::scientific << std::setprecision(2) << h.correction
+            << std::defaultfloat << "\n";
+      }
+    if (state.converged)
+      out << "  converged:      " << state.increments << " increments, "
+          << state.newton_iterations << " Newton iterations (at most "
+          << state.max_increment_iterations << " per increment)\n"
+          << "  force on probe: (" << Utilities::to_string(state.force, 5)
+          << ") N, |f| = "
+          << Utilities::to_string(Utilities::norm(state.force), 5) << " N\n";
+    else
+      out << "  FAILURE POINT:  " << to_string(state.status) << ": "
+          << state.message
+          << "\n  (no force is reported for a failure point)\n";
+
+    if (!solver.linear_solver_statistics().empty())
+      out << "  factorisation:  " << solver.linear_solver_statistics() << "\n";
+    // Where the time went, summed over the iterations.
+    double assembly = 0, solve = 0, line_search = 0;
+    for (const auto &h : state.history)
+      assembly += h.assembly_time, solve += h.solve_time,
+        line_search += h.line_search_time;
+    if (p.output.print_timings)
+      out << std::setprecision(3) << "  time:           set-up "
+          << 1000 * solver.setup_time() << " ms; solve "
+          << 1000 * state.wall_time << " ms = assembly " << 1000 * assembly
+          << " + linear solves " << 1000 * solve << " + line search "
+          << 1000 * line_search << " + other "
+          << 1000 * (state.wall_time - assembly - solve - line_search)
+          << " ms\n";
+
+    // Effects: only when the scene asks for them.
+    if (p.effects.vtu_export || p.effects.force_log)
+      std::filesystem::create_directories(p.output.directory);
+    const std::string stem =
+      scene.file().empty() ?
+        "default" :
+        std::filesystem::path(scene.file()).stem().string();
+    if (p.effects.vtu_export)
+      {
+        const std::string file = p.output.directory + "/" + stem + "-state.vtu";
+        system.write_vtu(state, file);
+        out << "  wrote " << file << " (warp by 'displacement' in ParaView)\n";
+      }
+    if (p.effects.force_log)
+      {
+        const std::string file =
+          p.output.directory + "/" + stem + "-forces.csv";
+        std::ofstream csv(file);
+        csv << "target_x_m,target_y_m,target_z_m,force_x_N,force_y_N,force_z_N,"
+               "converged,newton_iterations\n"
+            << std::setprecision(10) << target[0] << "," << target[1] << ","
+            << target[2] << "," << state.force[0] << "," << state.force[1]
+            << "," << state.force[2] << "," << (state.converged ? 1 : 0) << ","
+            << state.newton_iterations << "\n";
+        out << "  wrote " << file << "\n";
+      }
+    return state.converged;
+  }
+} // namespace palpate

@@ -1,0 +1,515 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/linear_solver.h>
+#include <palpate/hyperelastic/state_solver.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace palpate
+{
+  std::string
+  to_string(const SolveStatus status)
+  {
+    switch (status)
+      {
+        case SolveStatus::converged:
+          return "converged";
+        case SolveStatus::max_iterations:
+          return "max iterations";
+        case SolveStatus::inverted_element:
+          return "inverted element";
+        case SolveStatus::not_finite:
+          return "not finite";
+        case SolveStatus::linear_solver_failure:
+          return "linear solver failure";
+      }
+    return "unknown";
+  }
+
+
+
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    double
+    seconds_since(const Clock::time_point start)
+    {
+      return std::chrono::duration<double>(Clock::now() - start).count();
+    }
+
+    double
+    norm(const std::vector<double> &v)
+    {
+      double s = 0;
+      for (const double x : v)
+        s += x * x;
+      return std::sqrt(s);
+    }
+  } // namespace
+
+
+
+  struct StateSolver::Impl
+  {
+    Impl(const Mesh                      &mesh,
+         const NodeSelection             &nodes,
+         const Parameters::AllParameters &p)
+      : settings(p.nonlinear_solver)
+    {
+      const auto start = Clock::now();
+      system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
+      linear_solver =
+        LinearSolver::create(p.linear_solver.solver, p.linear_solver.ordering);
+      linear_solver->analyze(system->sparsity());
+      setup_time = seconds_since(start);
+    }
+
+    /** What one Newton solve of one increment ended with. */
+    struct Outcome
+    {
+      SolveStatus  status = SolveStatus::converged;
+      std::string  message;
+      unsigned int iterations = 0;
+    };
+
+    /** s = R_u . dx_u: the derivative of the energy along the step dx
+     * once the constraints hold. */
+    double
+    directional_derivative(const std::vector<double> &residual,
+                           const std::vector<double> &dx) const
+    {
+      const unsigned int n = system->n_equations() - system->n_multipliers();
+      double             s = 0;
+      for (unsigned int i = 0; i < n; ++i)
+        s += residual[i] * dx[i];
+      return s;
+    }
+
+    /** Newton's method for the active node at @p target, from @p x. */
+    Outcome
+    newton(std::vector<double>     &x,
+           const Utilities::Point3 &target,
+           State                   &state);
+
+    /**
+     * Whether @p residual is an equilibrium: force residual below the
+     * tolerance relative to the force scale and the constraints satisfied;
+     * or, where round-off keeps the residual from going lower, a negligible
+     * last correction and a residual within 1000 times the tolerance.
+     */
+    bool
+    converged(const std::vector<double> &residual,
+              const double               force_scale,
+              const double               last_correction) const
+    {
+      const double L = system->length_scale();
+      if (system->constraint_violation(residual) >
+          settings.increment_tolerance * L)
+        return false;
+      const double r = system->force_residual_norm(residual);
+      if (r <= settings.residual_tolerance * force_scale)
+        return true;
+      return last_correction >= 0 &&
+             last_correction <= settings.increment_tolerance * L &&
+             r <= 1e3 * settings.residual_tolerance * force_scale;
+    }
+
+    std::unique_ptr<HyperelasticSystem> system;
+    std::unique_ptr<LinearSolver>       linear_solver;
+    Parameters::NonlinearSolver         settings;
+    double                              setup_time = 0;
+
+    // Work vectors, reused from solve to solve.
+    std::vector<double> residual, trial_residual, best_residual, matrix, step,
+      trial, best_x;
+  };
+
+
+
+  StateSolver::Impl::Outcome
+  StateSolver::Impl::newton(std::vector<double>     &x,
+                            const Utilities::Point3 &target,
+                            State                   &state)
+  {
+    Outcome outcome;
+    double  scale = 0;
+
+    auto start = Clock::now();
+    if (!system->assemble(x, target, residual, &matrix, &scale))
+      {
+        // The starting state is a converged neighbour, so this is only
+        // reachable with a corrupt input state.
+        outcome.status  = SolveStatus::not_finite;
+        outcome.message = "the starting state is not admissible";
+        return outcome;
+      }
+    double       assembly_time   = seconds_since(start);
+    double       last_correction = -1;
+    unsigned int short_steps     = 0;
+
+    for (unsigned int iteration = 0;; ++iteration)
+      {
+        if (converged(residual, scale, last_correction))
+          {
+            outcome.iterations = iteration;
+            return outcome;
+          }
+        if (iteration == settings.max_newton_iterations)
+          {
+            outcome.status     = SolveStatus::max_iterations;
+            outcome.iterations = iteration;
+            outcome.message =
+              "Newton did not converge in " + std::to_string(iteration) +
+              " iterations (relative residual " +
+              Utilities::to_string(system->force_residual_norm(residual) /
+                                     scale,
+                                   3) +
+              ")";
+            return outcome;
+          }
+
+        NewtonIteration record;
+        record.increment       = state.increments;
+        record.residual_before = system->force_residual_norm(residual) / scale;
+        record.assembly_time   = assembly_time;
+
+        // The Newton step: K dx = -R.
+        start = Clock::now();
+        step  = residual;
+        for (double &s : step)
+          s = -s;
+        if (!linear_solver->factorize(matrix) || !linear_solver->solve(step))
+          {
+            outcome.status     = SolveStatus::linear_solver_failure;
+            outcome.iterations = iteration;
+            outcome.message    = linear_solver->message();
+            return outcome;
+          }
+        record.solve_time = seconds_since(start);
+
+        // Step length. While the active node's constraint is violated (the
+        // first iteration of an increment), the step is the predictor that
+        // moves the node onto its target: take the longest admissible one
+        // of 1, 1/2, 1/4, ... Afterwards every Newton step keeps the
+        // constraint (B dx = 0), the multipliers drop out of
+        // s(alpha) = R(x + alpha dx) . dx = dPi/dalpha, and the line search
+        // looks for a step where the energy Pi stops decreasing:
+        // |s(alpha)| <= 0.8 |s(0)| (Crisfield's criterion), by regula falsi
+        // on s. If dx is not a descent direction (s(0) >= 0: the tangent is
+        // indefinite near a buckling point), it backtracks on the residual
+        // norm instead. Without line search the full step is taken.
+        start             = Clock::now();
+        const double phi0 = norm(residual);
+        const bool   predictor =
+          system->constraint_violation(residual) >
+          settings.increment_tolerance * system->length_scale();
+        const double s0     = directional_derivative(residual, step);
+        const bool   energy = !predictor && s0 < 0;
+        double       alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
+        double       lower = 0, s_lower = s0, upper = -1, s_upper = 0;
+        const unsigned int steps =
+          settings.line_search ? settings.max_line_search_steps : 1;
+        for (unsigned int k = 0; k < steps; ++k)
+          {
+            trial = x;
+            for (unsigned int i = 0; i < x.size(); ++i)
+              trial[i] += alpha * step[i];
+            double trial_scale = 0;
+            if (!system->assemble(
+                  trial, target, trial_residual, nullptr, &trial_scale))
+              {
+                // Inadmissible (an element inverts): shorten the step.
+                upper   = alpha;
+                s_upper = std::numeric_limits<double>::max();
+                alpha   = 0.5 * (lower + alpha);
+                continue;
+              }
+            const double phi   = norm(trial_residual);
+            const double s     = directional_derivative(trial_residual, step);
+            const double merit = energy ? std::abs(s) : phi;
+            if (best_alpha < 0 || merit < best_merit)
+              {
+                best_alpha = alpha;
+                best_merit = merit;
+                best_scale = trial_scale;
+                best_x.swap(trial);
+                best_residual.swap(trial_residual);
+              }
+            if (predictor)
+              break; // the longest admissible predictor step
+            if (energy)
+              {
+                if (std::abs(s) <= 0.8 * std::abs(s0) || (s < 0 && upper < 0))
+                  break; // energy stationary enough, or still descending at the
+                         // full step
+                // Regula falsi on s between the bracket ends.
+                if (s < 0)
+                  lower = alpha, s_lower = s;
+                else
+                  upper = alpha, s_upper = s;
+                alpha =
+                  (s_upper == std::numeric_limits<double>::max()) ?
+                    0.5 * (lower + upper) :
+                    lower - s_lower * (upper - lower) / (s_upper - s_lower);
+                alpha = std::clamp(alpha,
+                                   lower + 0.05 * (upper - lower),
+                                   upper - 0.05 * (upper - lower));
+              }
+            else
+              {
+                if (phi <= (1 - 1e-4 * alpha) * phi0)
+                  break;
+                // g(a) = phi(a)^2 has g'(0) = -2 g(0) along the Newton
+                // step; minimise the quadratic through g(0), g'(0), g(a).
+                const double g0 = phi0 * phi0;
+                const double a =
+                  g0 * alpha * alpha / (phi * phi - g0 + 2 * g0 * alpha);
+                alpha = std::clamp(a, 0.1 * alpha, 0.5 * alpha);
+              }
+          }
+        record.line_search_time = seconds_since(start);
+        if (best_alpha < 0)
+          {
+            record.step_length      = 0;
+            record.correction       = 0;
+            record.residual_after   = record.residual_before;
+            record.constraint_after = system->constraint_violation(residual);
+            state.history.push_back(record);
+            outcome.status     = SolveStatus::inverted_element;
+            outcome.iterations = iteration + 1;
+            outcome.message =
+              settings.line_search ?
+                "every step the line search tried inverts an element" :
+                "the Newton step inverts an element";
+            return outcome;
+          }
+        x.swap(best_x);
+        residual.swap(best_residual);
+        scale                   = best_scale;
+        record.residual_after   = system->force_residual_norm(residual) / scale;
+        record.constraint_after = system->constraint_violation(residual);
+        record.step_length      = best_alpha;
+        record.correction       = best_alpha * system->max_displacement(step);
+        state.history.push_back(record);
+        last_correction = record.correction;
+
+        // A line search that keeps cutting the step to almost nothing is
+        // not getting anywhere: stop instead of burning the iteration
+        // budget (the state is a failure point either way).
+        short_steps = best_alpha < 1e-2 ? short_steps + 1 : 0;
+        if (short_steps == 4)
+          {
+            outcome.status     = SolveStatus::max_iterations;
+            outcome.iterations = iteration + 1;
+            outcome.message    = "Newton stagnates: 4 line-search steps "
+                                 "shorter than 1/100 (relative residual " +
+                              Utilities::to_string(record.residual_after, 3) +
+                              ")";
+            return outcome;
+          }
+
+        if (converged(residual, scale, last_correction))
+          {
+            outcome.iterations = iteration + 1;
+            return outcome;
+          }
+        start = Clock::now();
+        system->assemble(x, target, residual, &matrix, &scale);
+        assembly_time = seconds_since(start);
+      }
+  }
+
+
+
+  StateSolver::StateSolver(const Mesh                      &mesh,
+                           const NodeSelection             &nodes,
+                           const Parameters::AllParameters &parameters)
+    : impl(std::make_unique<Impl>(mesh, nodes, parameters))
+  {}
+
+
+
+  StateSolver::~StateSolver() = default;
+
+
+
+  State
+  StateSolver::rest_state() const
+  {
+    State state;
+    impl->system->to_state(impl->system->rest_unknowns(), state);
+    return state;
+  }
+
+
+
+  State
+  StateSolver::solve(const State &from, const Utilities::Point3 &target)
+  {
+    const auto start = Clock::now();
+    State      state;
+    state.active_displacement = target;
+
+    for (const double t : target)
+      if (!std::isfinite(t))
+        {
+          state.converged = false;
+          state.status    = SolveStatus::not_finite;
+          state.message   = "the target position is not finite";
+          state.solution  = from.solution;
+          state.multipliers.assign(from.multipliers.size(), 0.0);
+          state.force = {{0, 0, 0}};
+          return state;
+        }
+
+    const auto         &s      = impl->settings;
+    std::vector<double> x      = impl->system->from_state(from);
+    const auto          a      = from.active_displacement;
+    const double        length = Utilities::distance(a, target);
+    unsigned int        n      = s.n_increments;
+    if (s.max_increment_length > 0)
+      n = std::max(n,
+                   static_cast<unsigned int>(
+                     std::ceil(length / s.max_increment_length - 1e-12)));
+    const auto point = [&](const double t) {
+      return Utilities::Point3{{a[0] + t * (target[0] - a[0]),
+                                a[1] + t * (target[1] - a[1]),
+                                a[2] + t * (target[2] - a[2])}};
+    };
+
+    // One increment from parameter t0 to t1 of the path, halved up to
+    // max_cutbacks times if it fails. After the first increment, Newton
+    // starts from the secant predictor: the previous increment's change,
+    // extrapolated (it puts the active node on its new target, and is
+    // usually much closer to equilibrium than the previous state).
+    Impl::Outcome       failure;
+    std::vector<double> previous; // converged unknowns one increment back
+    double              previous_t = 0, current_t = 0;
+    std::function<bool(double, double, unsigned int)> increment =
+      [&](const double t0, const double t1, const unsigned int depth) {
+        const std::vector<double> saved     = x;
+        bool                      predicted = false;
+        if (!previous.empty() && t0 == current_t && current_t > previous_t)
+          {
+            const double        r     = (t1 - t0) / (current_t - previous_t);
+            std::vector<double> guess = x;
+            for (unsigned int i = 0; i < x.size(); ++i)
+              guess[i] += r * (x[i] - previous[i]);
+            if (impl->system->assemble(
+                  guess, point(t1), impl->residual, nullptr))
+              {
+                x.swap(guess);
+                predicted = true;
+              }
+          }
+        ++state.increments;
+        Impl::Outcome o = impl->newton(x, point(t1), state);
+        state.newton_iterations += o.iterations;
+        if (o.status != SolveStatus::converged && predicted)
+          {
+            // The extrapolation can overshoot into an unstable region:
+            // start again from the last equilibrium.
+            x                         = saved;
+            const Impl::Outcome retry = impl->newton(x, point(t1), state);
+            state.newton_iterations += retry.iterations;
+            o.iterations += retry.iterations;
+            if (retry.status == SolveStatus::converged)
+              o.status = SolveStatus::converged;
+            else
+              o = retry;
+          }
+        state.max_increment_iterations =
+          std::max(state.max_increment_iterations, o.iterations);
+        if (o.status == SolveStatus::converged)
+          {
+            previous   = saved;
+            previous_t = t0;
+            current_t  = t1;
+            return true;
+          }
+        x = saved;
+        if (depth < s.max_cutbacks)
+          {
+            const double middle = 0.5 * (t0 + t1);
+            return increment(t0, middle, depth + 1) &&
+                   increment(middle, t1, depth + 1);
+          }
+        failure = o;
+        failure.message +=
+          " (increment to " + Utilities::to_string(point(t1), 4) + " m)";
+        return false;
+      };
+
+    bool ok = true;
+    for (unsigned int i = 1; i <= n && ok; ++i)
+      ok = increment(double(i - 1) / n, double(i) / n, 0);
+
+    impl->system->to_state(x, state);
+    if (!ok)
+      {
+        // A failure point: keep the last equilibrium reached on the way,
+        // but never hand out its force as the target's.
+        state.converged = false;
+        state.status    = failure.status;
+        state.message   = failure.message;
+        state.force     = {{0, 0, 0}};
+      }
+    state.wall_time = seconds_since(start);
+    return state;
+  }
+
+
+
+  const HyperelasticSystem &
+  StateSolver::system() const
+  {
+    return *impl->system;
+  }
+
+
+
+  HyperelasticSystem &
+  StateSolver::system()
+  {
+    return *impl->system;
+  }
+
+
+
+  std::string
+  StateSolver::linear_solver_name() const
+  {
+    return impl->linear_solver->name();
+  }
+
+
+
+  std::string
+  StateSolver::linear_solver_statistics() const
+  {
+    return impl->linear_solver->statistics();
+  }
+
+
+
+  Parameters::NonlinearSolver &
+  StateSolver::settings()
+  {
+    return impl->settings;
+  }
+
+
+
+  double
+  StateSolver::setup_time() const
+  {
+    return impl->setup_time;
+  }
+} // namespace palpate
