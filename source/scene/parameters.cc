@@ -666,9 +666,12 @@ namespace palpate
           "analyse the sparsity pattern once per solver.");
         prm.declare_entry(
           "Ordering",
-          "METIS",
-          Patterns::Selection("METIS|AMD|AMF|QAMD|PORD|SCOTCH|automatic"),
-          "Fill-reducing ordering MUMPS uses in its analysis (ICNTL(7)).");
+          "AMF",
+          Patterns::Selection("AMF|METIS|AMD|QAMD|PORD|SCOTCH|automatic"),
+          "Fill-reducing ordering of the MUMPS analysis (ICNTL(7)). AMF is "
+          "the fastest on the liver meshes (doc/benchmarks/newton.md); "
+          "METIS (nested dissection, computed by palpate since Debian's "
+          "MUMPS lacks it) needs fewer flops on larger meshes.");
       }
       prm.leave_subsection();
     }

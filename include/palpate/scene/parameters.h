@@ -198,7 +198,7 @@ namespace palpate
     {
       /** "MUMPS", "UMFPACK", "KLU", "Amesos MUMPS" or "Amesos KLU". */
       std::string solver;
-      /** MUMPS fill-reducing ordering: "METIS", "AMD", "AMF", "QAMD",
+      /** MUMPS fill-reducing ordering: "AMF", "METIS", "AMD", "QAMD",
        * "PORD", "SCOTCH" or "automatic". */
       std::string ordering;
 
