@@ -267,8 +267,9 @@ namespace palpate
         if (const int ei = cell_eqs[c * dofs_per_cell + i]; ei >= 0)
           for (unsigned int j = 0; j < dofs_per_cell; ++j)
             if (const int ej = cell_eqs[c * dofs_per_cell + j]; ej >= 0)
-              matrix_position[(c * dofs_per_cell + i) * dofs_per_cell + j] =
-                pattern.position(ei, ej);
+              matrix_position[(std::size_t(c) * dofs_per_cell + i) *
+                                dofs_per_cell +
+                              j] = pattern.position(ei, ej);
     for (unsigned int m = 0; m < multiplier_dof.size(); ++m)
       {
         const int e = eq_of_dof[multiplier_dof[m]];
@@ -283,15 +284,21 @@ namespace palpate
 
     // --- Cell colours: no two cells of a colour share a node, so threads
     // can add into the global vectors without locks.
+    // (Vertices are taken from the DoF cells themselves, indexed as the
+    // assembly indexes them.)
+    std::vector<std::array<unsigned int, 4>> cell_vertices(n_cells);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      for (unsigned int v = 0; v < 4; ++v)
+        cell_vertices[cell->active_cell_index()][v] = cell->vertex_index(v);
     std::vector<std::vector<unsigned int>> cells_of_vertex(mesh.n_vertices());
     for (unsigned int c = 0; c < n_cells; ++c)
-      for (const unsigned int v : mesh.cells()[c])
+      for (const unsigned int v : cell_vertices[c])
         cells_of_vertex[v].push_back(c);
     std::vector<int> color(n_cells, -1);
     for (unsigned int c = 0; c < n_cells; ++c)
       {
         std::set<int> taken;
-        for (const unsigned int v : mesh.cells()[c])
+        for (const unsigned int v : cell_vertices[c])
           for (const unsigned int other : cells_of_vertex[v])
             if (color[other] >= 0)
               taken.insert(color[other]);
@@ -337,13 +344,15 @@ namespace palpate
       for (unsigned int a = 0; a < 3; ++a)
         u_local[k][a] = u[dofs[local_dof[3 * k + a]]];
 
-    double       r_local[max_dofs]                              = {};
-    double       k_local[with_matrix ? max_dofs * max_dofs : 1] = {};
+    double r_local[max_dofs] = {};
+    double k_local[with_matrix ? max_dofs * max_dofs : 1];
+    if constexpr (with_matrix)
+      std::fill_n(k_local, dpc * dpc, 0.0);
     Tensor<2, 3> F, P;
     Tensor<4, 3> A;
     for (unsigned int q = 0; q < n_q; ++q)
       {
-        const double *g = &gradients[(c * n_q + q) * nk * 3];
+        const double *g = &gradients[(std::size_t(c) * n_q + q) * nk * 3];
         F               = unit_symmetric_tensor<3>();
         for (unsigned int k = 0; k < nk; ++k)
           for (unsigned int a = 0; a < 3; ++a)
@@ -395,7 +404,8 @@ namespace palpate
           residual[e] += r_local[i];
         if constexpr (with_matrix)
           {
-            const long *position = &matrix_position[(c * dpc + i) * dpc];
+            const long *position =
+              &matrix_position[(std::size_t(c) * dpc + i) * dpc];
             for (unsigned int j = 0; j < dpc; ++j)
               if (position[j] >= 0)
                 matrix[position[j]] += k_local[i * dpc + j];
@@ -410,27 +420,31 @@ namespace palpate
   bool
   HyperelasticSystem::Impl::for_all_cells(const Function &f) const
   {
-    std::atomic<bool> ok(true);
-    for (const auto &color : colors)
+    if (!arena)
       {
-        if (arena)
-          arena->execute([&]() {
-            tbb::parallel_for(
-              tbb::blocked_range<std::size_t>(0, color.size(), 16),
-              [&](const tbb::blocked_range<std::size_t> &range) {
-                for (std::size_t i = range.begin(); i < range.end(); ++i)
-                  if (!f(color[i]))
-                    ok = false;
-              });
-          });
-        else
+        for (const auto &color : colors)
           for (const unsigned int c : color)
             if (!f(c))
               return false;
-        if (!ok)
-          return false;
+        return true;
       }
-    return true;
+    // Enter the arena once; colours run one after the other inside it.
+    std::atomic<bool> ok(true);
+    arena->execute([&]() {
+      for (const auto &color : colors)
+        {
+          tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, color.size(), 16),
+            [&](const tbb::blocked_range<std::size_t> &range) {
+              for (std::size_t i = range.begin(); i < range.end(); ++i)
+                if (!f(color[i]))
+                  ok = false;
+            });
+          if (!ok)
+            return;
+        }
+    });
+    return ok;
   }
 
 
@@ -733,9 +747,9 @@ namespace palpate
         const unsigned int *dofs = &s.cell_dofs[c * s.dofs_per_cell];
         for (unsigned int q = 0; q < s.n_q; ++q)
           {
-            const double *g =
-              &s.gradients[(c * s.n_q + q) * s.n_nodes_per_cell * 3];
-            F = unit_symmetric_tensor<3>();
+            const double *g = &s.gradients[(std::size_t(c) * s.n_q + q) *
+                                           s.n_nodes_per_cell * 3];
+            F               = unit_symmetric_tensor<3>();
             for (unsigned int k = 0; k < s.n_nodes_per_cell; ++k)
               for (unsigned int a = 0; a < 3; ++a)
                 for (unsigned int b = 0; b < 3; ++b)

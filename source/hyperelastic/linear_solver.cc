@@ -192,19 +192,19 @@ namespace palpate
             return false;
           }
         id.a = values.data();
+        // -8, -9, -17, -20: a workspace was too small (e.g. many delayed
+        // pivots); enlarge it for this factorisation and retry.
+        const MUMPS_INT margin = id.icntl[13];
         for (unsigned int attempt = 0; attempt < 5; ++attempt)
           {
             id.job = 2;
             dmumps_c(&id);
-            // -8, -9, -14..-20: a workspace was too small; enlarge, retry.
-            if (id.infog[0] == -8 || id.infog[0] == -9 ||
-                (id.infog[0] <= -14 && id.infog[0] >= -20))
-              {
-                id.icntl[13] *= 2;
-                continue;
-              }
-            break;
+            const int e = id.infog[0];
+            if (e != -8 && e != -9 && e != -17 && e != -20)
+              break;
+            id.icntl[13] *= 2;
           }
+        id.icntl[13] = margin;
         if (id.infog[0] < 0)
           {
             message_ = id.infog[0] == -10 ?
@@ -298,11 +298,13 @@ namespace palpate
       {
         if (numeric)
           umfpack_di_free_numeric(&numeric);
-        // The matrix is symmetric: A^T has the same values, CSR = CSC.
-        values           = &matrix;
+        // UMFPACK reads our CSR arrays as CSC, i.e. it factors A^T; the
+        // solve below uses UMFPACK_At, so the result is exact even where
+        // round-off makes the tangent slightly unsymmetric.
+        values           = matrix;
         const int status = umfpack_di_numeric(ap.data(),
                                               ai.data(),
-                                              matrix.data(),
+                                              values.data(),
                                               symbolic,
                                               &numeric,
                                               control,
@@ -321,10 +323,10 @@ namespace palpate
       bool
       solve(std::vector<double> &rhs) override
       {
-        const int status = umfpack_di_solve(UMFPACK_A,
+        const int status = umfpack_di_solve(UMFPACK_At,
                                             ap.data(),
                                             ai.data(),
-                                            values->data(),
+                                            values.data(),
                                             x.data(),
                                             rhs.data(),
                                             numeric,
@@ -347,14 +349,14 @@ namespace palpate
       }
 
     private:
-      int                        n = 0;
-      std::vector<int>           ap, ai;
-      std::vector<double>        x;
-      const std::vector<double> *values   = nullptr;
-      void                      *symbolic = nullptr;
-      void                      *numeric  = nullptr;
-      double                     control[UMFPACK_CONTROL];
-      double                     info[UMFPACK_INFO];
+      int                 n = 0;
+      std::vector<int>    ap, ai;
+      std::vector<double> x;
+      std::vector<double> values;
+      void               *symbolic = nullptr;
+      void               *numeric  = nullptr;
+      double              control[UMFPACK_CONTROL];
+      double              info[UMFPACK_INFO];
     };
 
     // ------------------------------------------------------------------
@@ -388,6 +390,8 @@ namespace palpate
       factorize(const std::vector<double> &matrix) override
       {
         values.assign(matrix.begin(), matrix.end());
+        // Refactorising keeps the old pivot sequence; accept it only if
+        // neither the pivots nor their growth went bad.
         if (numeric != nullptr &&
             klu_refactor(ap.data(),
                          ai.data(),
@@ -395,7 +399,14 @@ namespace palpate
                          symbolic,
                          numeric,
                          &common) &&
-            klu_rcond(symbolic, numeric, &common) && common.rcond > 1e-12)
+            klu_rcond(symbolic, numeric, &common) && common.rcond > 1e-12 &&
+            klu_rgrowth(ap.data(),
+                        ai.data(),
+                        values.data(),
+                        symbolic,
+                        numeric,
+                        &common) &&
+            common.rgrowth > 1e-8)
           return true;
         // First factorisation, or the old pivots went bad: pivot anew.
         if (numeric)
@@ -413,9 +424,9 @@ namespace palpate
       bool
       solve(std::vector<double> &rhs) override
       {
-        // KLU solves A x = b for CSC A; our CSR of a symmetric matrix is
-        // the same thing.
-        if (!klu_solve(symbolic, numeric, n, 1, rhs.data(), &common) ||
+        // KLU read our CSR arrays as CSC, i.e. it factored A^T: solve with
+        // the transpose to get A x = b exactly.
+        if (!klu_tsolve(symbolic, numeric, n, 1, rhs.data(), &common) ||
             !all_finite(rhs))
           {
             message_ = "KLU solve failed";
@@ -516,7 +527,12 @@ namespace palpate
             return false;
           }
         std::copy(&(*x)[0], &(*x)[0] + rhs.size(), rhs.begin());
-        return all_finite(rhs);
+        if (!all_finite(rhs))
+          {
+            message_ = type + " returned a non-finite solution";
+            return false;
+          }
+        return true;
       }
 
       std::string

@@ -102,7 +102,7 @@ namespace palpate
      * Whether @p residual is an equilibrium: force residual below the
      * tolerance relative to the force scale and the constraints satisfied;
      * or, where round-off keeps the residual from going lower, a negligible
-     * last correction and a residual within 1000 times the tolerance.
+     * last full Newton step and a residual within 1000 times the tolerance.
      */
     bool
     converged(const std::vector<double> &residual,
@@ -298,7 +298,9 @@ namespace palpate
         record.step_length      = best_alpha;
         record.correction       = best_alpha * system->max_displacement(step);
         state.history.push_back(record);
-        last_correction = record.correction;
+        // The round-off test of converged() looks at the full Newton step:
+        // a short line-search step says nothing about being close.
+        last_correction = system->max_displacement(step);
 
         // A line search that keeps cutting the step to almost nothing is
         // not getting anywhere: stop instead of burning the iteration
@@ -321,7 +323,14 @@ namespace palpate
             return outcome;
           }
         start = Clock::now();
-        system->assemble(x, target, residual, &matrix, &scale);
+        if (!system->assemble(x, target, residual, &matrix, &scale))
+          {
+            outcome.status     = SolveStatus::not_finite;
+            outcome.iterations = iteration + 1;
+            outcome.message =
+              "the tangent cannot be assembled at an accepted step";
+            return outcome;
+          }
         assembly_time = seconds_since(start);
       }
   }
@@ -369,15 +378,49 @@ namespace palpate
           return state;
         }
 
+    // The start must be an equilibrium of this body.
+    bool usable = from.converged &&
+                  from.solution.size() == impl->system->n_dofs() &&
+                  from.multipliers.size() == impl->system->n_multipliers();
+    for (const double v : from.active_displacement)
+      usable = usable && std::isfinite(v);
+    for (unsigned int i = 0; usable && i < from.solution.size(); ++i)
+      usable = std::isfinite(from.solution[i]);
+    if (!usable)
+      {
+        state.converged = false;
+        state.status    = SolveStatus::not_finite;
+        state.message =
+          "the starting state is not a converged state of this body";
+        state.solution.assign(impl->system->n_dofs(), 0.0);
+        state.multipliers.assign(impl->system->n_multipliers(), 0.0);
+        state.force = {{0, 0, 0}};
+        return state;
+      }
+
     const auto         &s      = impl->settings;
     std::vector<double> x      = impl->system->from_state(from);
     const auto          a      = from.active_displacement;
     const double        length = Utilities::distance(a, target);
     unsigned int        n      = s.n_increments;
     if (s.max_increment_length > 0)
-      n = std::max(n,
-                   static_cast<unsigned int>(
-                     std::ceil(length / s.max_increment_length - 1e-12)));
+      {
+        // A path of more than 1000 increments is not a haptic interaction
+        // but a mistake; refuse it rather than work for minutes.
+        const double needed =
+          std::ceil(length / s.max_increment_length - 1e-12);
+        if (needed > 1000)
+          {
+            impl->system->to_state(x, state);
+            state.converged = false;
+            state.status    = SolveStatus::max_iterations;
+            state.message = "the target is " + Utilities::to_string(length, 3) +
+                            " m away: more than 1000 increments";
+            state.force = {{0, 0, 0}};
+            return state;
+          }
+        n = std::max(n, static_cast<unsigned int>(needed));
+      }
     const auto point = [&](const double t) {
       return Utilities::Point3{{a[0] + t * (target[0] - a[0]),
                                 a[1] + t * (target[1] - a[1]),
@@ -420,10 +463,8 @@ namespace palpate
             const Impl::Outcome retry = impl->newton(x, point(t1), state);
             state.newton_iterations += retry.iterations;
             o.iterations += retry.iterations;
-            if (retry.status == SolveStatus::converged)
-              o.status = SolveStatus::converged;
-            else
-              o = retry;
+            o.status  = retry.status;
+            o.message = retry.message;
           }
         state.max_increment_iterations =
           std::max(state.max_increment_iterations, o.iterations);

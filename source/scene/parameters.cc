@@ -591,15 +591,18 @@ namespace palpate
           "1e-8",
           Patterns::Double(0.),
           "Newton converges when the Euclidean norm of the force residual is "
-          "below this times the force scale max(|f_int|, |reactions|, "
-          "1e-6 E L^2) (dimensionless), and the increment test holds.");
+          "below this times the force scale max(|f_int|, |multipliers|, "
+          "1e-12 E L^2) (dimensionless) and the active node is on its "
+          "target to Increment tolerance.");
         prm.declare_entry(
           "Increment tolerance",
           "1e-8",
           Patterns::Double(0.),
-          "Newton converges when the largest displacement correction is "
-          "below this times the body's diameter L (dimensionless), and the "
-          "residual test holds.");
+          "The active node must be on its target to this times the body's "
+          "diameter L (dimensionless). Where round-off keeps the residual "
+          "above its tolerance, Newton also converges when the full Newton "
+          "step is below this times L and the residual below 1000 times its "
+          "tolerance.");
         prm.declare_entry("Line search",
                           "true",
                           Patterns::Bool(),

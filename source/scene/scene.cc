@@ -505,6 +505,14 @@ namespace palpate
       throw error("Material model/Neo-Hookean/Poisson's ratio",
                   "nu = 0.5 makes the Lame parameter lambda infinite",
                   "use nu < 0.5, or the incompressible Mooney-Rivlin model.");
+    if ((m.model_name == "St.Venant-Kirchhoff" &&
+         m.stvk_poissons_ratio <= -1) ||
+        (m.model_name == "Neo-Hookean" && m.nh_poissons_ratio <= -1))
+      throw error(m.model_name == "Neo-Hookean" ?
+                    "Material model/Neo-Hookean/Poisson's ratio" :
+                    "Material model/St.Venant-Kirchhoff/Poisson's ratio",
+                  "nu = -1 makes the shear modulus E/(2(1+nu)) infinite",
+                  "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
     if (m.model_name == "St.Venant-Kirchhoff" && m.stvk_youngs_modulus <= 0)
       throw error("Material model/St.Venant-Kirchhoff/Young's modulus",
                   "Young's modulus must be positive",
