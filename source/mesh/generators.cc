@@ -104,14 +104,23 @@ namespace palpate
   MeshData
   generate_blob(const Parameters::Mesh &p)
   {
-    dealii::Triangulation<3> ball;
-    dealii::GridGenerator::hyper_ball(ball, dealii::Point<3>(), 1.0, true);
-    ball.refine_global(p.blob_refinements);
-
+    // A cube of n^3 blocks of tetrahedra, mapped onto the unit ball by the
+    // smooth cube-to-sphere map: every face of the cube becomes a sixth of
+    // the sphere, so the surface nodes are spread evenly (unlike a
+    // converted hexahedral ball, whose surface is coarse).
+    const unsigned int       n = 3 * (p.blob_refinements + 1);
     dealii::Triangulation<3> tria;
-    dealii::GridGenerator::convert_hypercube_to_simplex_mesh(ball, tria);
-    tria.reset_all_manifolds();
-    tria.set_all_manifold_ids(dealii::numbers::flat_manifold_id);
+    dealii::GridGenerator::subdivided_hyper_rectangle_with_simplices(
+      tria, {n, n, n}, dealii::Point<3>(-1, -1, -1), dealii::Point<3>(1, 1, 1));
+    dealii::GridTools::transform(
+      [](const dealii::Point<3> &c) {
+        const double x2 = c[0] * c[0], y2 = c[1] * c[1], z2 = c[2] * c[2];
+        return dealii::Point<3>(
+          c[0] * std::sqrt(1 - y2 / 2 - z2 / 2 + y2 * z2 / 3),
+          c[1] * std::sqrt(1 - z2 / 2 - x2 / 2 + z2 * x2 / 3),
+          c[2] * std::sqrt(1 - x2 / 2 - y2 / 2 + x2 * y2 / 3));
+      },
+      tria);
 
     // Map the unit ball onto a liver-like shape: an ellipsoid whose +x lobe
     // is thicker and wider than the -x lobe, with a flatter underside. The

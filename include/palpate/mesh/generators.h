@@ -18,8 +18,8 @@ namespace palpate
   MeshData
   generate_beam(const Parameters::Mesh &parameters);
 
-  /**
-   * An organ-like blob (metres): a refined ball of tetrahedra mapped onto an
+  /** An organ-like blob (metres): a cube of tetrahedra mapped onto the unit
+   * ball (evenly spread surface nodes), then onto an
    * ellipsoid with the given semi-axes and then made asymmetric — one lobe
    * thicker and wider than the other, the underside flatter — so
    * that it behaves like a liver rather than a sphere. All boundary faces
