@@ -8,6 +8,7 @@
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -29,9 +30,17 @@ namespace palpate
     out << "Static solve\n"
         << "  discretisation: " << system.discretization_description() << ", "
         << system.n_dofs() << " DoFs\n"
-        << "  equations:      " << system.n_equations() << " ("
-        << system.n_equations() - system.n_multipliers() << " displacements, "
-        << system.n_multipliers() << " multipliers)\n"
+        << "  equations:      " << system.n_equations() << " (";
+    const auto &components = system.dof_components();
+    const auto  n_pressure =
+      std::count(components.begin(), components.end(), 3u);
+    if (n_pressure > 0)
+      out << system.n_equations() - system.n_multipliers() - n_pressure
+          << " displacements, " << n_pressure << " pressures, ";
+    else
+      out << system.n_equations() - system.n_multipliers()
+          << " displacements, ";
+    out << system.n_multipliers() << " multipliers)\n"
         << "  linear solver:  " << solver.linear_solver_name() << "\n"
         << "  active node:    from rest to (" << Utilities::to_string(target, 4)
         << ") m\n";

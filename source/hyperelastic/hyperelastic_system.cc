@@ -35,8 +35,21 @@ namespace palpate
   {
     /** Largest number of scalar shape functions per cell (P2 tetrahedron). */
     constexpr unsigned int max_nodes = 10;
+    /** Pressure shape functions per cell (P1). */
+    constexpr unsigned int max_pressure = 4;
     /** Largest number of DoFs per cell. */
-    constexpr unsigned int max_dofs = 3 * max_nodes;
+    constexpr unsigned int max_dofs = 3 * max_nodes + max_pressure;
+
+    std::unique_ptr<FESystem<3>>
+    make_fe(const unsigned int degree, const bool mixed)
+    {
+      if (mixed)
+        return std::make_unique<FESystem<3>>(FE_SimplexP<3>(degree),
+                                             3,
+                                             FE_SimplexP<3>(1),
+                                             1);
+      return std::make_unique<FESystem<3>>(FE_SimplexP<3>(degree), 3);
+    }
   } // namespace
 
 
@@ -60,42 +73,57 @@ namespace palpate
     bool
     for_all_cells(const Function &f) const;
 
-    /** Full DoF vector of displacements from the unknowns. */
+    /** Full DoF vector (displacements, scaled pressures) from the unknowns. */
     void
     expand(const std::vector<double> &x, std::vector<double> &u) const;
 
-    const Mesh               &mesh;
-    NodeSelection             nodes;
-    std::unique_ptr<Material> material;
-    const unsigned int        degree;
-    FESystem<3>               fe;
-    MappingFE<3>              mapping;
-    QGaussSimplex<3>          quadrature;
-    DoFHandler<3>             dof_handler;
-    unsigned int              n_nodes_per_cell, n_q, dofs_per_cell;
-    std::vector<unsigned int> local_dof; // [k * 3 + component] -> local DoF
-    std::vector<unsigned int> cell_dofs; // [cell * dofs_per_cell + i]
-    std::vector<int>          cell_eqs;  // equation of each, or -1
+    /** Subtract the dead loads (gravity, tractions) from @p f at all DoFs
+     * for which @p keep(d) holds. */
+    template <typename Keep>
+    void
+    subtract_dead_loads(double *f, const Keep &keep) const;
+
+    const Mesh                  &mesh;
+    NodeSelection                nodes;
+    std::unique_ptr<Material>    material;
+    const bool                   mixed; // pressure field present
+    const bool                   taylor_hood;
+    const double                 kappa_inverse; // 0: exact incompressibility
+    const bool                   stabilize;     // Brezzi-Pitkaranta (P1-P1)
+    const double                 alpha;
+    const unsigned int           degree;
+    std::unique_ptr<FESystem<3>> fe;
+    MappingFE<3>                 mapping;
+    QGaussSimplex<3>             quadrature;
+    DoFHandler<3>                dof_handler;
+    unsigned int              n_nodes_per_cell, n_pressure, n_q, dofs_per_cell;
+    std::vector<unsigned int> local_dof;  // [k * 3 + component] -> local DoF
+    std::vector<unsigned int> local_pdof; // [m] -> local pressure DoF
+    std::vector<unsigned int> cell_dofs;  // [cell * dofs_per_cell + i]
+    std::vector<int>          cell_eqs;   // equation of each, or -1
     std::vector<double> gradients; // [((cell * n_q + q) * nodes + k) * 3 + d]
     std::vector<double> JxW;       // [cell * n_q + q]
-    std::vector<long>   matrix_position; // [cell * dpc^2 + i * dpc + j]
+    std::vector<double> pressure_values;    // [q * n_pressure + m]
+    std::vector<double> pressure_gradients; // [(cell * n_pressure + m) * 3 + d]
+    std::vector<double> stabilization_tau;  // [cell]: alpha h^2 / mu
+    std::vector<long>   matrix_position;    // [cell * dpc^2 + i * dpc + j]
     std::vector<std::vector<unsigned int>> colors;
 
-    std::vector<int>                eq_of_dof;
-    unsigned int                    n_free = 0;
-    std::vector<unsigned int>       multiplier_dof;
-    std::vector<long>               position_lambda_u, position_u_lambda;
-    std::vector<double>             fixed_value;
-    std::array<unsigned int, 3>     active;
-    std::vector<unsigned int>       fixed;
-    std::vector<std::array<int, 3>> vertex_dofs;
-    std::vector<Utilities::Point3>  dof_position;
-    std::vector<unsigned int>       dof_component;
-    SparsityCSR                     pattern;
+    std::vector<int>               eq_of_dof;
+    unsigned int                   n_free = 0, n_active_multipliers = 0;
+    std::vector<unsigned int>      multiplier_dof;
+    std::vector<long>              position_lambda_u, position_u_lambda;
+    std::vector<double>            fixed_value;
+    std::array<unsigned int, 3>    active;
+    std::vector<unsigned int>      fixed;
+    std::vector<Utilities::Point3> dof_position;
+    std::vector<unsigned int>      dof_component;
+    SparsityCSR                    pattern;
 
-    double              beta, L;
+    double              beta, L, pressure_scale = 1;
     bool                gravity;
-    std::vector<double> f_ext;
+    std::vector<double> f_gravity, f_surface;
+    double              load_factor = 1;
 
     unsigned int                     n_threads;
     std::unique_ptr<tbb::task_arena> arena;
@@ -110,108 +138,152 @@ namespace palpate
     : mesh(mesh)
     , nodes(nodes)
     , material(Material::create(p.material_model))
-    , degree(p.discretization.polynomial_degree)
-    , fe(FE_SimplexP<3>(degree), 3)
+    , mixed(material->isochoric())
+    , taylor_hood(mixed && p.material_model.mr_element == "Taylor-Hood")
+    , kappa_inverse(mixed &&
+                        p.material_model.mr_incompressibility == "penalty" ?
+                      1.0 / p.material_model.mr_bulk_modulus :
+                      0.0)
+    , stabilize(mixed && !taylor_hood &&
+                p.material_model.mr_stabilization == "Brezzi-Pitkaranta")
+    , alpha(p.material_model.mr_stabilization_factor)
+    , degree(mixed ? (taylor_hood ? 2 : 1) : p.discretization.polynomial_degree)
+    , fe(make_fe(degree, mixed))
     , mapping(FE_SimplexP<3>(1))
     , quadrature(p.discretization.quadrature_order > 0 ?
                    p.discretization.quadrature_order :
-                   (degree == 1 ? 1 : 3))
+                   // Exact for St.Venant-Kirchhoff; the penalty's pressure
+                   // mass matrix needs the 4-point rule on P1.
+                   (degree == 1 ? (kappa_inverse > 0 ? 2 : 1) : 3))
     , dof_handler(mesh.triangulation())
     , gravity(p.effects.gravity)
     , n_threads(p.nonlinear_solver.assembly_threads)
   {
-    dof_handler.distribute_dofs(fe);
-    n_nodes_per_cell = fe.base_element(0).n_dofs_per_cell();
+    dof_handler.distribute_dofs(*fe);
+    n_nodes_per_cell = fe->base_element(0).n_dofs_per_cell();
+    n_pressure       = mixed ? fe->base_element(1).n_dofs_per_cell() : 0;
     n_q              = quadrature.size();
-    dofs_per_cell    = fe.n_dofs_per_cell();
+    dofs_per_cell    = fe->n_dofs_per_cell();
     local_dof.resize(3 * n_nodes_per_cell);
     for (unsigned int k = 0; k < n_nodes_per_cell; ++k)
       for (unsigned int c = 0; c < 3; ++c)
-        local_dof[3 * k + c] = fe.component_to_system_index(c, k);
+        local_dof[3 * k + c] = fe->component_to_system_index(c, k);
+    for (unsigned int m = 0; m < n_pressure; ++m)
+      local_pdof.push_back(fe->component_to_system_index(3, m));
 
     const unsigned int n_cells = mesh.n_cells();
     const unsigned int n_dofs  = dof_handler.n_dofs();
     L                          = mesh.diameter();
+    const double h_mean        = std::cbrt(mesh.volume() / n_cells);
 
     // --- Which DoFs are fixed, which are the active node's. A DoF on a
     // vertex belongs to that node; a DoF on an edge (P2) is fixed when both
-    // of the edge's end nodes are.
-    std::vector<bool> vertex_fixed(mesh.n_vertices(), false);
+    // of the edge's end nodes are. Pressure DoFs are never fixed.
+    std::vector<unsigned int> vertex_mask(mesh.n_vertices(),
+                                          0); // bit c: component c fixed
     for (const unsigned int v : nodes.fixed_vertices)
-      vertex_fixed[v] = true;
+      vertex_mask[v] = 7;
+    for (const auto &[v, c] : nodes.fixed_components)
+      vertex_mask[v] |= 1u << c;
+    const bool has_active =
+      nodes.active_vertex != NodeSelection::no_active_node;
     std::vector<bool> dof_fixed(n_dofs, false);
-    vertex_dofs.assign(mesh.n_vertices(), {{-1, -1, -1}});
+    active.fill(static_cast<unsigned int>(-1));
     dof_position.resize(n_dofs);
     dof_component.resize(n_dofs);
     std::vector<types::global_dof_index> dofs(dofs_per_cell);
-    const unsigned int                   first_line = fe.get_first_line_index();
-    const unsigned int first_quad = fe.get_first_quad_index(0);
+    const unsigned int first_line = fe->get_first_line_index();
+    const unsigned int first_quad = fe->get_first_quad_index(0);
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         cell->get_dof_indices(dofs);
         for (unsigned int i = 0; i < dofs_per_cell; ++i)
           {
             const unsigned int component =
-              fe.system_to_component_index(i).first;
+              fe->system_to_component_index(i).first;
             dof_component[dofs[i]] = component;
             if (i < first_line)
               {
                 const unsigned int v =
-                  cell->vertex_index(i / fe.n_dofs_per_vertex());
-                vertex_dofs[v][component] = dofs[i];
-                dof_position[dofs[i]]     = mesh.vertices()[v];
-                if (vertex_fixed[v])
-                  dof_fixed[dofs[i]] = true;
+                  cell->vertex_index(i / fe->n_dofs_per_vertex());
+                dof_position[dofs[i]] = mesh.vertices()[v];
+                if (component < 3)
+                  {
+                    if (vertex_mask[v] & (1u << component))
+                      dof_fixed[dofs[i]] = true;
+                    if (has_active && v == nodes.active_vertex)
+                      active[component] = dofs[i];
+                  }
               }
             else if (i < first_quad)
               {
                 const auto line =
-                  cell->line((i - first_line) / fe.n_dofs_per_line());
+                  cell->line((i - first_line) / fe->n_dofs_per_line());
                 const auto c          = line->center();
                 dof_position[dofs[i]] = {{c[0], c[1], c[2]}};
-                if (vertex_fixed[line->vertex_index(0)] &&
-                    vertex_fixed[line->vertex_index(1)])
+                if (component < 3 &&
+                    (vertex_mask[line->vertex_index(0)] & (1u << component)) &&
+                    (vertex_mask[line->vertex_index(1)] & (1u << component)))
                   dof_fixed[dofs[i]] = true;
               }
           }
       }
-    for (unsigned int c = 0; c < 3; ++c)
-      active[c] = vertex_dofs[nodes.active_vertex][c];
     for (unsigned int d = 0; d < n_dofs; ++d)
       if (dof_fixed[d])
         fixed.push_back(d);
     fixed_value.assign(n_dofs, 0.0);
 
-    // --- Equations: free DoFs first (in DoF order), then multipliers.
+    // --- Equations: free DoFs first (in DoF order), then multipliers: the
+    // active node's three, then the fixed DoFs' if they use multipliers.
     const bool eliminate =
       p.boundary_conditions.fixed_nodes.treatment == "elimination";
     eq_of_dof.assign(n_dofs, -1);
     for (unsigned int d = 0; d < n_dofs; ++d)
       if (!(eliminate && dof_fixed[d]))
         eq_of_dof[d] = n_free++;
-    multiplier_dof.assign(active.begin(), active.end());
+    if (has_active)
+      {
+        multiplier_dof.assign(active.begin(), active.end());
+        n_active_multipliers = 3;
+      }
     if (!eliminate)
       multiplier_dof.insert(multiplier_dof.end(), fixed.begin(), fixed.end());
     const unsigned int n_eq = n_free + multiplier_dof.size();
 
-    // --- Geometry, cached once: shape gradients, JxW, DoF indices.
-    FEValues<3> fe_values(mapping,
-                          fe.base_element(0),
+    // --- Geometry, cached once: shape gradients, JxW, DoF indices; the
+    // pressure shape values (the same on every cell of an affine simplex
+    // mesh) and, for the stabilisation, gradients and cell sizes.
+    FEValues<3>                  fe_values(mapping,
+                          fe->base_element(0),
                           quadrature,
                           update_gradients | update_values | update_JxW_values);
+    std::unique_ptr<FEValues<3>> pressure_fe_values;
+    if (mixed)
+      pressure_fe_values =
+        std::make_unique<FEValues<3>>(mapping,
+                                      fe->base_element(1),
+                                      quadrature,
+                                      update_values | update_gradients);
     cell_dofs.resize(n_cells * dofs_per_cell);
     cell_eqs.resize(n_cells * dofs_per_cell);
-    gradients.resize(n_cells * n_q * n_nodes_per_cell * 3);
+    gradients.resize(std::size_t(n_cells) * n_q * n_nodes_per_cell * 3);
     JxW.resize(n_cells * n_q);
+    if (stabilize)
+      {
+        pressure_gradients.resize(std::size_t(n_cells) * n_pressure * 3);
+        stabilization_tau.resize(n_cells);
+      }
     if (gravity)
-      f_ext.assign(n_dofs, 0.0);
+      f_gravity.assign(n_dofs, 0.0);
     const auto  &g_accel = p.effects.gravitational_acceleration;
     const double rho     = p.material_model.density;
+    const double mu      = material->shear_modulus();
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         const unsigned int c = cell->active_cell_index();
-        // FEValues of the scalar element: it needs the geometry only.
-        fe_values.reinit(typename Triangulation<3>::cell_iterator(cell));
+        // FEValues of the scalar elements: they need the geometry only.
+        const typename Triangulation<3>::cell_iterator tria_cell(cell);
+        fe_values.reinit(tria_cell);
         cell->get_dof_indices(dofs);
         for (unsigned int i = 0; i < dofs_per_cell; ++i)
           {
@@ -225,14 +297,38 @@ namespace palpate
               {
                 const auto g = fe_values.shape_grad(k, q);
                 for (unsigned int d = 0; d < 3; ++d)
-                  gradients[((c * n_q + q) * n_nodes_per_cell + k) * 3 + d] =
-                    g[d];
+                  gradients[((std::size_t(c) * n_q + q) * n_nodes_per_cell +
+                             k) *
+                              3 +
+                            d] = g[d];
                 // Gravity is a dead load: integrate it once, here.
                 if (gravity)
                   for (unsigned int comp = 0; comp < 3; ++comp)
-                    f_ext[dofs[local_dof[3 * k + comp]]] +=
+                    f_gravity[dofs[local_dof[3 * k + comp]]] +=
                       rho * g_accel[comp] * fe_values.shape_value(k, q) *
                       fe_values.JxW(q);
+              }
+          }
+        if (mixed)
+          {
+            pressure_fe_values->reinit(tria_cell);
+            if (pressure_values.empty())
+              for (unsigned int q = 0; q < n_q; ++q)
+                for (unsigned int m = 0; m < n_pressure; ++m)
+                  pressure_values.push_back(
+                    pressure_fe_values->shape_value(m, q));
+            if (stabilize)
+              {
+                // P1 pressure: gradients are constant on the cell. h is the
+                // edge of the regular tetrahedron of the cell's volume.
+                for (unsigned int m = 0; m < n_pressure; ++m)
+                  for (unsigned int d = 0; d < 3; ++d)
+                    pressure_gradients[(std::size_t(c) * n_pressure + m) * 3 +
+                                       d] =
+                      pressure_fe_values->shape_grad(m, 0)[d];
+                const double h =
+                  std::cbrt(6 * std::sqrt(2.0) * cell->measure());
+                stabilization_tau[c] = alpha * h * h / mu;
               }
           }
       }
@@ -261,7 +357,8 @@ namespace palpate
         pattern.column.insert(pattern.column.end(), r.begin(), r.end());
         pattern.row_start.push_back(pattern.column.size());
       }
-    matrix_position.assign(n_cells * dofs_per_cell * dofs_per_cell, -1);
+    matrix_position.assign(std::size_t(n_cells) * dofs_per_cell * dofs_per_cell,
+                           -1);
     for (unsigned int c = 0; c < n_cells; ++c)
       for (unsigned int i = 0; i < dofs_per_cell; ++i)
         if (const int ei = cell_eqs[c * dofs_per_cell + i]; ei >= 0)
@@ -277,15 +374,16 @@ namespace palpate
         position_u_lambda.push_back(pattern.position(e, n_free + m));
       }
 
-    // --- Constraint scale: a typical diagonal stiffness E h, so that the
-    // constraint rows are forces like the others.
-    const double h = std::cbrt(mesh.volume() / n_cells);
-    beta           = material->youngs_modulus() * h;
+    // --- Scales: the constraint rows by a typical diagonal stiffness E h,
+    // the pressure unknowns by mu/h, so that every row is a force (N) and
+    // every unknown a length (m).
+    beta = material->youngs_modulus() * h_mean;
+    if (mixed)
+      pressure_scale = mu / h_mean;
 
     // --- Cell colours: no two cells of a colour share a node, so threads
-    // can add into the global vectors without locks.
-    // (Vertices are taken from the DoF cells themselves, indexed as the
-    // assembly indexes them.)
+    // can add into the global vectors without locks. (Vertices are taken
+    // from the DoF cells, indexed as the assembly indexes them.)
     std::vector<std::array<unsigned int, 4>> cell_vertices(n_cells);
     for (const auto &cell : dof_handler.active_cell_iterators())
       for (unsigned int v = 0; v < 4; ++v)
@@ -328,6 +426,23 @@ namespace palpate
 
 
 
+  template <typename Keep>
+  void
+  HyperelasticSystem::Impl::subtract_dead_loads(double     *f,
+                                                const Keep &keep) const
+  {
+    if (gravity)
+      for (unsigned int d = 0; d < f_gravity.size(); ++d)
+        if (keep(d))
+          f[d] -= f_gravity[d];
+    if (!f_surface.empty())
+      for (unsigned int d = 0; d < f_surface.size(); ++d)
+        if (keep(d))
+          f[d] -= load_factor * f_surface[d];
+  }
+
+
+
   template <bool with_matrix, bool to_dofs>
   bool
   HyperelasticSystem::Impl::assemble_cell(const unsigned int         c,
@@ -336,6 +451,7 @@ namespace palpate
                                           double *matrix) const
   {
     const unsigned int  nk   = n_nodes_per_cell;
+    const unsigned int  np   = n_pressure;
     const unsigned int  dpc  = dofs_per_cell;
     const unsigned int *dofs = &cell_dofs[c * dpc];
 
@@ -343,13 +459,18 @@ namespace palpate
     for (unsigned int k = 0; k < nk; ++k)
       for (unsigned int a = 0; a < 3; ++a)
         u_local[k][a] = u[dofs[local_dof[3 * k + a]]];
+    double p_local[max_pressure];
+    for (unsigned int m = 0; m < np; ++m)
+      p_local[m] = u[dofs[local_pdof[m]]]; // scaled: p = pressure_scale p_local
 
     double r_local[max_dofs] = {};
     double k_local[with_matrix ? max_dofs * max_dofs : 1];
     if constexpr (with_matrix)
       std::fill_n(k_local, dpc * dpc, 0.0);
-    Tensor<2, 3> F, P;
-    Tensor<4, 3> A;
+    const double s = pressure_scale;
+    Tensor<2, 3> F, P, dJ;
+    Tensor<4, 3> A, d2J;
+    double       J;
     for (unsigned int q = 0; q < n_q; ++q)
       {
         const double *g = &gradients[(std::size_t(c) * n_q + q) * nk * 3];
@@ -362,6 +483,24 @@ namespace palpate
           return false;
         material->evaluate(F, P, with_matrix ? &A : nullptr);
         const double w = JxW[c * n_q + q];
+
+        // The pressure: P = P_iso - p dJ/dF, A = A_iso - p d2J/dF2, and the
+        // pressure rows s int N_m (-(J - 1) - p/kappa) (+ stabilisation).
+        const double *N = mixed ? &pressure_values[q * np] : nullptr;
+        if (mixed)
+          {
+            volume_derivatives(F, J, dJ, with_matrix ? &d2J : nullptr);
+            double p_tilde = 0;
+            for (unsigned int m = 0; m < np; ++m)
+              p_tilde += p_local[m] * N[m];
+            const double pressure = s * p_tilde;
+            P -= pressure * dJ;
+            if constexpr (with_matrix)
+              A -= pressure * d2J;
+            const double volumetric = -(J - 1) - kappa_inverse * pressure;
+            for (unsigned int m = 0; m < np; ++m)
+              r_local[local_pdof[m]] += s * w * volumetric * N[m];
+          }
 
         for (unsigned int k = 0; k < nk; ++k)
           for (unsigned int a = 0; a < 3; ++a)
@@ -392,6 +531,58 @@ namespace palpate
                              Ag[k][a][b][1] * g[3 * l + 1] +
                              Ag[k][a][b][2] * g[3 * l + 2]);
                 }
+            if (mixed)
+              {
+                // K_u,p = K_p,u = -s w N_m (dJ/dF)_aJ g_kJ;
+                // K_p,p = -s^2 w N_m N_n / kappa.
+                for (unsigned int k = 0; k < nk; ++k)
+                  for (unsigned int a = 0; a < 3; ++a)
+                    {
+                      const double dJg = dJ[a][0] * g[3 * k] +
+                                         dJ[a][1] * g[3 * k + 1] +
+                                         dJ[a][2] * g[3 * k + 2];
+                      const unsigned int i = local_dof[3 * k + a];
+                      for (unsigned int m = 0; m < np; ++m)
+                        {
+                          const double v = -s * w * N[m] * dJg;
+                          k_local[i * dpc + local_pdof[m]] += v;
+                          k_local[local_pdof[m] * dpc + i] += v;
+                        }
+                    }
+                if (kappa_inverse > 0)
+                  for (unsigned int m = 0; m < np; ++m)
+                    for (unsigned int n = 0; n < np; ++n)
+                      k_local[local_pdof[m] * dpc + local_pdof[n]] -=
+                        s * s * w * kappa_inverse * N[m] * N[n];
+              }
+          }
+      }
+
+    // Brezzi-Pitkaranta: - tau int grad p . grad q over the cell (the
+    // gradients are constant, so the integral is the volume).
+    if (stabilize)
+      {
+        const double *G      = &pressure_gradients[std::size_t(c) * np * 3];
+        double        volume = 0;
+        for (unsigned int q = 0; q < n_q; ++q)
+          volume += JxW[c * n_q + q];
+        double grad_p[3] = {0, 0, 0};
+        for (unsigned int m = 0; m < np; ++m)
+          for (unsigned int d = 0; d < 3; ++d)
+            grad_p[d] += s * p_local[m] * G[3 * m + d];
+        const double t = stabilization_tau[c] * volume;
+        for (unsigned int m = 0; m < np; ++m)
+          {
+            r_local[local_pdof[m]] -=
+              s * t *
+              (grad_p[0] * G[3 * m] + grad_p[1] * G[3 * m + 1] +
+               grad_p[2] * G[3 * m + 2]);
+            if constexpr (with_matrix)
+              for (unsigned int n = 0; n < np; ++n)
+                k_local[local_pdof[m] * dpc + local_pdof[n]] -=
+                  s * s * t *
+                  (G[3 * m] * G[3 * n] + G[3 * m + 1] * G[3 * n + 1] +
+                   G[3 * m + 2] * G[3 * n + 2]);
           }
       }
 
@@ -470,6 +661,22 @@ namespace palpate
 
 
 
+  bool
+  HyperelasticSystem::has_pressure() const
+  {
+    return impl->mixed;
+  }
+
+
+
+  bool
+  HyperelasticSystem::has_active_node() const
+  {
+    return impl->n_active_multipliers > 0;
+  }
+
+
+
   unsigned int
   HyperelasticSystem::n_equations() const
   {
@@ -537,9 +744,18 @@ namespace palpate
   std::string
   HyperelasticSystem::discretization_description() const
   {
-    return "P" + std::to_string(impl->degree) + " tetrahedra, " +
-           std::to_string(impl->n_q) + " quadrature point" +
-           (impl->n_q > 1 ? "s" : "") + " per cell";
+    const Impl &s = *impl;
+    std::string d;
+    if (!s.mixed)
+      d = "P" + std::to_string(s.degree) + " tetrahedra";
+    else
+      d = std::string(s.taylor_hood ? "Taylor-Hood P2-P1" : "P1-P1") +
+          " tetrahedra, " +
+          (s.kappa_inverse > 0 ? "nearly incompressible (penalty)" :
+                                 "exactly incompressible") +
+          (s.stabilize ? ", Brezzi-Pitkaranta stabilised" : "");
+    return d + ", " + std::to_string(s.n_q) + " quadrature point" +
+           (s.n_q > 1 ? "s" : "") + " per cell";
   }
 
 
@@ -567,6 +783,71 @@ namespace palpate
   HyperelasticSystem::dof_components() const
   {
     return impl->dof_component;
+  }
+
+
+
+  void
+  HyperelasticSystem::add_surface_traction(const unsigned int       boundary_id,
+                                           const Utilities::Point3 &traction)
+  {
+    Impl &s = *impl;
+    if (s.f_surface.empty())
+      s.f_surface.assign(n_dofs(), 0.0);
+    const QGaussSimplex<2>               face_quadrature(s.degree + 1);
+    FEFaceValues<3>                      fe_face(s.mapping,
+                            s.fe->base_element(0),
+                            face_quadrature,
+                            update_values | update_JxW_values);
+    std::vector<types::global_dof_index> dofs(s.dofs_per_cell);
+    for (const auto &cell : s.dof_handler.active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->at_boundary() &&
+            cell->face(f)->boundary_id() == boundary_id)
+          {
+            fe_face.reinit(typename Triangulation<3>::cell_iterator(cell), f);
+            cell->get_dof_indices(dofs);
+            for (unsigned int q = 0; q < face_quadrature.size(); ++q)
+              for (unsigned int k = 0; k < s.n_nodes_per_cell; ++k)
+                for (unsigned int c = 0; c < 3; ++c)
+                  s.f_surface[dofs[s.local_dof[3 * k + c]]] +=
+                    traction[c] * fe_face.shape_value(k, q) * fe_face.JxW(q);
+          }
+  }
+
+
+
+  void
+  HyperelasticSystem::set_load_factor(const double factor)
+  {
+    impl->load_factor = factor;
+  }
+
+
+
+  double
+  HyperelasticSystem::deformed_volume(const std::vector<double> &solution) const
+  {
+    const Impl  &s      = *impl;
+    double       volume = 0;
+    Tensor<2, 3> F;
+    for (unsigned int c = 0; c < s.mesh.n_cells(); ++c)
+      {
+        const unsigned int *dofs = &s.cell_dofs[c * s.dofs_per_cell];
+        for (unsigned int q = 0; q < s.n_q; ++q)
+          {
+            const double *g = &s.gradients[(std::size_t(c) * s.n_q + q) *
+                                           s.n_nodes_per_cell * 3];
+            F               = unit_symmetric_tensor<3>();
+            for (unsigned int k = 0; k < s.n_nodes_per_cell; ++k)
+              for (unsigned int a = 0; a < 3; ++a)
+                for (unsigned int b = 0; b < 3; ++b)
+                  F[a][b] +=
+                    solution[dofs[s.local_dof[3 * k + a]]] * g[3 * k + b];
+            volume += s.JxW[c * s.n_q + q] * determinant(F);
+          }
+      }
+    return volume;
   }
 
 
@@ -613,27 +894,37 @@ namespace palpate
       return false;
 
     residual.assign(n_equations(), 0.0);
-    double f_norm = 0;
+    double f_norm = 0; // internal forces only, not the pressure rows
     for (unsigned int d = 0; d < s.eq_of_dof.size(); ++d)
       {
-        f_norm += s.f_work[d] * s.f_work[d];
+        if (s.dof_component[d] < 3)
+          f_norm += s.f_work[d] * s.f_work[d];
         if (s.eq_of_dof[d] >= 0)
           residual[s.eq_of_dof[d]] = s.f_work[d];
       }
 
-    // Dead loads, only when the scene switches gravity on.
-    if (s.gravity)
-      for (unsigned int d = 0; d < s.eq_of_dof.size(); ++d)
-        if (s.eq_of_dof[d] >= 0)
-          residual[s.eq_of_dof[d]] -= s.f_ext[d];
+    // Dead loads, only when there are any (gravity switched on, tractions
+    // added): no work at all otherwise.
+    if (s.gravity || !s.f_surface.empty())
+      {
+        for (unsigned int d = 0; d < s.eq_of_dof.size(); ++d)
+          s.f_work[d] = 0;
+        s.subtract_dead_loads(s.f_work.data(), [&](const unsigned int d) {
+          return s.eq_of_dof[d] >= 0;
+        });
+        for (unsigned int d = 0; d < s.eq_of_dof.size(); ++d)
+          if (s.eq_of_dof[d] >= 0)
+            residual[s.eq_of_dof[d]] += s.f_work[d];
+      }
 
     // The constraints: beta B^T x_lambda and beta (B u - g).
     double lambda_norm = 0;
     for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
       {
-        const unsigned int d      = s.multiplier_dof[m];
-        const double       value  = m < 3 ? target[m] : s.fixed_value[d];
-        const double       lambda = s.beta * x[s.n_free + m];
+        const unsigned int d = s.multiplier_dof[m];
+        const double       value =
+          m < s.n_active_multipliers ? target[m] : s.fixed_value[d];
+        const double lambda = s.beta * x[s.n_free + m];
         residual[s.eq_of_dof[d]] += lambda;
         residual[s.n_free + m] = s.beta * (s.u_work[d] - value);
         lambda_norm += lambda * lambda;
@@ -696,11 +987,15 @@ namespace palpate
   {
     const Impl &s = *impl;
     s.expand(x, state.solution);
+    if (s.mixed)
+      for (unsigned int d = 0; d < state.solution.size(); ++d)
+        if (s.dof_component[d] == 3)
+          state.solution[d] *= s.pressure_scale;
     state.multipliers.resize(s.multiplier_dof.size());
     for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
       state.multipliers[m] = s.beta * x[s.n_free + m];
     for (unsigned int c = 0; c < 3; ++c)
-      state.force[c] = state.multipliers[c];
+      state.force[c] = c < s.n_active_multipliers ? state.multipliers[c] : 0.0;
   }
 
 
@@ -712,7 +1007,9 @@ namespace palpate
     std::vector<double> x(n_equations(), 0.0);
     for (unsigned int d = 0; d < s.eq_of_dof.size(); ++d)
       if (s.eq_of_dof[d] >= 0)
-        x[s.eq_of_dof[d]] = state.solution[d];
+        x[s.eq_of_dof[d]] = s.dof_component[d] == 3 ?
+                              state.solution[d] / s.pressure_scale :
+                              state.solution[d];
     for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
       x[s.n_free + m] = state.multipliers[m] / s.beta;
     return x;
@@ -723,14 +1020,18 @@ namespace palpate
   std::vector<double>
   HyperelasticSystem::nodal_residual(const std::vector<double> &solution) const
   {
-    const Impl         &s = *impl;
+    const Impl &s = *impl;
+    // The kernel works with scaled pressures.
+    std::vector<double> u = solution;
+    if (s.mixed)
+      for (unsigned int d = 0; d < u.size(); ++d)
+        if (s.dof_component[d] == 3)
+          u[d] /= s.pressure_scale;
     std::vector<double> f(n_dofs(), 0.0);
     s.for_all_cells([&](const unsigned int c) {
-      return s.assemble_cell<false, true>(c, solution, f.data(), nullptr);
+      return s.assemble_cell<false, true>(c, u, f.data(), nullptr);
     });
-    if (s.gravity)
-      for (unsigned int d = 0; d < f.size(); ++d)
-        f[d] -= s.f_ext[d];
+    s.subtract_dead_loads(f.data(), [](const unsigned int) { return true; });
     return f;
   }
 
@@ -797,20 +1098,27 @@ namespace palpate
     const auto     f = nodal_residual(state.solution);
     for (const unsigned int d : s.fixed)
       reaction[d] = -f[d];
-    for (unsigned int c = 0; c < 3; ++c)
-      reaction[s.active[c]] = state.force[c];
+    if (has_active_node())
+      for (unsigned int c = 0; c < 3; ++c)
+        reaction[s.active[c]] = state.force[c];
 
+    // With a pressure field the FE has a fourth, scalar component.
     std::vector<DataComponentInterpretation::DataComponentInterpretation>
       vector_field(3, DataComponentInterpretation::component_is_part_of_vector);
+    std::vector<std::string> u_names(3, "displacement"), r_names(3, "reaction");
+    if (s.mixed)
+      {
+        vector_field.push_back(
+          DataComponentInterpretation::component_is_scalar);
+        u_names.push_back("pressure");
+        r_names.push_back("volume_residual");
+      }
     DataOut<3> data_out;
     data_out.add_data_vector(s.dof_handler,
                              displacement,
-                             std::vector<std::string>(3, "displacement"),
+                             u_names,
                              vector_field);
-    data_out.add_data_vector(s.dof_handler,
-                             reaction,
-                             std::vector<std::string>(3, "reaction"),
-                             vector_field);
+    data_out.add_data_vector(s.dof_handler, reaction, r_names, vector_field);
     data_out.add_data_vector(scalar, node_id, "node_id");
     data_out.add_data_vector(scalar, fixed, "fixed");
     data_out.add_data_vector(scalar, active, "active");

@@ -26,11 +26,9 @@ namespace palpate
     if (p.model_name == "Neo-Hookean")
       return std::make_unique<NeoHookean>(p.nh_youngs_modulus,
                                           p.nh_poissons_ratio);
-    throw NotAvailableError("The " + p.model_name + " material",
-                            "Use St.Venant-Kirchhoff or Neo-Hookean in "
-                            "Material model / Model name; Mooney-Rivlin "
-                            "with its pressure field comes with the "
-                            "incompressible mixed elements.");
+    if (p.model_name == "Mooney-Rivlin")
+      return std::make_unique<MooneyRivlin>(p.mr_c10, p.mr_c01);
+    throw std::invalid_argument("unknown material " + p.model_name);
   }
 
 
@@ -196,5 +194,164 @@ namespace palpate
   {
     return "compressible neo-Hookean, E = " + Utilities::to_string(E) +
            " Pa, nu = " + Utilities::to_string(nu);
+  }
+
+
+  void
+  volume_derivatives(const Tensor<2, 3> &F,
+                     double             &J,
+                     Tensor<2, 3>       &dJ,
+                     Tensor<4, 3>       *d2J)
+  {
+    J                       = dealii::determinant(F);
+    const Tensor<2, 3> Finv = dealii::invert(F);
+    dJ                      = J * dealii::transpose(Finv);
+    if (d2J != nullptr)
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int A = 0; A < 3; ++A)
+          for (unsigned int k = 0; k < 3; ++k)
+            for (unsigned int B = 0; B < 3; ++B)
+              (*d2J)[i][A][k][B] =
+                J * (Finv[A][i] * Finv[B][k] - Finv[A][k] * Finv[B][i]);
+  }
+
+
+
+  namespace
+  {
+    /**
+     * For f = phi(J) I, with phi = J^e, given I, dI/dF and d2I/dF2 and
+     * the derivatives of J: f, df/dF and d2f/dF2 by the product rule.
+     */
+    double
+    scaled_invariant(const double        e,
+                     const double        J,
+                     const Tensor<2, 3> &dJ,
+                     const Tensor<4, 3> &d2J,
+                     const double        I,
+                     const Tensor<2, 3> &dI,
+                     const Tensor<4, 3> &d2I,
+                     Tensor<2, 3>       &df,
+                     Tensor<4, 3>       *d2f)
+    {
+      const double phi   = std::pow(J, e);
+      const double dphi  = e * phi / J;
+      const double d2phi = e * (e - 1) * phi / (J * J);
+      df                 = dphi * I * dJ + phi * dI;
+      if (d2f != nullptr)
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int A = 0; A < 3; ++A)
+            for (unsigned int k = 0; k < 3; ++k)
+              for (unsigned int B = 0; B < 3; ++B)
+                (*d2f)[i][A][k][B] =
+                  d2phi * I * dJ[i][A] * dJ[k][B] + dphi * I * d2J[i][A][k][B] +
+                  dphi * (dJ[i][A] * dI[k][B] + dI[i][A] * dJ[k][B]) +
+                  phi * d2I[i][A][k][B];
+      return phi * I;
+    }
+  } // namespace
+
+
+
+  MooneyRivlin::MooneyRivlin(const double c10, const double c01)
+    : c10(c10)
+    , c01(c01)
+  {}
+
+
+
+  bool
+  MooneyRivlin::admissible(const Tensor<2, 3> &F) const
+  {
+    const double J = dealii::determinant(F);
+    return std::isfinite(J) && J > 0;
+  }
+
+
+
+  double
+  MooneyRivlin::evaluate(const Tensor<2, 3> &F,
+                         Tensor<2, 3>       &P,
+                         Tensor<4, 3>       *tangent) const
+  {
+    double       J;
+    Tensor<2, 3> dJ;
+    Tensor<4, 3> d2J;
+    volume_derivatives(F, J, dJ, tangent ? &d2J : nullptr);
+
+    // I1 = F:F, dI1 = 2F, d2I1 = 2 d_ik d_AB.
+    const double I1  = dealii::scalar_product(F, F);
+    Tensor<2, 3> dI1 = 2.0 * F;
+    // I2 = (I1^2 - C:C)/2, dI2 = 2 (I1 F - F C),
+    // d2I2 = 2 (2 F_iA F_kB + I1 d_ik d_AB - d_ik C_AB - F_iB F_kA - b_ik
+    // d_AB).
+    const Tensor<2, 3> C   = dealii::transpose(F) * F;
+    const Tensor<2, 3> b   = F * dealii::transpose(F);
+    const double       I2  = 0.5 * (I1 * I1 - dealii::scalar_product(C, C));
+    const Tensor<2, 3> dI2 = 2.0 * (I1 * F - F * C);
+    Tensor<4, 3>       d2I1, d2I2;
+    if (tangent != nullptr)
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int A = 0; A < 3; ++A)
+          for (unsigned int k = 0; k < 3; ++k)
+            for (unsigned int B = 0; B < 3; ++B)
+              {
+                const double dik = (i == k), dAB = (A == B);
+                d2I1[i][A][k][B] = 2.0 * dik * dAB;
+                d2I2[i][A][k][B] =
+                  2.0 * (2.0 * F[i][A] * F[k][B] + I1 * dik * dAB -
+                         dik * C[A][B] - F[i][B] * F[k][A] - b[i][k] * dAB);
+              }
+
+    Tensor<2, 3> dI1bar, dI2bar;
+    Tensor<4, 3> d2I1bar, d2I2bar;
+    const double I1bar = scaled_invariant(-2.0 / 3.0,
+                                          J,
+                                          dJ,
+                                          d2J,
+                                          I1,
+                                          dI1,
+                                          d2I1,
+                                          dI1bar,
+                                          tangent ? &d2I1bar : nullptr);
+    const double I2bar = scaled_invariant(-4.0 / 3.0,
+                                          J,
+                                          dJ,
+                                          d2J,
+                                          I2,
+                                          dI2,
+                                          d2I2,
+                                          dI2bar,
+                                          tangent ? &d2I2bar : nullptr);
+
+    P = c10 * dI1bar + c01 * dI2bar;
+    if (tangent != nullptr)
+      *tangent = c10 * d2I1bar + c01 * d2I2bar;
+    return c10 * (I1bar - 3.0) + c01 * (I2bar - 3.0);
+  }
+
+
+
+  double
+  MooneyRivlin::shear_modulus() const
+  {
+    return 2.0 * (c10 + c01);
+  }
+
+
+
+  double
+  MooneyRivlin::youngs_modulus() const
+  {
+    return 3.0 * shear_modulus();
+  }
+
+
+
+  std::string
+  MooneyRivlin::description() const
+  {
+    return "Mooney-Rivlin (isochoric), C10 = " + Utilities::to_string(c10) +
+           " Pa, C01 = " + Utilities::to_string(c01) + " Pa";
   }
 } // namespace palpate

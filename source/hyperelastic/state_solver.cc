@@ -210,10 +210,12 @@ namespace palpate
         const bool   predictor =
           system->constraint_violation(residual) >
           settings.increment_tolerance * system->length_scale();
-        const double s0     = directional_derivative(residual, step);
-        const bool   energy = !predictor && s0 < 0;
-        double       alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
-        double       lower = 0, s_lower = s0, upper = -1, s_upper = 0;
+        const double s0 = directional_derivative(residual, step);
+        // The energy of the mixed u-p formulation has a saddle in p, so
+        // there the residual norm is the merit function.
+        const bool energy = !predictor && s0 < 0 && !system->has_pressure();
+        double     alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
+        double     lower = 0, s_lower = s0, upper = -1, s_upper = 0;
         const unsigned int steps =
           settings.line_search ? settings.max_line_search_steps : 1;
         for (unsigned int k = 0; k < steps; ++k)

@@ -527,6 +527,26 @@ namespace palpate
                   "set C10 (and C01) in Pa; for Young's modulus E of an "
                   "incompressible solid, C10 + C01 = E/6.");
 
+    // Mooney-Rivlin: the element pair fixes the displacement degree.
+    if (m.model_name == "Mooney-Rivlin" &&
+        line_of("Discretization/Polynomial degree") > 0)
+      {
+        const unsigned int pair_degree = m.mr_element == "Taylor-Hood" ? 2 : 1;
+        if (p.discretization.polynomial_degree != pair_degree)
+          throw error(
+            "Discretization/Polynomial degree",
+            "Mooney-Rivlin's element pair " + m.mr_element +
+              " has displacements of degree " + std::to_string(pair_degree),
+            "remove this entry (Material model / Mooney-Rivlin / Element chooses the "
+            "degree), or choose the element pair with the degree you want.");
+      }
+    if (m.model_name == "Mooney-Rivlin" &&
+        m.mr_incompressibility == "penalty" && m.mr_bulk_modulus <= 0)
+      throw error(
+        "Material model/Mooney-Rivlin/Bulk modulus",
+        "the bulk modulus must be positive",
+        "set it in Pa, typically 1000 times C10 + C01 for soft tissue.");
+
     // Mesh.
     if (p.mesh.source == "file" && p.mesh.file_name.empty())
       throw error("Mesh/File name",

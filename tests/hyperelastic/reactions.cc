@@ -120,6 +120,43 @@ main(int argc, char **argv)
         }
     }
 
+  // The incompressible Mooney-Rivlin liver (P1-P1 and Taylor-Hood): the
+  // multiplier is still the reaction, and reactions still balance.
+  for (const std::string element : {"P1-P1", "Taylor-Hood"})
+    {
+      palpate::Scene scene = shipped_scene("liver-mooney-rivlin.prm");
+      scene.parameters.material_model.mr_element           = element;
+      scene.parameters.nonlinear_solver.residual_tolerance = 1e-11;
+      const Body           body(scene);
+      palpate::StateSolver solver(body.mesh, body.nodes, scene.parameters);
+      const auto          &system = solver.system();
+      const palpate::State state =
+        solver.solve(solver.rest_state(), {{0.005, -0.005, -0.01}});
+      const auto f = system.nodal_residual(state.solution);
+      Point3     from_residual;
+      for (unsigned int c = 0; c < 3; ++c)
+        from_residual[c] = -f[system.active_dofs()[c]];
+      const double scale = palpate::Utilities::norm(state.force);
+      deallog << "liver, Mooney-Rivlin " << element << ": converged "
+              << state.converged << ", force on the probe ("
+              << palpate::Utilities::to_string(state.force, 4) << ") N"
+              << std::endl;
+      deallog
+        << "  multiplier = reaction from the residual, relative difference < 1e-8: "
+        << (small(palpate::Utilities::distance(from_residual, state.force) /
+                  scale) ?
+              "yes" :
+              "NO")
+        << std::endl;
+      deallog << "  sum of all reactions (active + fixed) / |force| < 1e-8: "
+              << (small(
+                    palpate::Utilities::norm(total_reaction(system, state)) /
+                    scale) ?
+                    "yes" :
+                    "NO")
+              << std::endl;
+    }
+
   // With gravity, the constrained nodes carry the weight rho g V.
   {
     palpate::Scene scene             = shipped_scene("beam.prm");

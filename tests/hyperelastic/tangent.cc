@@ -4,7 +4,10 @@
 // The assembled tangent is the derivative of the assembled residual: at a
 // deformed, non-equilibrium point x and a random direction v,
 // || K v - (R(x + e v) - R(x - e v)) / 2e || / || K v || < 1e-6, for each
-// material, both treatments of the fixed nodes, and P1 and P2 elements.
+// material, both treatments of the fixed nodes, and P1 and P2 elements;
+// for Mooney-Rivlin the mixed u-p residual with P1-P1 (stabilised) and
+// Taylor-Hood, exact and penalised. The compressible materials have no
+// pressure field: 3 DoFs per node.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -84,6 +87,8 @@ namespace
         best = std::min(best, norm(difference) / norm(Kv));
       }
     deallog << name << ": " << system.discretization_description() << ", "
+            << system.n_dofs() << " DoFs ("
+            << (system.has_pressure() ? "with" : "no") << " pressure field), "
             << system.n_equations() << " equations, state "
             << (state.converged ? "converged" : "FAILED")
             << "; tangent vs central difference, relative error < 1e-6: "
@@ -136,4 +141,39 @@ main(int argc, char **argv)
         "multipliers",
         2,
         {{0, 0.005, -0.01}});
+
+  // Mooney-Rivlin: the mixed u-p residual, P1-P1 (stabilised) and
+  // Taylor-Hood, exact and penalised incompressibility.
+  const palpate::Scene mr = shipped_scene("liver-mooney-rivlin.prm");
+  check("liver, Mooney-Rivlin P1-P1, exact",
+        mr,
+        "Mooney-Rivlin",
+        "elimination",
+        1,
+        {{0, 0, -0.015}});
+  check("liver, Mooney-Rivlin P1-P1, exact, multipliers",
+        mr,
+        "Mooney-Rivlin",
+        "multipliers",
+        1,
+        {{0.01, 0, -0.01}});
+  palpate::Scene penalty                                 = mr;
+  penalty.parameters.material_model.mr_incompressibility = "penalty";
+  penalty.parameters.material_model.mr_bulk_modulus      = 2.5e6;
+  check("liver, Mooney-Rivlin P1-P1, penalty",
+        penalty,
+        "Mooney-Rivlin",
+        "elimination",
+        1,
+        {{0, 0.01, -0.01}});
+  palpate::Scene taylor_hood                       = beam;
+  taylor_hood.parameters.material_model.mr_c10     = 2e4;
+  taylor_hood.parameters.material_model.mr_c01     = 5e3;
+  taylor_hood.parameters.material_model.mr_element = "Taylor-Hood";
+  check("beam, Mooney-Rivlin Taylor-Hood, exact",
+        taylor_hood,
+        "Mooney-Rivlin",
+        "elimination",
+        2,
+        {{0, 0.003, -0.008}});
 }

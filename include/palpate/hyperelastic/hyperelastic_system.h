@@ -23,12 +23,24 @@ namespace palpate
 
   /**
    * The discrete non-linear system of one body: the finite element space
-   * (FE_SimplexP of degree 1 or 2, three components), the constraints, and
-   * the assembly of the residual and its tangent.
+   * (FE_SimplexP of degree 1 or 2, three components; plus a P1 pressure
+   * for Mooney-Rivlin), the constraints, and the assembly of the residual
+   * and its tangent.
+   *
+   * With a pressure field (mixed u-p), the energy is
+   *
+   *   Pi(u, p) = int W_iso(F) - p (J - 1) - p^2 / (2 kappa) dV
+   *
+   * (1/kappa = 0 for exact incompressibility), so p is the hydrostatic
+   * pressure and the pressure rows say int q (J - 1 + p/kappa) dV = 0. For
+   * P1-P1, which is not inf-sup stable, the Brezzi-Pitkaranta term
+   * - alpha h^2/mu int grad p . grad q is added to the pressure rows. The
+   * pressure unknowns are scaled by mu/h so that all rows are forces and
+   * all unknowns lengths, as for the multipliers.
    *
    * The unknowns x are the *equations* of the system:
    *
-   *   x = [ free displacement DoFs | multipliers ]
+   *   x = [ free displacement (and pressure) DoFs | multipliers ]
    *
    * Fixed nodes are either eliminated (their DoFs are not unknowns) or
    * constrained by multipliers, as the scene says. The active node's three
@@ -94,6 +106,18 @@ namespace palpate
     double
     constraint_scale() const;
 
+    /**
+     * Whether the body has a pressure field: the Mooney-Rivlin model's
+     * incompressibility (exact or penalised) is a mixed u-p formulation.
+     * Its pressure DoFs have component 3 in dof_components().
+     */
+    bool
+    has_pressure() const;
+
+    /** Whether the body has an active node (its three multipliers). */
+    bool
+    has_active_node() const;
+
     /** The DoFs of the active node (x, y, z components). */
     const std::array<unsigned int, 3> &
     active_dofs() const;
@@ -102,14 +126,14 @@ namespace palpate
     const std::vector<unsigned int> &
     fixed_dofs() const;
 
-    /**
-     * The reference position of each DoF's node (m): the vertex, or (P2)
-     * the edge midpoint; and the component (0, 1, 2) each DoF displaces.
+    /** The reference position of each DoF's node (m): the vertex, or (P2)
+     * the edge midpoint.
      */
     const std::vector<Utilities::Point3> &
     dof_positions() const;
 
-    /** The component of each DoF. */
+    /** The component of each DoF: 0, 1, 2 for displacements, 3 for the
+     * pressure. */
     const std::vector<unsigned int> &
     dof_components() const;
 
@@ -125,6 +149,24 @@ namespace palpate
     void
     set_fixed_displacement(
       const std::function<Utilities::Point3(const Utilities::Point3 &)> &f);
+
+    /**
+     * Add a dead traction @p traction (Pa, per unit reference area) on the
+     * boundary faces with @p boundary_id, scaled by the load factor. Tests
+     * and benchmarks use it (Cook's membrane); scenes load the body only
+     * through the active node and gravity.
+     */
+    void
+    add_surface_traction(const unsigned int       boundary_id,
+                         const Utilities::Point3 &traction);
+
+    /** The factor that scales the surface tractions (default 1). */
+    void
+    set_load_factor(const double factor);
+
+    /** Deformed volume of the body at @p solution, int J dV (m^3). */
+    double
+    deformed_volume(const std::vector<double> &solution) const;
 
     /** The unknowns of the rest state: all zero. */
     std::vector<double>
@@ -164,7 +206,8 @@ namespace palpate
     double
     max_displacement(const std::vector<double> &dx) const;
 
-    /** Fill the solution, multipliers and force of @p state from @p x. */
+    /** Fill the solution (displacements in m, pressures in Pa),
+     * multipliers and force of @p state from @p x. */
     void
     to_state(const std::vector<double> &x, State &state) const;
 

@@ -46,6 +46,17 @@ namespace palpate
     virtual bool
     admissible(const Tensor<2, 3> &F) const;
 
+    /**
+     * Whether the energy is only the isochoric (volume-preserving) part,
+     * so that the FE module must add a pressure field that imposes or
+     * penalises J - 1 (Mooney-Rivlin).
+     */
+    virtual bool
+    isochoric() const
+    {
+      return false;
+    }
+
     /** The shear modulus mu of the small-strain limit (Pa). */
     virtual double
     shear_modulus() const = 0;
@@ -58,10 +69,8 @@ namespace palpate
     virtual std::string
     description() const = 0;
 
-    /**
-     * The compressible material a scene asks for. The incompressible
-     * Mooney-Rivlin model needs a pressure field and is built by the FE
-     * module, not here.
+    /** The material a scene asks for. For Mooney-Rivlin this is the
+     * isochoric energy only; the FE module adds the pressure field.
      */
     static std::unique_ptr<Material>
     create(const Parameters::MaterialModel &parameters);
@@ -129,6 +138,61 @@ namespace palpate
     /** Lame parameters (Pa). */
     const double E, nu, lambda, mu;
   };
+
+  /**
+   * The isochoric Mooney-Rivlin energy
+   *   W_iso = C10 (I1bar - 3) + C01 (I2bar - 3),
+   * with the invariants of the isochoric deformation Fbar = J^(-1/3) F:
+   * I1bar = J^(-2/3) I1, I2bar = J^(-4/3) I2, I2 = ((tr C)^2 - tr C^2)/2. It
+   * carries no volumetric stiffness: the FE module imposes J = 1 with a
+   * pressure field p (adding -p (J - 1) to the energy), or penalises it. C01 =
+   * 0 is the incompressible neo-Hookean solid. The small-strain shear modulus
+   * is mu = 2 (C10 + C01).
+   */
+  class MooneyRivlin : public Material
+  {
+  public:
+    /** @p c10, @p c01 in Pa. */
+    MooneyRivlin(const double c10, const double c01);
+
+    double
+    evaluate(const Tensor<2, 3> &F,
+             Tensor<2, 3>       &P,
+             Tensor<4, 3>       *tangent) const override;
+
+    bool
+    admissible(const Tensor<2, 3> &F) const override;
+
+    bool
+    isochoric() const override
+    {
+      return true;
+    }
+
+    double
+    shear_modulus() const override;
+
+    /** 3 mu, the Young's modulus of an incompressible solid (Pa). */
+    double
+    youngs_modulus() const override;
+
+    std::string
+    description() const override;
+
+    /** The coefficients (Pa). */
+    const double c10, c01;
+  };
+
+  /**
+   * J = det F and its first and second derivatives with respect to F:
+   * dJ/dF = J F^-T, d2J/dF2_iJkL = J (Finv_Ji Finv_Lk - Finv_Jk Finv_Li).
+   * The pressure terms of the mixed formulation use them.
+   */
+  void
+  volume_derivatives(const Tensor<2, 3> &F,
+                     double             &J,
+                     Tensor<2, 3>       &dJ,
+                     Tensor<4, 3>       *d2J);
 } // namespace palpate
 
 #endif

@@ -18,9 +18,18 @@ namespace palpate
    */
   struct NodeSelection
   {
-    /** Fixed vertices, sorted, without repetitions. */
+    /** Fixed vertices (all three components), sorted, unique. */
     std::vector<unsigned int> fixed_vertices;
-    /** The active vertex. */
+    /**
+     * Further constraints on single components: (vertex, component) pairs
+     * held at zero, e.g. a sliding support or plane strain. Not set by
+     * scenes yet; tests and benchmarks use them.
+     */
+    std::vector<std::pair<unsigned int, unsigned int>> fixed_components;
+    /** Value of active_vertex for a body without an active node. */
+    static constexpr unsigned int no_active_node =
+      static_cast<unsigned int>(-1);
+    /** The active vertex, or no_active_node. */
     unsigned int active_vertex = 0;
     /** Distance from the scene's Point to the active node, metres (0 for
      * Selection = node id). */
