@@ -21,6 +21,7 @@
 #include <cmath>
 #include <iomanip>
 #include <map>
+#include <mutex>
 #include <sstream>
 
 namespace palpate
@@ -84,6 +85,20 @@ namespace palpate
       return position;
     }
 
+    /**
+     * Debian's MUMPS keeps the state of its load-balancing module in
+     * global (Fortran module) variables, so two instances that factorise at
+     * the same time corrupt each other ("PB allocation in DMUMPS_LOAD_INIT",
+     * then a crash). Every MUMPS call in the process therefore holds this
+     * lock; solver workers still assemble and line-search in parallel.
+     */
+    std::mutex &
+    mumps_lock()
+    {
+      static std::mutex m;
+      return m;
+    }
+
     // ------------------------------------------------------------------
     // MUMPS through its C interface.
     //
@@ -121,6 +136,7 @@ namespace palpate
       {
         if (initialized)
           {
+            std::lock_guard<std::mutex> lock(mumps_lock());
             id.job = -2;
             dmumps_c(&id);
           }
@@ -142,6 +158,7 @@ namespace palpate
               }
         values.resize(upper.size());
 
+        std::lock_guard<std::mutex> lock(mumps_lock());
         id.job          = -1; // initialise an instance
         id.par          = 1;  // this process works
         id.sym          = 2;  // general symmetric: LDL^T with 2x2 pivots
@@ -192,6 +209,7 @@ namespace palpate
             return false;
           }
         id.a = values.data();
+        std::lock_guard<std::mutex> lock(mumps_lock());
         // -8, -9, -17, -20: a workspace was too small (e.g. many delayed
         // pivots); enlarge it for this factorisation and retry.
         const MUMPS_INT margin = id.icntl[13];
@@ -219,9 +237,12 @@ namespace palpate
       bool
       solve(std::vector<double> &rhs) override
       {
-        id.rhs = rhs.data();
-        id.job = 3;
-        dmumps_c(&id);
+        {
+          std::lock_guard<std::mutex> lock(mumps_lock());
+          id.rhs = rhs.data();
+          id.job = 3;
+          dmumps_c(&id);
+        }
         if (id.infog[0] < 0)
           {
             message_ =

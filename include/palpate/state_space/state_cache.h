@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_state_space_state_cache_h
+#define palpate_state_space_state_cache_h
+
+#include <palpate/base/utilities.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace palpate
+{
+  struct State;
+
+  /** What the cache knows about a grid point. */
+  enum class PointStatus : std::uint8_t
+  {
+    /** Not computed (or computed for parameters that changed since). */
+    missing = 0,
+    /** Computed: its force can be interpolated. */
+    available = 1,
+    /** A failure point: no equilibrium was found; never interpolated. */
+    failed = 2
+  };
+
+  /**
+   * The computed states of the state grid.
+   *
+   * Two kinds of readers, two mechanisms:
+   * - The real-time side reads only forces, through read_force(): a
+   *   sequence lock per grid point, so it never waits, never allocates and
+   *   never sees a half-written force; a read that races with a write
+   *   reports the point as missing for that tick.
+   * - The engine (sources of new computations) and the shape interpolator
+   *   read whole states, through state(), under a mutex.
+   *
+   * Whole states are kept within a memory budget: when it is exceeded, the
+   * states farthest from the focus (the HIP) are dropped; their forces stay.
+   *
+   * invalidate() starts a new generation: every point is missing again, and
+   * results that arrive for an older generation are discarded, so no stale
+   * state is ever interpolated after the parameters change.
+   */
+  class StateCache
+  {
+  public:
+    /** A cache for @p grid holding at most @p memory_budget bytes of states. */
+    StateCache(const StateGrid &grid, const std::size_t memory_budget);
+
+    ~StateCache();
+
+    /** The current generation (starts at 1). */
+    std::uint64_t
+    generation() const noexcept;
+
+    /** Start a new generation: every point missing, all states dropped. */
+    void
+    invalidate();
+
+    /**
+     * Store a converged state for @p point, computed for @p generation; it
+     * is discarded if the generation has changed since.
+     */
+    void
+    publish(const unsigned int           point,
+            std::shared_ptr<const State> state,
+            const std::uint64_t          generation);
+
+    /** Record @p point as a failure point (for @p generation). */
+    void
+    publish_failure(const unsigned int point, const std::uint64_t generation);
+
+    /** What is known about @p point in the current generation. Lock-free. */
+    PointStatus
+    status(const unsigned int point) const noexcept;
+
+    /** The whole state at @p point, or null if missing, failed or evicted. */
+    std::shared_ptr<const State>
+    state(const unsigned int point) const;
+
+    /** Whether the whole state at @p point is held (usable as a source). */
+    bool
+    has_state(const unsigned int point) const;
+
+    /** The point states are kept near when the budget is tight (m). */
+    void
+    set_focus(const Utilities::Point3 &hip);
+
+    /**
+     * Real-time read of the force at @p point (N): true and @p force set if
+     * the point is available, false otherwise. Never blocks, never
+     * allocates.
+     */
+    bool
+    read_force(const unsigned int point,
+               Utilities::Point3 &force) const noexcept;
+
+    /** Number of available and of failed points in this generation. */
+    std::pair<unsigned int, unsigned int>
+    counts() const;
+
+    /** Number of whole states held, and their size in bytes. */
+    std::pair<unsigned int, std::size_t>
+    memory() const;
+
+    /** Number of states dropped to respect the budget. */
+    unsigned int
+    n_evicted() const;
+
+  private:
+    struct Entry;
+
+    const StateGrid                          &grid;
+    std::unique_ptr<Entry[]>                  entries;
+    std::atomic<std::uint64_t>                current_generation;
+    mutable std::mutex                        mutex;
+    std::vector<std::shared_ptr<const State>> states;
+    std::size_t                               bytes = 0, budget;
+    unsigned int                              held = 0, evicted = 0;
+    Utilities::Point3                         focus = {{0, 0, 0}};
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_state_space_state_grid_h
+#define palpate_state_space_state_grid_h
+
+#include <palpate/base/utilities.h>
+
+#include <array>
+
+namespace palpate
+{
+  /** Integer coordinates (i, j, k) of a grid point. */
+  using GridIndex = std::array<int, 3>;
+
+  /**
+   * The state space: a regular grid of active-node displacements, centred
+   * on the active node's rest position. Point (i, j, k) is the displacement
+   * h (i, j, k), with |i|, |j|, |k| <= n = floor(extent / h). Cells are the
+   * cubes between neighbouring points; inside a cell, force and shape are
+   * interpolated trilinearly from its 8 corners.
+   *
+   * Pure arithmetic, no allocation: the real-time thread uses it.
+   */
+  class StateGrid
+  {
+  public:
+    /** @p spacing h and @p extent (half-width), both in metres. */
+    StateGrid(const double spacing, const double extent);
+
+    /** Grid spacing h (m). */
+    double
+    spacing() const noexcept
+    {
+      return h;
+    }
+
+    /** Points per half-axis: indices run from -n to n. */
+    int
+    half_width() const noexcept
+    {
+      return n;
+    }
+
+    /** Number of grid points, (2n + 1)^3. */
+    unsigned int
+    size() const noexcept
+    {
+      return side * side * side;
+    }
+
+    /** Whether (i, j, k) is a point of the grid. */
+    bool
+    contains(const GridIndex &g) const noexcept;
+
+    /** The linear number of point @p g (which must be in the grid). */
+    unsigned int
+    linear(const GridIndex &g) const noexcept;
+
+    /** The point with linear number @p p. */
+    GridIndex
+    index(const unsigned int p) const noexcept;
+
+    /** Displacement of the active node at point @p g (m). */
+    Utilities::Point3
+    position(const GridIndex &g) const noexcept;
+
+    /** Displacement of the active node at point @p p (m). */
+    Utilities::Point3
+    position(const unsigned int p) const noexcept;
+
+    /** The grid point nearest to @p x (clamped to the grid). */
+    GridIndex
+    nearest(const Utilities::Point3 &x) const noexcept;
+
+    /**
+     * The cell that contains @p x: its lower corner and the local
+     * coordinates of @p x in [0, 1]^3. Returns false if @p x lies outside
+     * the grid (or is not finite).
+     */
+    bool
+    locate(const Utilities::Point3 &x,
+           GridIndex               &lower,
+           std::array<double, 3>   &local) const noexcept;
+
+    /**
+     * The 8 corners of the cell with lower corner @p lower, as linear
+     * numbers; corner c has offsets (c & 1, (c >> 1) & 1, (c >> 2) & 1).
+     */
+    std::array<unsigned int, 8>
+    corners(const GridIndex &lower) const noexcept;
+
+  private:
+    double       h;
+    int          n;
+    unsigned int side;
+  };
+
+  /**
+   * Trilinear weights of the 8 corners (ordered as StateGrid::corners())
+   * at local coordinates @p local in [0, 1]^3. They sum to 1.
+   */
+  std::array<double, 8>
+  trilinear_weights(const std::array<double, 3> &local) noexcept;
+} // namespace palpate
+
+#endif

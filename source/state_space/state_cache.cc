@@ -1,0 +1,247 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/hyperelastic/state.h>
+#include <palpate/state_space/state_cache.h>
+
+namespace palpate
+{
+  /**
+   * One grid point as the real-time side sees it, behind a sequence lock:
+   * the writer makes the sequence odd, writes, and makes it even again; a
+   * reader that sees an odd or changed sequence discards what it read. All
+   * fields are atomics (relaxed inside the lock), so there is no data race
+   * in the C++ sense either.
+   */
+  struct StateCache::Entry
+  {
+    std::atomic<std::uint32_t> sequence{0};
+    std::atomic<std::uint64_t> generation{0};
+    std::atomic<std::uint8_t>  status{0};
+    std::atomic<double>        force[3] = {};
+  };
+
+
+
+  namespace
+  {
+    std::size_t
+    size_of(const State &s)
+    {
+      return sizeof(State) + s.solution.size() * sizeof(double) +
+             s.multipliers.size() * sizeof(double);
+    }
+  } // namespace
+
+
+
+  StateCache::StateCache(const StateGrid &grid, const std::size_t memory_budget)
+    : grid(grid)
+    , entries(new Entry[grid.size()])
+    , current_generation(1)
+    , states(grid.size())
+    , budget(memory_budget)
+  {}
+
+
+
+  StateCache::~StateCache() = default;
+
+
+
+  std::uint64_t
+  StateCache::generation() const noexcept
+  {
+    return current_generation.load(std::memory_order_acquire);
+  }
+
+
+
+  void
+  StateCache::invalidate()
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    current_generation.fetch_add(1, std::memory_order_acq_rel);
+    for (auto &s : states)
+      s.reset();
+    bytes = 0;
+    held  = 0;
+  }
+
+
+
+  void
+  StateCache::publish(const unsigned int           point,
+                      std::shared_ptr<const State> state,
+                      const std::uint64_t          generation)
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (generation != current_generation.load(std::memory_order_acquire))
+      return; // computed for parameters that no longer hold
+    Entry              &e = entries[point];
+    const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
+    e.sequence.store(s + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    for (unsigned int d = 0; d < 3; ++d)
+      e.force[d].store(state->force[d], std::memory_order_relaxed);
+    e.status.store(static_cast<std::uint8_t>(PointStatus::available),
+                   std::memory_order_relaxed);
+    e.generation.store(generation, std::memory_order_relaxed);
+    e.sequence.store(s + 2, std::memory_order_release);
+
+    if (!states[point])
+      ++held;
+    else
+      bytes -= size_of(*states[point]);
+    bytes += size_of(*state);
+    states[point] = std::move(state);
+
+    // Over budget: drop the states farthest from the focus (their forces
+    // stay available to the real-time side).
+    while (bytes > budget && held > 1)
+      {
+        unsigned int farthest = 0;
+        double       distance = -1;
+        for (unsigned int p = 0; p < states.size(); ++p)
+          if (states[p] && p != point)
+            if (const double d = Utilities::distance(grid.position(p), focus);
+                d > distance)
+              distance = d, farthest = p;
+        if (distance < 0)
+          break;
+        bytes -= size_of(*states[farthest]);
+        states[farthest].reset();
+        --held;
+        ++evicted;
+      }
+  }
+
+
+
+  void
+  StateCache::publish_failure(const unsigned int  point,
+                              const std::uint64_t generation)
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (generation != current_generation.load(std::memory_order_acquire))
+      return;
+    Entry              &e = entries[point];
+    const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
+    e.sequence.store(s + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    for (unsigned int d = 0; d < 3; ++d)
+      e.force[d].store(0.0, std::memory_order_relaxed);
+    e.status.store(static_cast<std::uint8_t>(PointStatus::failed),
+                   std::memory_order_relaxed);
+    e.generation.store(generation, std::memory_order_relaxed);
+    e.sequence.store(s + 2, std::memory_order_release);
+  }
+
+
+
+  PointStatus
+  StateCache::status(const unsigned int point) const noexcept
+  {
+    const Entry &e = entries[point];
+    for (unsigned int attempt = 0; attempt < 4; ++attempt)
+      {
+        const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
+        if (s1 & 1)
+          continue;
+        const auto status     = e.status.load(std::memory_order_relaxed);
+        const auto generation = e.generation.load(std::memory_order_relaxed);
+        std::atomic_thread_fence(std::memory_order_acquire);
+        if (e.sequence.load(std::memory_order_relaxed) != s1)
+          continue;
+        return generation ==
+                   current_generation.load(std::memory_order_acquire) ?
+                 static_cast<PointStatus>(status) :
+                 PointStatus::missing;
+      }
+    return PointStatus::missing;
+  }
+
+
+
+  bool
+  StateCache::read_force(const unsigned int point,
+                         Utilities::Point3 &force) const noexcept
+  {
+    const Entry        &e  = entries[point];
+    const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
+    if (s1 & 1)
+      return false;
+    const auto        status     = e.status.load(std::memory_order_relaxed);
+    const auto        generation = e.generation.load(std::memory_order_relaxed);
+    Utilities::Point3 f;
+    for (unsigned int d = 0; d < 3; ++d)
+      f[d] = e.force[d].load(std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (e.sequence.load(std::memory_order_relaxed) != s1 ||
+        generation != current_generation.load(std::memory_order_acquire) ||
+        status != static_cast<std::uint8_t>(PointStatus::available))
+      return false;
+    force = f;
+    return true;
+  }
+
+
+
+  std::shared_ptr<const State>
+  StateCache::state(const unsigned int point) const
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    return states[point];
+  }
+
+
+
+  bool
+  StateCache::has_state(const unsigned int point) const
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    return states[point] != nullptr;
+  }
+
+
+
+  void
+  StateCache::set_focus(const Utilities::Point3 &hip)
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    focus = hip;
+  }
+
+
+
+  std::pair<unsigned int, unsigned int>
+  StateCache::counts() const
+  {
+    unsigned int available = 0, failed = 0;
+    for (unsigned int p = 0; p < grid.size(); ++p)
+      {
+        const PointStatus s = status(p);
+        available += s == PointStatus::available;
+        failed += s == PointStatus::failed;
+      }
+    return {available, failed};
+  }
+
+
+
+  std::pair<unsigned int, std::size_t>
+  StateCache::memory() const
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    return {held, bytes};
+  }
+
+
+
+  unsigned int
+  StateCache::n_evicted() const
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    return evicted;
+  }
+} // namespace palpate

@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/state_space/state_grid.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace palpate
+{
+  StateGrid::StateGrid(const double spacing, const double extent)
+    : h(spacing)
+    , n(static_cast<int>(std::floor(extent / spacing + 1e-9)))
+    , side(2 * n + 1)
+  {
+    if (!(spacing > 0) || n < 1)
+      throw std::invalid_argument(
+        "a state grid needs a positive spacing and at "
+        "least one cell per half-axis");
+  }
+
+
+
+  bool
+  StateGrid::contains(const GridIndex &g) const noexcept
+  {
+    return std::abs(g[0]) <= n && std::abs(g[1]) <= n && std::abs(g[2]) <= n;
+  }
+
+
+
+  unsigned int
+  StateGrid::linear(const GridIndex &g) const noexcept
+  {
+    return ((g[2] + n) * side + (g[1] + n)) * side + (g[0] + n);
+  }
+
+
+
+  GridIndex
+  StateGrid::index(const unsigned int p) const noexcept
+  {
+    return {{static_cast<int>(p % side) - n,
+             static_cast<int>((p / side) % side) - n,
+             static_cast<int>(p / (side * side)) - n}};
+  }
+
+
+
+  Utilities::Point3
+  StateGrid::position(const GridIndex &g) const noexcept
+  {
+    return {{h * g[0], h * g[1], h * g[2]}};
+  }
+
+
+
+  Utilities::Point3
+  StateGrid::position(const unsigned int p) const noexcept
+  {
+    return position(index(p));
+  }
+
+
+
+  GridIndex
+  StateGrid::nearest(const Utilities::Point3 &x) const noexcept
+  {
+    GridIndex g;
+    for (unsigned int d = 0; d < 3; ++d)
+      {
+        const double v = std::isfinite(x[d]) ? std::round(x[d] / h) : 0.0;
+        g[d]           = static_cast<int>(std::clamp(v, double(-n), double(n)));
+      }
+    return g;
+  }
+
+
+
+  bool
+  StateGrid::locate(const Utilities::Point3 &x,
+                    GridIndex               &lower,
+                    std::array<double, 3>   &local) const noexcept
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+      {
+        if (!std::isfinite(x[d]))
+          return false;
+        const double s = x[d] / h;
+        if (s < -n || s > n)
+          return false;
+        // The upper boundary belongs to the last cell.
+        const int i = std::min(static_cast<int>(std::floor(s)), n - 1);
+        lower[d]    = i;
+        local[d]    = s - i;
+      }
+    return true;
+  }
+
+
+
+  std::array<unsigned int, 8>
+  StateGrid::corners(const GridIndex &lower) const noexcept
+  {
+    std::array<unsigned int, 8> c;
+    for (unsigned int k = 0; k < 8; ++k)
+      c[k] = linear({{lower[0] + int(k & 1),
+                      lower[1] + int((k >> 1) & 1),
+                      lower[2] + int((k >> 2) & 1)}});
+    return c;
+  }
+
+
+
+  std::array<double, 8>
+  trilinear_weights(const std::array<double, 3> &s) noexcept
+  {
+    std::array<double, 8> w;
+    for (unsigned int k = 0; k < 8; ++k)
+      w[k] = ((k & 1) ? s[0] : 1 - s[0]) * (((k >> 1) & 1) ? s[1] : 1 - s[1]) *
+             (((k >> 2) & 1) ? s[2] : 1 - s[2]);
+    return w;
+  }
+} // namespace palpate

@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The state grid and the force interpolation: index <-> position round
+// trips; locating points (inside, on faces, on the outer boundary, outside,
+// NaN); trilinear interpolation from the cache is exact for a trilinear
+// force field, continuous across cell faces, and reports missing corners,
+// failure points and generations that changed.
+
+#include <palpate/haptics/force_interpolation.h>
+#include <palpate/hyperelastic/state.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "../tests.h"
+
+namespace
+{
+  using palpate::Utilities::Point3;
+
+  /** A trilinear field: every monomial up to xyz. */
+  Point3
+  field(const Point3 &x)
+  {
+    const double a = x[0] * 100, b = x[1] * 100, c = x[2] * 100;
+    return {{1 + 2 * a - b + 0.5 * c + 0.3 * a * b - 0.2 * b * c + 0.7 * c * a +
+               0.1 * a * b * c,
+             -0.5 + a * b * c,
+             3 * c - a * c}};
+  }
+
+  void
+  fill(const palpate::StateGrid &grid, palpate::StateCache &cache)
+  {
+    for (unsigned int p = 0; p < grid.size(); ++p)
+      {
+        auto s   = std::make_shared<palpate::State>();
+        s->force = field(grid.position(p));
+        cache.publish(p, s, cache.generation());
+      }
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  const palpate::StateGrid grid(0.005, 0.02);
+  deallog << "grid: h = " << grid.spacing() << " m, half width "
+          << grid.half_width() << ", " << grid.size() << " points" << std::endl;
+
+  bool round_trip = true;
+  for (unsigned int p = 0; p < grid.size(); ++p)
+    round_trip = round_trip && grid.linear(grid.index(p)) == p &&
+                 grid.nearest(grid.position(p)) == grid.index(p);
+  deallog << "index <-> position round trips: " << (round_trip ? "yes" : "NO")
+          << std::endl;
+
+  palpate::GridIndex    lower;
+  std::array<double, 3> local;
+  for (const Point3 &x :
+       std::vector<Point3>{{{0.0012, -0.0031, 0.007}},
+                           {{0.005, 0.005, 0.005}},
+                           {{0.02, -0.02, 0.0}},
+                           {{0.0201, 0, 0}},
+                           {{std::numeric_limits<double>::quiet_NaN(), 0, 0}}})
+    {
+      const bool inside = grid.locate(x, lower, local);
+      deallog << "locate (" << palpate::Utilities::to_string(x, 4) << "): ";
+      if (inside)
+        deallog << "cell (" << lower[0] << ", " << lower[1] << ", " << lower[2]
+                << "), local (" << local[0] << ", " << local[1] << ", "
+                << local[2] << ")" << std::endl;
+      else
+        deallog << "outside" << std::endl;
+    }
+
+  palpate::StateCache cache(grid, 1 << 20);
+  fill(grid, cache);
+  std::mt19937                           random(3);
+  std::uniform_real_distribution<double> u(-0.0199, 0.0199);
+  double                                 worst = 0;
+  for (unsigned int k = 0; k < 2000; ++k)
+    {
+      const Point3 x = {{u(random), u(random), u(random)}};
+      const auto   s = palpate::interpolate_force(grid, cache, x);
+      if (!s.complete)
+        worst = 1e300;
+      else
+        worst =
+          std::max(worst, palpate::Utilities::distance(s.force, field(x)));
+    }
+  deallog
+    << "trilinear field reproduced at 2000 random points, error < 1e-12 N: "
+    << (worst < 1e-12 ? "yes" : "NO") << std::endl;
+
+  // Continuity across a face: just before and after x = 0.005.
+  const Point3 before{{0.005 - 1e-12, 0.0013, -0.0041}},
+    after{{0.005 + 1e-12, 0.0013, -0.0041}};
+  const auto a = palpate::interpolate_force(grid, cache, before);
+  const auto b = palpate::interpolate_force(grid, cache, after);
+  deallog << "across a cell face the cells differ ("
+          << (a.corners != b.corners ? "yes" : "NO")
+          << ") and the force is continuous, jump < 1e-9 N: "
+          << (palpate::Utilities::distance(a.force, b.force) < 1e-9 ? "yes" :
+                                                                      "NO")
+          << std::endl;
+
+  // A failure point among the corners: incomplete, zero force.
+  const unsigned int corner = a.corners[3];
+  cache.publish_failure(corner, cache.generation());
+  const auto c = palpate::interpolate_force(grid, cache, before);
+  deallog << "with a failure point at a corner: complete " << c.complete << ", "
+          << c.hits << " of 8 corners, force "
+          << palpate::Utilities::norm(c.force) << " N" << std::endl;
+
+  // A new generation: nothing is available, and late results of the old
+  // generation are discarded.
+  const auto old = cache.generation();
+  cache.invalidate();
+  auto late   = std::make_shared<palpate::State>();
+  late->force = {{1, 2, 3}};
+  cache.publish(corner, late, old);
+  const auto counts = cache.counts();
+  const auto d      = palpate::interpolate_force(grid, cache, before);
+  deallog << "after invalidate(): " << counts.first << " available, "
+          << counts.second
+          << " failed, a late result of the old generation ignored ("
+          << (cache.status(corner) == palpate::PointStatus::missing ? "yes" :
+                                                                      "NO")
+          << "), interpolation complete " << d.complete << std::endl;
+
+  // The memory budget keeps the states near the focus.
+  palpate::StateCache small(grid, 40 * sizeof(palpate::State));
+  small.set_focus({{0, 0, 0}});
+  fill(grid, small);
+  const auto memory = small.memory();
+  deallog << "budget of 40 states: " << memory.first << " held, "
+          << small.n_evicted() << " dropped, nearest kept ("
+          << (small.has_state(grid.linear({{0, 0, 1}})) ? "yes" : "NO")
+          << "), forces still available (" << small.counts().first << ")"
+          << std::endl;
+}
