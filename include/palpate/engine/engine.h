@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_engine_engine_h
+#define palpate_engine_engine_h
+
+#include <palpate/base/utilities.h>
+#include <palpate/hyperelastic/state.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  class HipChannel;
+  class Mesh;
+  class Scene;
+  class StateCache;
+  class StateGrid;
+  struct NodeSelection;
+
+  namespace Parameters
+  {
+    struct AllParameters;
+  }
+
+  /** What happened to one computed task. */
+  struct TaskRecord
+  {
+    unsigned int target, source;
+    /** Seconds since the engine started. */
+    double       start, duration;
+    bool         converged;
+    SolveStatus  status;
+    unsigned int newton_iterations;
+    unsigned int worker;
+  };
+
+  /** The engine's counters at some moment. */
+  struct EngineStatistics
+  {
+    unsigned int computed  = 0; // converged states published
+    unsigned int failed    = 0; // failure points
+    unsigned int dropped   = 0; // queued tasks that fell out of the cloud
+    unsigned int discarded = 0; // results for a generation that changed
+    double       busy_time = 0; // seconds workers spent solving
+    std::vector<TaskRecord> tasks;
+  };
+
+  /**
+   * The on-line precomputation engine as the haptic side sees it: it keeps
+   * the cloud of states around the HIP computed and publishes them in the
+   * StateCache. The threaded engine runs solver workers in this process; an
+   * MPI engine with solver servers implements the same interface.
+   */
+  class PrecomputationEngine
+  {
+  public:
+    virtual ~PrecomputationEngine() = default;
+
+    /**
+     * Start computing (attach): publish the rest state, then keep the cloud
+     * around the HIP read from the channel computed.
+     */
+    virtual void
+    start() = 0;
+
+    /** Stop (detach): no new tasks; running ones finish. Blocks until then. */
+    virtual void
+    stop() = 0;
+
+    /** Whether start() has been called without stop(). */
+    virtual bool
+    running() const = 0;
+
+    /**
+     * Use new parameters (material, fixed nodes, active node): only while
+     * stopped. The cache is invalidated; nothing computed before is used.
+     */
+    virtual void
+    change_parameters(const Parameters::AllParameters &parameters) = 0;
+
+    /** Whether nothing is under way and nothing in the cloud is left to do. */
+    virtual bool
+    idle() const = 0;
+
+    /** A copy of the counters and the task log. */
+    virtual EngineStatistics
+    statistics() const = 0;
+
+    /** A description, e.g. "2 solver threads". */
+    virtual std::string
+    description() const = 0;
+
+    /**
+     * The engine a scene asks for (Engine / Type). Throws
+     * NotAvailableError for engines this version does not have.
+     */
+    static std::unique_ptr<PrecomputationEngine>
+    create(const Scene         &scene,
+           const Mesh          &mesh,
+           const NodeSelection &nodes,
+           const StateGrid     &grid,
+           StateCache          &cache,
+           const HipChannel    &hip);
+  };
+} // namespace palpate
+
+#endif

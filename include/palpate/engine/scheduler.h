@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_engine_scheduler_h
+#define palpate_engine_scheduler_h
+
+#include <palpate/base/utilities.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace palpate
+{
+  /** What the scheduler knows about one grid point. */
+  enum class PointKnowledge : std::uint8_t
+  {
+    /** Nothing computed, nothing under way. */
+    unknown,
+    /** A worker is computing it. */
+    in_progress,
+    /** Computed, and its whole state is held: it can be a source. */
+    source,
+    /** Computed, but its whole state was dropped (force only). */
+    computed,
+    /** A failure point: never retried in this generation. */
+    failed
+  };
+
+  /**
+   * "Compute the state at grid point target, starting from the computed
+   * state at its neighbour source" (incremental staging over the path
+   * source -> target).
+   */
+  struct Task
+  {
+    unsigned int target;
+    unsigned int source;
+    /** Lower is more urgent: the distance (m) of the target from the
+     * HIP's predicted path. */
+    double priority;
+  };
+
+  /**
+   * The scheduling policy: which states to compute next.
+   *
+   * The *cloud* is the set of grid points within the cloud radius R of the
+   * HIP's predicted path, the segment from the HIP to where it will be
+   * after the look-ahead time at its current velocity (with zero velocity
+   * or look-ahead, the paper's sphere around the HIP). Points of the cloud
+   * that are not computed, not failed and not under way are candidates;
+   * each needs a source, an axis neighbour whose state is held (the one
+   * nearest the HIP). The corners of the cell the HIP is in come first
+   * (interaction can start, or go on, as soon as they exist); then
+   * candidates by their distance from the predicted path (ties by grid
+   * number), so that the cells the HIP is about to enter come before the
+   * rest of the cloud. If no point of the cloud can be reached (the HIP
+   * jumped, or outran the computed front), the plan builds a bridge: the
+   * points next to computed ones that are nearest the HIP's path, even
+   * outside the cloud, each nearer to the path than its source (so a
+   * bridge only ever leads toward the cloud, and cloud points walled off
+   * by failure points do not make it grow).
+   *
+   * The class holds no state between calls: the same inputs give the same
+   * plan, which is what the virtual-time tests check.
+   */
+  class Scheduler
+  {
+  public:
+    /** @p cloud_radius (m) and @p look_ahead_time (s). */
+    Scheduler(const StateGrid &grid,
+              const double     cloud_radius,
+              const double     look_ahead_time);
+
+    /**
+     * The most urgent tasks (at most @p max_tasks) for the HIP at @p hip
+     * moving with @p velocity (m/s), given what is known about each point.
+     */
+    std::vector<Task>
+    plan(const Utilities::Point3                           &hip,
+         const Utilities::Point3                           &velocity,
+         const std::function<PointKnowledge(unsigned int)> &knowledge,
+         const unsigned int                                 max_tasks) const;
+
+    /** Whether @p point belongs to the cloud for this HIP and velocity. */
+    bool
+    in_cloud(const unsigned int       point,
+             const Utilities::Point3 &hip,
+             const Utilities::Point3 &velocity) const;
+
+    /** Distance of @p x from the predicted path of the HIP (m). */
+    double
+    distance_to_path(const Utilities::Point3 &x,
+                     const Utilities::Point3 &hip,
+                     const Utilities::Point3 &velocity) const;
+
+  private:
+    const StateGrid &grid;
+    const double     radius, look_ahead;
+  };
+} // namespace palpate
+
+#endif

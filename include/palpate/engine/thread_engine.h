@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_engine_thread_engine_h
+#define palpate_engine_thread_engine_h
+
+#include <palpate/engine/engine.h>
+#include <palpate/scene/parameters.h>
+
+#include <memory>
+
+namespace palpate
+{
+  /**
+   * The precomputation engine on one machine: a scheduler thread (at
+   * Scheduler / Rate) plans tasks with the Scheduler policy into a small
+   * queue, rebuilt at every tick (tasks that left the cloud are dropped);
+   * solver workers, each with its own StateSolver, take tasks from the
+   * queue, compute the state from its source, and publish it (or the
+   * failure point) in the cache. Workers run at a lower scheduling
+   * priority (nice 10) than the haptic thread.
+   */
+  class ThreadEngine : public PrecomputationEngine
+  {
+  public:
+    ThreadEngine(const Mesh                      &mesh,
+                 const NodeSelection             &nodes,
+                 const Parameters::AllParameters &parameters,
+                 const StateGrid                 &grid,
+                 StateCache                      &cache,
+                 const HipChannel                &hip);
+
+    ~ThreadEngine() override;
+
+    void
+    start() override;
+
+    void
+    stop() override;
+
+    bool
+    running() const override;
+
+    void
+    change_parameters(const Parameters::AllParameters &parameters) override;
+
+    bool
+    idle() const override;
+
+    EngineStatistics
+    statistics() const override;
+
+    std::string
+    description() const override;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl;
+  };
+} // namespace palpate
+
+#endif
