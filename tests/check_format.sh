@@ -6,7 +6,7 @@ set -u
 clang_format=$1
 cd "$2"
 bad=0
-for f in $(find include source tests benchmarks -name '*.h' -o -name '*.cc' | sort); do
+for f in $(find include source tests benchmarks doc/examples -name '*.h' -o -name '*.cc' | sort); do
   if ! "$clang_format" --dry-run --Werror "$f" >/dev/null 2>&1; then
     echo "not formatted: $f"
     bad=1

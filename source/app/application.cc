@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/app/application.h>
+#include <palpate/app/interaction_run.h>
 #include <palpate/app/scene_report.h>
 #include <palpate/app/static_solve.h>
 #include <palpate/base/exceptions.h>
@@ -41,8 +42,9 @@ namespace palpate
 
     /**
      * Set up a scene (read it, build the mesh, select the nodes), report
-     * it, and solve for the active node's prescribed displacement if it is
-     * not zero or if @p target is given.
+     * it, and do what its Run / Mode says: an interaction, a static solve
+     * for the active node's prescribed displacement, or nothing more. A
+     * given @p target (palpate solve --to) always means a static solve.
      */
     int
     run_scene(const std::string               &filename,
@@ -53,6 +55,14 @@ namespace palpate
       const Mesh          mesh  = Mesh::create(scene);
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
       print_scene_report(out, scene, mesh, nodes);
+      const auto &mode = scene.parameters.run.mode;
+      if (!target && mode == "set-up only")
+        return ExitStatus::success;
+      if (!target && mode == "interaction")
+        {
+          run_interaction(out, scene);
+          return ExitStatus::success;
+        }
       const auto &prescribed = scene.parameters.boundary_conditions.active_node
                                  .prescribed_displacement;
       if (!target && Utilities::norm(prescribed) > 0)

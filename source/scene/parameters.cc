@@ -788,6 +788,13 @@ namespace palpate
                           "Number of solver workers, each computing one "
                           "state at a time with its own FE solver "
                           "(dimensionless).");
+        prm.declare_entry(
+          "Memory budget",
+          "1024",
+          Patterns::Double(1.),
+          "Memory for the whole states kept in the cache (MiB). "
+          "Beyond it, the states farthest from the HIP are "
+          "dropped; their forces stay.");
       }
       prm.leave_subsection();
     }
@@ -799,8 +806,9 @@ namespace palpate
     {
       prm.enter_subsection("Engine");
       {
-        type    = prm.get("Type");
-        workers = prm.get_integer("Workers");
+        type          = prm.get("Type");
+        workers       = prm.get_integer("Workers");
+        memory_budget = prm.get_double("Memory budget");
       }
       prm.leave_subsection();
     }
@@ -827,7 +835,9 @@ namespace palpate
         prm.declare_entry("Speed",
                           "0.01",
                           Patterns::Double(0.),
-                          "Speed of the HIP along the trajectory (m/s).");
+                          "Speed of the HIP (m/s): constant along the "
+                          "straight line and the circle, the root-mean-square "
+                          "speed of the smooth random walk.");
         prm.declare_entry("Duration",
                           "2",
                           Patterns::Double(0.),
@@ -845,9 +855,19 @@ namespace palpate
                           "",
                           Patterns::FileName(),
                           "CSV file of timed positions for Type = replay: "
-                          "columns t (s), x, y, z (m, relative to the rest "
-                          "position). Relative to the scene file's "
-                          "directory.");
+                          "columns t (s), x, y, z (m); a header line and "
+                          "lines starting with # are skipped. Times and "
+                          "positions count from the first row, so a "
+                          "recording in any device clock and frame replays "
+                          "from the rest position at t = 0. Relative to the "
+                          "scene file's directory.");
+        prm.declare_entry("Start",
+                          "after initial cloud",
+                          Patterns::Selection(
+                            "after initial cloud|immediately"),
+                          "When the motion starts: once the initial cloud "
+                          "around the rest position is computed (the "
+                          "paper's protocol), or at once.");
       }
       prm.leave_subsection();
     }
@@ -866,6 +886,7 @@ namespace palpate
         radius    = prm.get_double("Radius");
         seed      = prm.get_integer("Seed");
         file_name = prm.get("File name");
+        start     = prm.get("Start");
       }
       prm.leave_subsection();
     }
@@ -965,8 +986,39 @@ namespace palpate
 
 
     void
+    Run::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Run");
+      {
+        prm.declare_entry("Mode",
+                          "interaction",
+                          Patterns::Selection(
+                            "interaction|static solve|set-up only"),
+                          "What 'palpate SCENE.prm' does after setting the "
+                          "scene up: an interaction with the simulated device "
+                          "(states computed on-line, forces at the haptic "
+                          "rate, a run summary), a static solve to the active "
+                          "node's Prescribed displacement, or nothing more.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Run::parse_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Run");
+      mode = prm.get("Mode");
+      prm.leave_subsection();
+    }
+
+
+
+    void
     AllParameters::declare_parameters(ParameterHandler &prm)
     {
+      Run::declare_parameters(prm);
       Mesh::declare_parameters(prm);
       BoundaryConditions::declare_parameters(prm);
       MaterialModel::declare_parameters(prm);
@@ -986,6 +1038,7 @@ namespace palpate
     void
     AllParameters::parse_parameters(ParameterHandler &prm)
     {
+      run.parse_parameters(prm);
       mesh.parse_parameters(prm);
       boundary_conditions.parse_parameters(prm);
       material_model.parse_parameters(prm);

@@ -12,7 +12,8 @@
 
 namespace
 {
-  const std::string beam = "subsection Mesh\n  set Source = beam\nend\n"
+  const std::string beam = "subsection Run\n  set Mode = set-up only\nend\n"
+                           "subsection Mesh\n  set Source = beam\nend\n"
                            "subsection Boundary conditions\n"
                            "  subsection Fixed nodes\n"
                            "    set Selection = boundary id\n"
@@ -99,6 +100,7 @@ main(int argc, char **argv)
           "  subsection Active node\n    set Point = 0, 0, 0.01\n  end\nend\n");
   scene("an active node inside the body",
         "active-interior.prm",
+        "subsection Run\n  set Mode = set-up only\nend\n"
         "subsection Mesh\n  set Source = beam\nend\n"
         "subsection Boundary conditions\n"
         "  subsection Fixed nodes\n"
@@ -138,6 +140,17 @@ main(int argc, char **argv)
         "  set File name = inverted-liver.msh\n"
         "  set Scale factor = 0.039146\nend\n");
 
+  scene("an engine this version does not have (exit status 3)",
+        "mpi.prm",
+        beam + "subsection Engine\n  set Type = mpi\nend\n"
+               "subsection Run\n  set Mode = interaction\nend\n");
+  write_file("path.csv", "t, x, y, z\n0, 0, 0, 0\n0.1, 0.001, 0\n");
+  scene("a replay trajectory file with a bad line",
+        "replay.prm",
+        beam +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = path.csv\n  end\nend\n"
+          "subsection Run\n  set Mode = interaction\nend\n");
   run("a scene file that does not exist", "no-such-scene.prm");
   run("an unknown option", "--frobnicate");
 }

@@ -241,6 +241,8 @@ namespace palpate
       /** "threads" or "mpi". */
       std::string  type;
       unsigned int workers;
+      /** Memory for whole states in the cache, MiB. */
+      double memory_budget;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
@@ -259,6 +261,8 @@ namespace palpate
       double       radius;
       unsigned int seed;
       std::string  file_name;
+      /** "after initial cloud" or "immediately". */
+      std::string start;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
@@ -297,12 +301,25 @@ namespace palpate
       parse_parameters(dealii::ParameterHandler &prm);
     };
 
+    /** `subsection Run`: what `palpate SCENE.prm` does. */
+    struct Run
+    {
+      /** "interaction", "static solve" or "set-up only". */
+      std::string mode;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+    };
+
     /**
      * All parameters of a scene (step-44's AllParameters). The single
      * place where the top-level subsections are declared and parsed.
      */
     struct AllParameters
     {
+      Run                run;
       Mesh               mesh;
       BoundaryConditions boundary_conditions;
       MaterialModel      material_model;

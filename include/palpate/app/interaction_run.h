@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_app_interaction_run_h
+#define palpate_app_interaction_run_h
+
+#include <iosfwd>
+
+namespace palpate
+{
+  class Scene;
+
+  /**
+   * Run a scene's interaction: attach, compute the initial cloud, move the
+   * simulated device along the scene's trajectory with the built-in haptic
+   * loop, report missing-data events as they happen, detach, and print the
+   * run summary (and write it as CSV/JSON, the force log and the shape
+   * frames when the scene asks for them).
+   */
+  void
+  run_interaction(std::ostream &out, const Scene &scene);
+} // namespace palpate
+
+#endif

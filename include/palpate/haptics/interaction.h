@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_haptics_interaction_h
+#define palpate_haptics_interaction_h
+
+#include <palpate/base/utilities.h>
+#include <palpate/haptics/run_summary.h>
+
+#include <iosfwd>
+#include <memory>
+
+namespace palpate
+{
+  class HipChannel;
+  class Mesh;
+  class Scene;
+  class StateCache;
+  class StateGrid;
+  struct NodeSelection;
+
+  namespace Parameters
+  {
+    struct AllParameters;
+  }
+
+  /**
+   * palpate as a library for a haptics application that owns its device
+   * loop (CHAI3D, OpenHaptics, a robot controller):
+   *
+   *   palpate::Interaction interaction(palpate::Scene::read("liver.prm"));
+   *   interaction.attach();                          // start computing
+   *   // in the device's 1 kHz callback:
+   *   const auto f = interaction.force(position);    // never blocks
+   *   ...
+   *   interaction.detach();
+   *
+   * Positions are displacements of the active node from its rest position
+   * (m, in the mesh's frame; a host maps its device frame onto it); forces
+   * are what the device should render (N): the trilinear interpolation of
+   * the states at the 8 corners of the position's grid cell, clamped to
+   * Haptics / Force limit and changing by at most Haptics / Maximum force
+   * change per call. Where a corner is missing (not computed yet, a failure
+   * point, outside the grid, detached) the force fades to zero at that
+   * rate, and the event is counted and reported (poll_events(), summary()).
+   *
+   * force() may be called from exactly one thread at a time. It never
+   * blocks, never allocates and never returns NaN. Everything else is for
+   * the host's other threads.
+   */
+  class Interaction
+  {
+  public:
+    /** Set up the scene: mesh, nodes, state grid, cache, engine (which
+     * builds its solvers). No thread runs yet. */
+    explicit Interaction(const Scene &scene);
+
+    ~Interaction();
+
+    /** Contact: start computing the cloud around the rest position. */
+    void
+    attach();
+
+    /** No contact: stop computing (running tasks finish); force() fades
+     * to zero. Cached states stay. */
+    void
+    detach();
+
+    /** Whether the HIP is attached. */
+    bool
+    attached() const noexcept;
+
+    /**
+     * The force to render for the HIP at @p position (m, relative to the
+     * active node's rest position). Real-time safe.
+     */
+    Utilities::Point3
+    force(const Utilities::Point3 &position) noexcept;
+
+    /** Whether the last force() call found all 8 corners of its cell. */
+    bool
+    data_complete() const noexcept;
+
+    /** Whether the cloud around the attach position has been computed
+     * (latched: stays true once it was). */
+    bool
+    initial_cloud_complete() const;
+
+    /**
+     * Change the material, the fixed nodes, the active node, the effects or
+     * the solver settings: only while detached (std::logic_error
+     * otherwise). Every cached state becomes invalid; none is interpolated
+     * again. The mesh, state space, engine, scheduler and force filter
+     * cannot change (std::invalid_argument naming the subsection); bad
+     * parameters (an InputError, e.g. a region that selects no fixed node)
+     * leave the interaction as it was.
+     */
+    void
+    change_parameters(const Parameters::AllParameters &parameters);
+
+    /** Print one line per missing-data event since the last call; returns
+     * how many. For a non-real-time thread. */
+    unsigned int
+    poll_events(std::ostream &log);
+
+    /** What happened so far (engine and haptic side; no loop timing). */
+    RunSummary
+    summary() const;
+
+    /** The scene, mesh, nodes, grid, cache and HIP channel in use. */
+    const Scene &
+    scene() const;
+    const Mesh &
+    mesh() const;
+    const NodeSelection &
+    nodes() const;
+    const StateGrid &
+    grid() const;
+    const StateCache &
+    cache() const;
+    const HipChannel &
+    hip() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl;
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_haptics_run_summary_h
+#define palpate_haptics_run_summary_h
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace palpate
+{
+  /**
+   * What an interaction did, for the user (print()) and for tools
+   * (write_csv(), write_json(); Output / Summary formats).
+   */
+  struct RunSummary
+  {
+    // Set-up.
+    std::string scene, engine, trajectory;
+
+    // The engine.
+    unsigned int states_computed = 0, states_failed = 0, tasks_dropped = 0,
+                 results_discarded = 0;
+    double median_state_ms = 0, worker_busy_fraction = 0;
+
+    // What the haptic side read.
+    unsigned int  states_used  = 0;
+    std::uint64_t corner_reads = 0, corner_hits = 0;
+    std::uint64_t missing_events    = 0;
+    double        missing_seconds   = 0;
+    std::uint64_t non_finite_forces = 0;
+    double        largest_force = 0, largest_force_change = 0;
+
+    // The built-in haptic loop (zero if the host application ran its own).
+    bool          loop_ran = false, realtime_priority = false;
+    double        loop_rate = 0, motion_start = 0, motion_duration = 0;
+    std::uint64_t ticks = 0, deadline_misses = 0;
+    double        period_p50_ms = 0, period_p99_ms = 0, period_p999_ms = 0,
+           period_max_ms        = 0;
+    double interpolation_p50_us = 0, interpolation_p999_us = 0;
+
+    // Shape output.
+    unsigned int shape_frames = 0;
+
+    /** A human-readable summary. */
+    void
+    print(std::ostream &out) const;
+
+    /** key,value lines. */
+    void
+    write_csv(const std::string &filename) const;
+
+    /** One JSON object. */
+    void
+    write_json(const std::string &filename) const;
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,327 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/haptics/haptic_loop.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/haptics/run_summary.h>
+#include <palpate/haptics/trajectory.h>
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace palpate
+{
+  struct SimulatedDevice::Impl
+  {
+    std::unique_ptr<Trajectory>    trajectory;
+    std::size_t                    capacity, n = 0;
+    std::vector<double>            time;
+    std::vector<Utilities::Point3> position, force;
+    double                         last_t = 0;
+    Utilities::Point3              last_position{{0, 0, 0}};
+  };
+
+
+
+  SimulatedDevice::SimulatedDevice(std::unique_ptr<Trajectory> trajectory,
+                                   const std::size_t           log_capacity)
+    : impl(std::make_unique<Impl>())
+  {
+    impl->trajectory = std::move(trajectory);
+    impl->capacity   = log_capacity;
+    // The force log is allocated here, before the loop, or not at all.
+    impl->time.resize(log_capacity);
+    impl->position.resize(log_capacity);
+    impl->force.resize(log_capacity);
+  }
+
+
+
+  SimulatedDevice::~SimulatedDevice() = default;
+
+
+
+  Utilities::Point3
+  SimulatedDevice::position(const double t) noexcept
+  {
+    impl->last_t = t;
+    impl->last_position =
+      t > 0 ? impl->trajectory->position(t) : Utilities::Point3{{0, 0, 0}};
+    return impl->last_position;
+  }
+
+
+
+  void
+  SimulatedDevice::render(const Utilities::Point3 &force) noexcept
+  {
+    Impl &s = *impl;
+    if (s.n < s.capacity)
+      {
+        s.time[s.n]     = s.last_t;
+        s.position[s.n] = s.last_position;
+        s.force[s.n]    = force;
+        ++s.n;
+      }
+  }
+
+
+
+  std::string
+  SimulatedDevice::description() const
+  {
+    return "simulated device, " + impl->trajectory->description();
+  }
+
+
+
+  double
+  SimulatedDevice::duration() const
+  {
+    return impl->trajectory->duration();
+  }
+
+
+
+  void
+  SimulatedDevice::write_force_log(const std::string &filename) const
+  {
+    std::ofstream out(filename);
+    if (!out)
+      throw std::runtime_error("cannot write '" + filename + "'");
+    out << "t_s,x_m,y_m,z_m,fx_N,fy_N,fz_N\n" << std::setprecision(9);
+    for (std::size_t k = 0; k < impl->n; ++k)
+      out << impl->time[k] << "," << impl->position[k][0] << ","
+          << impl->position[k][1] << "," << impl->position[k][2] << ","
+          << impl->force[k][0] << "," << impl->force[k][1] << ","
+          << impl->force[k][2] << "\n";
+  }
+
+
+
+  struct HapticLoop::Impl
+  {
+    Interaction           &interaction;
+    Device                &device;
+    const double           rate;
+    const std::size_t      capacity;
+    std::vector<double>    period, lateness, interpolation; // seconds
+    std::size_t            n               = 0;
+    std::uint64_t          misses          = 0;
+    bool                   realtime        = false;
+    double                 motion_duration = 0;
+    std::atomic<long long> motion_start_ns{
+      -1};                            // since the loop started; -1: not yet
+    std::atomic<long long> t0_ns{-1}; // the loop's start (CLOCK_MONOTONIC)
+    std::atomic<bool>      done{false}, stop{false};
+    std::thread            thread;
+    double                 motion_started_at = 0;
+
+    Impl(Interaction &i, Device &d, const double r, const double max_seconds)
+      : interaction(i)
+      , device(d)
+      , rate(r)
+      , capacity(static_cast<std::size_t>(max_seconds * r) + 16)
+      , period(capacity)
+      , lateness(capacity)
+      , interpolation(capacity)
+    {}
+
+    void
+    run();
+  };
+
+
+
+  namespace
+  {
+    long long
+    nanoseconds(const timespec &t)
+    {
+      return static_cast<long long>(t.tv_sec) * 1000000000LL + t.tv_nsec;
+    }
+
+    timespec
+    to_timespec(const long long ns)
+    {
+      return {static_cast<time_t>(ns / 1000000000LL),
+              static_cast<long>(ns % 1000000000LL)};
+    }
+  } // namespace
+
+
+
+  void
+  HapticLoop::Impl::run()
+  {
+    // Real-time priority if the system allows it (root, or CAP_SYS_NICE,
+    // or an rtprio limit); otherwise normal priority, and the summary says
+    // so.
+    sched_param parameters{};
+    parameters.sched_priority = 80;
+    realtime =
+      pthread_setschedparam(pthread_self(), SCHED_FIFO, &parameters) == 0;
+
+    // No page fault inside the loop: lock what is mapped now (the solvers
+    // and the statistics arrays were allocated before), touch a stack
+    // reserve, and run the force path once before the first deadline.
+    mlockall(MCL_CURRENT);
+    {
+      volatile char stack[256 * 1024];
+      for (std::size_t i = 0; i < sizeof(stack); i += 4096)
+        stack[i] = 0;
+    }
+    interaction.force(device.position(0));
+
+    const long long period_ns =
+      static_cast<long long>(std::llround(1e9 / rate));
+    timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const long long t0 = nanoseconds(now);
+    t0_ns.store(t0, std::memory_order_release);
+    long long deadline = t0, previous_wake = t0;
+    while (n < capacity && !stop.load(std::memory_order_relaxed))
+      {
+        deadline += period_ns;
+        const timespec next = to_timespec(deadline);
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        const long long wake = nanoseconds(now);
+        lateness[n]          = 1e-9 * (wake - deadline);
+        period[n]            = 1e-9 * (wake - previous_wake);
+        previous_wake        = wake;
+        if (lateness[n] > 0.5e-3)
+          ++misses;
+
+        // The device's clock: the motion starts when told to.
+        const long long start = motion_start_ns.load(std::memory_order_acquire);
+        const double    t     = start < 0 ? 0.0 : 1e-9 * (wake - t0 - start);
+        const Utilities::Point3 x = device.position(t);
+
+        timespec a, b;
+        clock_gettime(CLOCK_MONOTONIC, &a);
+        const Utilities::Point3 f = interaction.force(x);
+        clock_gettime(CLOCK_MONOTONIC, &b);
+        interpolation[n] = 1e-9 * (nanoseconds(b) - nanoseconds(a));
+        device.render(f);
+        ++n;
+
+        if (start >= 0 && t > motion_duration)
+          break;
+      }
+    done.store(true, std::memory_order_release);
+  }
+
+
+
+  HapticLoop::HapticLoop(Interaction &interaction,
+                         Device      &device,
+                         const double rate,
+                         const double max_seconds)
+    : impl(std::make_unique<Impl>(interaction, device, rate, max_seconds))
+  {}
+
+
+
+  HapticLoop::~HapticLoop()
+  {
+    join();
+  }
+
+
+
+  void
+  HapticLoop::start(const double motion_duration)
+  {
+    impl->motion_duration = motion_duration;
+    impl->thread          = std::thread([this] { impl->run(); });
+  }
+
+
+
+  void
+  HapticLoop::start_motion() noexcept
+  {
+    const long long t0 = impl->t0_ns.load(std::memory_order_acquire);
+    if (impl->motion_start_ns.load() >= 0 || t0 < 0)
+      return;
+    timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const long long since_start = nanoseconds(now) - t0;
+    impl->motion_started_at     = 1e-9 * since_start;
+    impl->motion_start_ns.store(since_start, std::memory_order_release);
+  }
+
+
+
+  bool
+  HapticLoop::finished() const noexcept
+  {
+    return impl->done.load(std::memory_order_acquire);
+  }
+
+
+
+  void
+  HapticLoop::join()
+  {
+    impl->stop.store(true);
+    if (impl->thread.joinable())
+      impl->thread.join();
+  }
+
+
+
+  namespace
+  {
+    double
+    percentile(std::vector<double> v, const double q)
+    {
+      if (v.empty())
+        return 0;
+      const std::size_t k =
+        std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()));
+      std::nth_element(v.begin(), v.begin() + k, v.end());
+      return v[k];
+    }
+  } // namespace
+
+
+
+  void
+  HapticLoop::add_to(RunSummary &r) const
+  {
+    const Impl &s = *impl;
+    // The first sample has no previous tick.
+    std::vector<double> period(s.period.begin() + std::min<std::size_t>(1, s.n),
+                               s.period.begin() + s.n);
+    std::vector<double> interpolation(s.interpolation.begin(),
+                                      s.interpolation.begin() + s.n);
+    r.loop_ran              = true;
+    r.realtime_priority     = s.realtime;
+    r.loop_rate             = s.rate;
+    r.ticks                 = s.n;
+    r.deadline_misses       = s.misses;
+    r.period_p50_ms         = 1000 * percentile(period, 0.5);
+    r.period_p99_ms         = 1000 * percentile(period, 0.99);
+    r.period_p999_ms        = 1000 * percentile(period, 0.999);
+    r.period_max_ms         = period.empty() ?
+                                0 :
+                                1000 * *std::max_element(period.begin(), period.end());
+    r.interpolation_p50_us  = 1e6 * percentile(interpolation, 0.5);
+    r.interpolation_p999_us = 1e6 * percentile(interpolation, 0.999);
+    r.motion_start    = s.motion_start_ns.load() < 0 ? 0 : s.motion_started_at;
+    r.motion_duration = s.motion_duration;
+  }
+} // namespace palpate

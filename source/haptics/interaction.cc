@@ -1,0 +1,406 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/engine/engine.h>
+#include <palpate/engine/hip_channel.h>
+#include <palpate/haptics/force_interpolation.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <ostream>
+#include <stdexcept>
+
+namespace palpate
+{
+  using Clock = std::chrono::steady_clock;
+
+  struct Interaction::Impl
+  {
+    explicit Impl(const Scene &s)
+      : scene(s)
+      , mesh(Mesh::create(scene))
+      , nodes(NodeSelection::create(scene, mesh))
+      , grid(scene.parameters.state_space.grid_spacing,
+             scene.parameters.state_space.extent)
+      , cache(grid,
+              static_cast<std::size_t>(scene.parameters.engine.memory_budget *
+                                       1048576.0))
+      , used(new std::atomic<std::uint8_t>[grid.size()])
+      , filter(scene.parameters.haptics.force_limit,
+               scene.parameters.haptics.max_force_change)
+    {
+      for (unsigned int p = 0; p < grid.size(); ++p)
+        used[p].store(0, std::memory_order_relaxed);
+      engine =
+        PrecomputationEngine::create(scene, mesh, nodes, grid, cache, hip);
+    }
+
+    Scene                                        scene;
+    Mesh                                         mesh;
+    NodeSelection                                nodes;
+    StateGrid                                    grid;
+    StateCache                                   cache;
+    HipChannel                                   hip;
+    std::unique_ptr<PrecomputationEngine>        engine;
+    std::unique_ptr<std::atomic<std::uint8_t>[]> used;
+
+    // Real-time state (touched by force() only).
+    ForceFilter       filter;
+    Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
+    Clock::time_point previous_call;
+    bool first_call = true, was_complete = false, in_contact = false;
+
+    // Shared with other threads: atomics only.
+    std::atomic<bool>         is_attached{false}, complete{false}, reset{false};
+    mutable std::atomic<bool> initial_done{false};
+    std::atomic<std::uint64_t> corner_reads{0}, corner_hits{0},
+      missing_events{0}, missing_nanoseconds{0}, non_finite{0};
+    std::atomic<double> largest_force{0}, largest_change{0};
+    std::atomic<double> event_position[3] = {};
+    std::uint64_t       reported_events   = 0;
+    Clock::time_point   attach_time;
+  };
+
+
+
+  Interaction::Interaction(const Scene &scene)
+    : impl(std::make_unique<Impl>(scene))
+  {}
+
+
+
+  Interaction::~Interaction()
+  {
+    detach();
+  }
+
+
+
+  void
+  Interaction::attach()
+  {
+    Impl &s = *impl;
+    if (s.is_attached.load())
+      return;
+    s.hip.write({{0, 0, 0}}, {{0, 0, 0}});
+    s.initial_done.store(false);
+    s.attach_time = Clock::now();
+    s.reset.store(
+      true, std::memory_order_release); // force() restarts its contact logic
+    s.engine->start();
+    s.is_attached.store(true);
+  }
+
+
+
+  void
+  Interaction::detach()
+  {
+    Impl &s = *impl;
+    s.is_attached.store(false);
+    s.engine->stop();
+  }
+
+
+
+  bool
+  Interaction::attached() const noexcept
+  {
+    return impl->is_attached.load(std::memory_order_relaxed);
+  }
+
+
+
+  Utilities::Point3
+  Interaction::force(const Utilities::Point3 &position) noexcept
+  {
+    Impl &s = *impl;
+    if (s.reset.exchange(false, std::memory_order_acq_rel))
+      {
+        s.in_contact   = false;
+        s.was_complete = false;
+      }
+    const auto now = Clock::now();
+    double     dt  = s.first_call ?
+                       0.001 :
+                       std::chrono::duration<double>(now - s.previous_call).count();
+    if (!(dt > 0))
+      dt = 1e-6;
+
+    // A non-finite position is treated as "outside": no force.
+    bool finite = true;
+    for (const double x : position)
+      finite = finite && std::isfinite(x);
+
+    // Velocity for the scheduler's look-ahead: first-order low pass of the
+    // position differences, time constant 20 ms.
+    if (finite)
+      {
+        const double alpha = std::min(1.0, dt / 0.02);
+        for (unsigned int d = 0; d < 3; ++d)
+          {
+            const double v =
+              s.first_call ? 0.0 : (position[d] - s.previous_position[d]) / dt;
+            s.velocity[d] += alpha * (v - s.velocity[d]);
+          }
+        s.hip.write(position, s.velocity);
+        s.previous_position = position;
+      }
+    s.previous_call = now;
+    s.first_call    = false;
+
+    // Trilinear interpolation from the 8 corners, if all are there.
+    const bool  attached = s.is_attached.load(std::memory_order_relaxed);
+    ForceSample sample;
+    if (attached && finite)
+      {
+        sample = interpolate_force(s.grid, s.cache, position);
+        if (sample.hits > 0 || sample.complete)
+          {
+            s.corner_reads.fetch_add(8, std::memory_order_relaxed);
+            s.corner_hits.fetch_add(sample.hits, std::memory_order_relaxed);
+          }
+        if (sample.complete)
+          for (const unsigned int c : sample.corners)
+            s.used[c].store(1, std::memory_order_relaxed);
+      }
+    const bool complete = sample.complete;
+
+    // Missing data while in contact (from the first complete cell after
+    // attaching on): an event when it starts, time while it lasts.
+    if (complete)
+      s.in_contact = true;
+    if (attached && s.in_contact && !complete)
+      {
+        if (s.was_complete)
+          {
+            for (unsigned int d = 0; d < 3; ++d)
+              s.event_position[d].store(finite ? position[d] : 0.0,
+                                        std::memory_order_relaxed);
+            s.missing_events.fetch_add(1, std::memory_order_release);
+          }
+        s.missing_nanoseconds.fetch_add(static_cast<std::uint64_t>(dt * 1e9),
+                                        std::memory_order_relaxed);
+      }
+    s.was_complete = complete;
+    s.complete.store(complete, std::memory_order_relaxed);
+
+    // Never a NaN, never more than the device's limit, never a jump.
+    bool                    rejected;
+    const Utilities::Point3 f = s.filter.next(sample.force, complete, rejected);
+    if (rejected)
+      s.non_finite.fetch_add(1, std::memory_order_relaxed);
+    if (s.filter.change() > s.largest_change.load(std::memory_order_relaxed))
+      s.largest_change.store(s.filter.change(), std::memory_order_relaxed);
+    const double magnitude = Utilities::norm(f);
+    if (magnitude > s.largest_force.load(std::memory_order_relaxed))
+      s.largest_force.store(magnitude, std::memory_order_relaxed);
+    return f;
+  }
+
+
+
+  bool
+  Interaction::data_complete() const noexcept
+  {
+    return impl->complete.load(std::memory_order_relaxed);
+  }
+
+
+
+  bool
+  Interaction::initial_cloud_complete() const
+  {
+    Impl &s = *impl;
+    if (!s.initial_done.load() && s.is_attached.load() && s.engine->idle())
+      s.initial_done.store(true);
+    return s.initial_done.load();
+  }
+
+
+
+  void
+  Interaction::change_parameters(const Parameters::AllParameters &parameters)
+  {
+    Impl &s = *impl;
+    if (s.is_attached.load())
+      throw std::logic_error(
+        "Interaction::change_parameters: detach first (parameters can "
+        "change only while no contact is active)");
+
+    // What the grid, the cache, the mesh and the engine's threads were
+    // built for cannot change here.
+    const Parameters::AllParameters &o = s.scene.parameters;
+    const auto                      &m = o.mesh, &n = parameters.mesh;
+    const char                      *fixed = nullptr;
+    if (m.source != n.source || m.file_name != n.file_name ||
+        m.scale_factor != n.scale_factor || m.beam_length != n.beam_length ||
+        m.beam_width != n.beam_width || m.beam_height != n.beam_height ||
+        m.beam_subdivisions_length != n.beam_subdivisions_length ||
+        m.beam_subdivisions_width != n.beam_subdivisions_width ||
+        m.beam_subdivisions_height != n.beam_subdivisions_height ||
+        m.blob_semi_axes != n.blob_semi_axes ||
+        m.blob_refinements != n.blob_refinements)
+      fixed = "Mesh";
+    else if (o.state_space.grid_spacing !=
+               parameters.state_space.grid_spacing ||
+             o.state_space.extent != parameters.state_space.extent)
+      fixed = "State space";
+    else if (o.engine.type != parameters.engine.type ||
+             o.engine.workers != parameters.engine.workers ||
+             o.engine.memory_budget != parameters.engine.memory_budget)
+      fixed = "Engine";
+    else if (o.scheduler.cloud_radius != parameters.scheduler.cloud_radius ||
+             o.scheduler.rate != parameters.scheduler.rate ||
+             o.scheduler.look_ahead_time !=
+               parameters.scheduler.look_ahead_time)
+      fixed = "Scheduler";
+    else if (o.haptics.force_limit != parameters.haptics.force_limit ||
+             o.haptics.max_force_change != parameters.haptics.max_force_change)
+      fixed = "Haptics";
+    if (fixed != nullptr)
+      throw std::invalid_argument(
+        std::string("Interaction::change_parameters: the subsection '") +
+        fixed +
+        "' cannot change during an interaction (the mesh, state grid, cache, "
+        "engine and force filter are built for it). Change only the "
+        "material, the boundary conditions, the effects or the solver "
+        "settings, or create a new Interaction from the changed scene.");
+
+    // Check the new scene and select its nodes before anything changes, so
+    // that bad parameters leave the interaction as it was.
+    Scene changed      = s.scene;
+    changed.parameters = parameters;
+    changed.validate();
+    NodeSelection nodes = NodeSelection::create(changed, s.mesh);
+
+    s.scene = std::move(changed);
+    s.nodes = std::move(nodes); // the engine's solvers refer to s.nodes
+    s.engine->change_parameters(parameters);
+  }
+
+
+
+  unsigned int
+  Interaction::poll_events(std::ostream &log)
+  {
+    Impl               &s = *impl;
+    const std::uint64_t events =
+      s.missing_events.load(std::memory_order_acquire);
+    if (events == s.reported_events)
+      return 0;
+    const unsigned int n = events - s.reported_events;
+    s.reported_events    = events;
+    Utilities::Point3 p;
+    for (unsigned int d = 0; d < 3; ++d)
+      p[d] = s.event_position[d].load(std::memory_order_relaxed);
+    const double t =
+      std::chrono::duration<double>(Clock::now() - s.attach_time).count();
+    log << "palpate: missing data at t = " << Utilities::to_string(t, 4)
+        << " s, HIP at (" << Utilities::to_string(p, 3)
+        << ") m: the force fades to zero until the cell's states "
+        << "are computed"
+        << (n > 1 ? " (" + std::to_string(n) + " events)" : "") << std::endl;
+    return n;
+  }
+
+
+
+  RunSummary
+  Interaction::summary() const
+  {
+    const Impl &s = *impl;
+    RunSummary  r;
+    r.scene                  = s.scene.file();
+    r.engine                 = s.engine->description();
+    const EngineStatistics e = s.engine->statistics();
+    r.states_computed        = e.computed;
+    r.states_failed          = e.failed;
+    r.tasks_dropped          = e.dropped;
+    r.results_discarded      = e.discarded;
+    std::vector<double> times;
+    double              span = 0;
+    for (const auto &t : e.tasks)
+      {
+        if (t.converged)
+          times.push_back(1000 * t.duration);
+        span = std::max(span, t.start + t.duration);
+      }
+    if (!times.empty())
+      {
+        std::nth_element(times.begin(),
+                         times.begin() + times.size() / 2,
+                         times.end());
+        r.median_state_ms = times[times.size() / 2];
+      }
+    const unsigned int workers =
+      std::max(1u, s.scene.parameters.engine.workers);
+    r.worker_busy_fraction = span > 0 ? e.busy_time / (span * workers) : 0;
+    for (unsigned int p = 0; p < s.grid.size(); ++p)
+      r.states_used += s.used[p].load(std::memory_order_relaxed);
+    r.corner_reads         = s.corner_reads.load();
+    r.corner_hits          = s.corner_hits.load();
+    r.missing_events       = s.missing_events.load();
+    r.missing_seconds      = 1e-9 * s.missing_nanoseconds.load();
+    r.non_finite_forces    = s.non_finite.load();
+    r.largest_force        = s.largest_force.load();
+    r.largest_force_change = s.largest_change.load();
+    return r;
+  }
+
+
+
+  const Scene &
+  Interaction::scene() const
+  {
+    return impl->scene;
+  }
+
+
+
+  const Mesh &
+  Interaction::mesh() const
+  {
+    return impl->mesh;
+  }
+
+
+
+  const NodeSelection &
+  Interaction::nodes() const
+  {
+    return impl->nodes;
+  }
+
+
+
+  const StateGrid &
+  Interaction::grid() const
+  {
+    return impl->grid;
+  }
+
+
+
+  const StateCache &
+  Interaction::cache() const
+  {
+    return impl->cache;
+  }
+
+
+
+  const HipChannel &
+  Interaction::hip() const
+  {
+    return impl->hip;
+  }
+} // namespace palpate

@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/engine/hip_channel.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/haptics/shape_interpolator.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/scene/scene.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <deal.II/base/data_out_base.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+namespace palpate
+{
+  struct ShapeInterpolator::Impl
+  {
+    Impl(const Interaction &i,
+         const double       r,
+         const std::string &d,
+         const std::string &s)
+      : interaction(i)
+      , rate(r)
+      , directory(d)
+      , stem(s)
+      , system(i.mesh(), i.nodes(), i.scene().parameters)
+    {}
+
+    void
+    run();
+
+    const Interaction        &interaction;
+    const double              rate;
+    const std::string         directory, stem;
+    HyperelasticSystem        system; // for the FE space and VTU output
+    std::atomic<bool>         running{false};
+    std::atomic<unsigned int> written{0}, skipped{0};
+    std::vector<std::pair<double, std::string>> records;
+    std::thread                                 thread;
+  };
+
+
+
+  void
+  ShapeInterpolator::Impl::run()
+  {
+    using Clock        = std::chrono::steady_clock;
+    const auto  t0     = Clock::now();
+    const auto  period = std::chrono::duration<double>(1.0 / rate);
+    auto        next   = t0;
+    const auto &grid   = interaction.grid();
+    while (running.load())
+      {
+        next += std::chrono::duration_cast<Clock::duration>(period);
+        std::this_thread::sleep_until(next);
+
+        Utilities::Point3 x, v;
+        interaction.hip().read(x, v);
+        GridIndex             lower;
+        std::array<double, 3> local;
+        if (!grid.locate(x, lower, local))
+          {
+            ++skipped;
+            continue;
+          }
+        const auto                   corners = grid.corners(lower);
+        const auto                   w       = trilinear_weights(local);
+        std::shared_ptr<const State> states[8];
+        bool                         complete = true;
+        for (unsigned int k = 0; k < 8 && complete; ++k)
+          {
+            states[k] = interaction.cache().state(corners[k]);
+            complete  = states[k] != nullptr;
+          }
+        if (!complete)
+          {
+            ++skipped;
+            continue;
+          }
+        // The blended state: displacement (and pressure), multipliers.
+        State blend               = *states[0];
+        blend.active_displacement = x;
+        for (double &u : blend.solution)
+          u = 0;
+        for (double &m : blend.multipliers)
+          m = 0;
+        blend.force = {{0, 0, 0}};
+        for (unsigned int k = 0; k < 8; ++k)
+          {
+            for (std::size_t i = 0; i < blend.solution.size(); ++i)
+              blend.solution[i] += w[k] * states[k]->solution[i];
+            for (std::size_t i = 0; i < blend.multipliers.size(); ++i)
+              blend.multipliers[i] += w[k] * states[k]->multipliers[i];
+            for (unsigned int d = 0; d < 3; ++d)
+              blend.force[d] += w[k] * states[k]->force[d];
+          }
+        char name[64];
+        std::snprintf(name, sizeof(name), "-shape-%05u.vtu", written.load());
+        const std::string file = stem + name;
+        system.write_vtu(blend, directory + "/" + file);
+        records.emplace_back(
+          std::chrono::duration<double>(Clock::now() - t0).count(), file);
+        ++written;
+      }
+  }
+
+
+
+  ShapeInterpolator::ShapeInterpolator(const Interaction &interaction,
+                                       const double       rate,
+                                       const std::string &directory,
+                                       const std::string &stem)
+    : impl(std::make_unique<Impl>(interaction, rate, directory, stem))
+  {}
+
+
+
+  ShapeInterpolator::~ShapeInterpolator()
+  {
+    stop();
+  }
+
+
+
+  void
+  ShapeInterpolator::start()
+  {
+    std::filesystem::create_directories(impl->directory);
+    impl->running.store(true);
+    impl->thread = std::thread([this] { impl->run(); });
+  }
+
+
+
+  void
+  ShapeInterpolator::stop()
+  {
+    if (!impl->running.exchange(false))
+      return;
+    impl->thread.join();
+    std::ofstream pvd(impl->directory + "/" + impl->stem + "-shape.pvd");
+    dealii::DataOutBase::write_pvd_record(pvd, impl->records);
+  }
+
+
+
+  std::pair<unsigned int, unsigned int>
+  ShapeInterpolator::frames() const
+  {
+    return {impl->written.load(), impl->skipped.load()};
+  }
+} // namespace palpate

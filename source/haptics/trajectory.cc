@@ -1,0 +1,287 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/exceptions.h>
+#include <palpate/haptics/trajectory.h>
+#include <palpate/scene/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace palpate
+{
+  namespace
+  {
+    Utilities::Point3
+    normalized(const Utilities::Point3 &v)
+    {
+      const double n = Utilities::norm(v);
+      return {{v[0] / n, v[1] / n, v[2] / n}};
+    }
+  } // namespace
+
+
+
+  StraightLine::StraightLine(const Utilities::Point3 &direction,
+                             const double             speed,
+                             const double             duration)
+    : d(normalized(direction))
+    , speed(speed)
+    , length(duration)
+  {}
+
+
+
+  Utilities::Point3
+  StraightLine::position(const double t) const noexcept
+  {
+    const double s = speed * std::clamp(t, 0.0, length);
+    return {{s * d[0], s * d[1], s * d[2]}};
+  }
+
+
+
+  std::string
+  StraightLine::description() const
+  {
+    return "straight line along (" + Utilities::to_string(d, 3) + ") at " +
+           Utilities::to_string(1000 * speed, 4) + " mm/s for " +
+           Utilities::to_string(length, 3) + " s";
+  }
+
+
+
+  Circle::Circle(const Utilities::Point3 &normal,
+                 const double             radius,
+                 const double             speed,
+                 const double             duration)
+    : radius(radius)
+    , omega(speed / radius)
+    , length(duration)
+  {
+    const Utilities::Point3 n = normalized(normal);
+    // Any unit vector normal to n, then the third by the cross product.
+    const Utilities::Point3 a  = std::abs(n[0]) < 0.9 ?
+                                   Utilities::Point3{{1, 0, 0}} :
+                                   Utilities::Point3{{0, 1, 0}};
+    const double            an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+    e1 = normalized({{a[0] - an * n[0], a[1] - an * n[1], a[2] - an * n[2]}});
+    e2 = {{n[1] * e1[2] - n[2] * e1[1],
+           n[2] * e1[0] - n[0] * e1[2],
+           n[0] * e1[1] - n[1] * e1[0]}};
+  }
+
+
+
+  Utilities::Point3
+  Circle::position(const double t) const noexcept
+  {
+    const double phi = omega * std::clamp(t, 0.0, length);
+    const double c = radius * (std::cos(phi) - 1), s = radius * std::sin(phi);
+    return {
+      {c * e1[0] + s * e2[0], c * e1[1] + s * e2[1], c * e1[2] + s * e2[2]}};
+  }
+
+
+
+  std::string
+  Circle::description() const
+  {
+    return "circle of radius " + Utilities::to_string(1000 * radius, 4) +
+           " mm at " + Utilities::to_string(1000 * omega * radius, 4) +
+           " mm/s for " + Utilities::to_string(length, 3) + " s";
+  }
+
+
+
+  SmoothRandom::SmoothRandom(const double       radius,
+                             const double       speed,
+                             const double       duration,
+                             const unsigned int seed)
+    : length(duration)
+    , radius(radius)
+    , speed(speed)
+    , seed(seed)
+  {
+    std::mt19937                           random(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    // Per axis, |sum_k a_k (sin(w_k t + phi_k) - sin(phi_k))| <= 2 sum_k
+    // a_k <= radius / sqrt(3), so |p| <= radius. Frequencies are random
+    // within a factor 3 of each other, then scaled together so that the
+    // root-mean-square speed, sqrt(sum (a w)^2 / 2), is the given speed.
+    double mean_square = 0;
+    for (unsigned int d = 0; d < 3; ++d)
+      for (unsigned int k = 0; k < 3; ++k)
+        {
+          amplitude[d][k] =
+            radius / (6 * std::sqrt(3.0)) * (0.5 + 0.5 * u(random));
+          frequency[d][k] = 1 + 2 * u(random);
+          phase[d][k]     = 2 * M_PI * u(random);
+          mean_square += 0.5 * std::pow(amplitude[d][k] * frequency[d][k], 2);
+        }
+    const double scale = speed / std::sqrt(mean_square);
+    for (auto &axis : frequency)
+      for (double &w : axis)
+        w *= scale;
+  }
+
+
+
+  Utilities::Point3
+  SmoothRandom::position(const double t) const noexcept
+  {
+    const double      s = std::clamp(t, 0.0, length);
+    Utilities::Point3 p{{0, 0, 0}};
+    for (unsigned int d = 0; d < 3; ++d)
+      for (unsigned int k = 0; k < 3; ++k)
+        p[d] += amplitude[d][k] * (std::sin(frequency[d][k] * s + phase[d][k]) -
+                                   std::sin(phase[d][k]));
+    return p;
+  }
+
+
+
+  std::string
+  SmoothRandom::description() const
+  {
+    return "smooth random motion within " +
+           Utilities::to_string(1000 * radius, 4) + " mm, RMS speed " +
+           Utilities::to_string(1000 * speed, 4) + " mm/s, seed " +
+           std::to_string(seed) + ", for " + Utilities::to_string(length, 3) +
+           " s";
+  }
+
+
+
+  Replay::Replay(const std::string &filename)
+    : file(filename)
+  {
+    std::ifstream in(filename);
+    if (!in)
+      throw InputError(
+        filename,
+        0,
+        "trajectory replay (Haptics / Trajectory / File name)",
+        "the file cannot be opened",
+        "check Haptics / Trajectory / File name (relative to the scene "
+        "file's directory).");
+    std::string  line;
+    unsigned int number = 0;
+    while (std::getline(in, line))
+      {
+        ++number;
+        const std::string t = Utilities::trim(line);
+        if (t.empty() || t[0] == '#' ||
+            std::isalpha(static_cast<unsigned char>(t[0])))
+          continue; // comments and a header line
+        const auto pieces = Utilities::split(t, ',');
+        double     v[4];
+        bool       ok = pieces.size() == 4;
+        for (unsigned int k = 0; ok && k < 4; ++k)
+          {
+            std::size_t used = 0;
+            try
+              {
+                v[k] = std::stod(pieces[k], &used);
+              }
+            catch (const std::exception &)
+              {
+                used = 0;
+              }
+            ok = used == pieces[k].size() && std::isfinite(v[k]);
+          }
+        if (!ok)
+          throw InputError(
+            filename,
+            number,
+            "trajectory replay (Haptics / Trajectory / File name)",
+            "the line is not four numbers t, x, y, z",
+            "write one timed position per line: t (s), x, y, z (m).");
+        if (!times.empty() && !(v[0] > times.back()))
+          throw InputError(
+            filename,
+            number,
+            "trajectory replay (Haptics / Trajectory / File name)",
+            "the times do not increase",
+            "sort the lines by time; each time must be later than the last.");
+        times.push_back(v[0]);
+        points.push_back({{v[1], v[2], v[3]}});
+      }
+    if (times.empty())
+      throw InputError(
+        filename,
+        0,
+        "trajectory replay (Haptics / Trajectory / File name)",
+        "the file holds no positions",
+        "write one timed position per line: t (s), x, y, z (m).");
+
+    // Count from the first row: the replay starts at rest at t = 0.
+    const double            t0 = times.front();
+    const Utilities::Point3 x0 = points.front();
+    for (std::size_t k = 0; k < times.size(); ++k)
+      {
+        times[k] -= t0;
+        for (unsigned int d = 0; d < 3; ++d)
+          points[k][d] -= x0[d];
+      }
+  }
+
+
+
+  Utilities::Point3
+  Replay::position(const double t) const noexcept
+  {
+    if (t <= times.front())
+      return points.front();
+    if (t >= times.back())
+      return points.back();
+    const std::size_t k =
+      std::upper_bound(times.begin(), times.end(), t) - times.begin();
+    const double      s = (t - times[k - 1]) / (times[k] - times[k - 1]);
+    Utilities::Point3 p;
+    for (unsigned int d = 0; d < 3; ++d)
+      p[d] = points[k - 1][d] + s * (points[k][d] - points[k - 1][d]);
+    return p;
+  }
+
+
+
+  double
+  Replay::duration() const noexcept
+  {
+    return times.back();
+  }
+
+
+
+  std::string
+  Replay::description() const
+  {
+    return "replay of " + std::to_string(times.size()) + " positions from '" +
+           file + "' (" + Utilities::to_string(times.back(), 4) + " s)";
+  }
+
+
+
+  std::unique_ptr<Trajectory>
+  Trajectory::create(const Scene &scene)
+  {
+    const auto &t = scene.parameters.haptics.trajectory;
+    if (t.type == "straight line")
+      return std::make_unique<StraightLine>(t.direction, t.speed, t.duration);
+    if (t.type == "circle")
+      return std::make_unique<Circle>(t.direction,
+                                      t.radius,
+                                      t.speed,
+                                      t.duration);
+    if (t.type == "smooth random")
+      return std::make_unique<SmoothRandom>(t.radius,
+                                            t.speed,
+                                            t.duration,
+                                            t.seed);
+    return std::make_unique<Replay>(scene.resolve_path(t.file_name));
+  }
+} // namespace palpate

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// A short real run of the whole chain, as `palpate scene.prm` does it: the
+// beam scene, 2 solver threads, the built-in 1 kHz haptic loop, a simulated
+// device on a 3 mm circle at 5 mm/s for 1.5 s after the initial cloud,
+// shape output at 30 Hz, force log and CSV/JSON summaries. Wall-clock
+// times vary, so the test checks counts and bounds, not seconds:
+// - the loop ran for (motion start + motion) x rate ticks, within 10 %;
+// - no non-finite force, no force change above the scene's limit, in the
+//   summary and in every row of the force log;
+// - states were computed and used, no missing-data event (the HIP is slow
+//   for this scene), fewer than 5 % of the ticks late;
+// - the summary files and the shape frames (PVD + one VTU per frame) exist.
+
+#include <palpate/app/interaction_run.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "../tests.h"
+
+namespace
+{
+  /** The key,value lines of a run summary CSV. */
+  std::map<std::string, std::string>
+  read_summary(const std::string &file)
+  {
+    std::map<std::string, std::string> values;
+    std::ifstream                      in(file);
+    std::string                        line;
+    std::getline(in, line); // header
+    while (std::getline(in, line))
+      {
+        const auto  comma = line.find(',');
+        std::string value = line.substr(comma + 1);
+        if (value.size() >= 2 && value.front() == '"')
+          value = value.substr(1, value.size() - 2);
+        values[line.substr(0, comma)] = value;
+      }
+    return values;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  std::ifstream     beam(palpate_source_dir + "/parameters/beam.prm");
+  std::stringstream text;
+  text << beam.rdbuf();
+  text << R"(
+subsection Material model
+  subsection St.Venant-Kirchhoff
+    set Young's modulus = 1e6
+  end
+end
+subsection Effects
+  set Shape output      = true
+  set Shape output rate = 30
+  set Force log         = true
+end
+subsection State space
+  set Grid spacing = 0.002
+  set Extent       = 0.01
+end
+subsection Scheduler
+  set Cloud radius = 0.005
+end
+subsection Engine
+  set Workers = 2
+end
+subsection Haptics
+  set Loop rate               = 1000
+  set Force limit             = 5
+  set Maximum force change    = 0.01
+  subsection Trajectory
+    set Type      = circle
+    set Direction = 0, 1, 0
+    set Radius    = 0.003
+    set Speed     = 0.005
+    set Duration  = 1.5
+  end
+end
+subsection Output
+  set Directory       = realtime-output
+  set Summary formats = csv, json
+end
+)";
+  write_file("realtime.prm", text.str());
+  std::filesystem::remove_all("realtime-output");
+
+  std::ostringstream report;
+  palpate::run_interaction(report, palpate::Scene::read("realtime.prm"));
+  const bool events_logged =
+    report.str().find("missing data at") != std::string::npos;
+
+  auto       s      = read_summary("realtime-output/realtime-summary.csv");
+  const auto number = [&](const std::string &key) {
+    return std::stod(s.at(key));
+  };
+  const double rate = number("loop_rate_Hz");
+  const double expected =
+    (number("motion_start_s") + number("motion_duration_s")) * rate;
+  const double ticks = number("ticks");
+  deallog << "loop ran: " << s["loop_ran"]
+          << "; ticks / ((motion start + motion) x rate) within "
+          << "10 %: " << (std::abs(ticks / expected - 1) < 0.1 ? "yes" : "NO")
+          << "; motion lasted " << number("motion_duration_s") << " s"
+          << std::endl;
+  deallog << "states computed > 0: "
+          << (number("states_computed") > 0 ? "yes" : "NO")
+          << ", states used >= 8: "
+          << (number("states_used") >= 8 ? "yes" : "NO")
+          << ", failure points: " << s["states_failed"] << std::endl;
+  deallog << "missing-data events: " << s["missing_data_events"]
+          << ", logged: " << (events_logged ? "yes" : "no") << std::endl;
+  deallog << "non-finite forces: " << s["non_finite_forces"]
+          << ", largest change per tick <= 0.01 N: "
+          << (number("largest_force_change_N") <= 0.01 + 1e-12 ? "yes" : "NO")
+          << ", largest force > 0: "
+          << (number("largest_force_N") > 0 ? "yes" : "NO") << std::endl;
+  deallog << "deadline misses below 5 % of the ticks: "
+          << (number("deadline_misses") < 0.05 * ticks ? "yes" : "NO")
+          << std::endl;
+  deallog << "interpolation time measured: "
+          << (number("interpolation_p50_us") > 0 &&
+                  number("interpolation_p999_us") >=
+                    number("interpolation_p50_us") ?
+                "yes" :
+                "NO")
+          << std::endl;
+
+  // The force log: one row per tick, finite, changing by at most 0.01 N.
+  std::ifstream log("realtime-output/realtime-forces.csv");
+  std::string   line;
+  std::getline(log, line);
+  deallog << "force log header: " << line << std::endl;
+  unsigned int rows   = 0;
+  bool         finite = true, smooth = true;
+  double       previous[3] = {0, 0, 0};
+  while (std::getline(log, line))
+    {
+      double             v[7];
+      char               comma;
+      std::istringstream in(line);
+      in >> v[0];
+      for (unsigned int k = 1; k < 7; ++k)
+        in >> comma >> v[k];
+      for (unsigned int k = 0; k < 7; ++k)
+        finite = finite && std::isfinite(v[k]);
+      const double change = std::sqrt(std::pow(v[4] - previous[0], 2) +
+                                      std::pow(v[5] - previous[1], 2) +
+                                      std::pow(v[6] - previous[2], 2));
+      smooth = smooth && change <= 0.01 + 1e-7; // the log has 9 digits
+      for (unsigned int d = 0; d < 3; ++d)
+        previous[d] = v[4 + d];
+      ++rows;
+    }
+  deallog << "force log: one row per tick: " << (rows == ticks ? "yes" : "NO")
+          << ", all finite: " << (finite ? "yes" : "NO")
+          << ", change per row <= 0.01 N: " << (smooth ? "yes" : "NO")
+          << std::endl;
+
+  // The shape frames.
+  const unsigned int frames = static_cast<unsigned int>(number("shape_frames"));
+  unsigned int       vtus   = 0;
+  for (const auto &entry :
+       std::filesystem::directory_iterator("realtime-output"))
+    vtus += entry.path().extension() == ".vtu";
+  std::ifstream pvd("realtime-output/realtime-shape.pvd");
+  std::string   pvd_text((std::istreambuf_iterator<char>(pvd)),
+                       std::istreambuf_iterator<char>());
+  unsigned int  datasets = 0;
+  for (std::size_t at = pvd_text.find("<DataSet"); at != std::string::npos;
+       at             = pvd_text.find("<DataSet", at + 1))
+    ++datasets;
+  deallog << "shape frames: " << (frames > 0 ? "some" : "NONE")
+          << ", one VTU each: " << (vtus == frames ? "yes" : "NO")
+          << ", all in the PVD: " << (datasets == frames ? "yes" : "NO")
+          << std::endl;
+  deallog << "JSON summary written: "
+          << (std::filesystem::exists("realtime-output/realtime-summary.json") ?
+                "yes" :
+                "NO")
+          << std::endl;
+}
