@@ -35,7 +35,8 @@ namespace palpate
     SimulatedDevice device(std::move(trajectory),
                            p.effects.force_log ?
                              static_cast<std::size_t>(max_seconds *
-                                                      p.haptics.loop_rate) :
+                                                      p.haptics.loop_rate) +
+                               16 : // as many as the loop's ticks
                              0);
 
     out << "\nInteraction\n"

@@ -54,26 +54,26 @@ namespace palpate
   Scheduler::plan(const Utilities::Point3                           &hip,
                   const Utilities::Point3                           &velocity,
                   const std::function<PointKnowledge(unsigned int)> &knowledge,
-                  const unsigned int max_tasks) const
+                  const unsigned int                                 max_tasks,
+                  const bool allow_bridge) const
   {
     std::vector<Task> candidates;
     if (max_tasks == 0)
       return candidates;
 
-    // The grid box around the path, widened by the radius.
-    const double h = grid.spacing();
+    // The grid box around the path, widened by the radius (clamped in
+    // floating point before the conversion: the host controls the HIP).
+    const double h = grid.spacing(), n = grid.half_width();
     GridIndex    low, high;
     for (unsigned int k = 0; k < 3; ++k)
       {
         const double a = hip[k], b = hip[k] + look_ahead * velocity[k];
         if (!std::isfinite(a) || !std::isfinite(b))
           return candidates;
-        low[k] =
-          std::max(-grid.half_width(),
-                   static_cast<int>(std::floor((std::min(a, b) - radius) / h)));
-        high[k] =
-          std::min(grid.half_width(),
-                   static_cast<int>(std::ceil((std::max(a, b) + radius) / h)));
+        low[k] = static_cast<int>(
+          std::clamp(std::floor((std::min(a, b) - radius) / h), -n, n));
+        high[k] = static_cast<int>(
+          std::clamp(std::ceil((std::max(a, b) + radius) / h), -n, n));
       }
 
     // The cell the HIP is in: its corners come before everything else.
@@ -88,83 +88,114 @@ namespace palpate
 
     static const int axis[6][3] = {
       {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const auto distance = [&](const unsigned int p) {
+      return distance_to_path(grid.position(p), hip, velocity);
+    };
+    // The axis neighbour of g with a held state nearest the HIP (ties: the
+    // lower grid number), among those accepted by @p admissible; -1 if none.
+    const auto find_source = [&](const GridIndex &g, const auto &admissible) {
+      int    source = -1;
+      double best   = 0;
+      for (const auto &a : axis)
+        {
+          const GridIndex n{{g[0] + a[0], g[1] + a[1], g[2] + a[2]}};
+          if (!grid.contains(n))
+            continue;
+          const unsigned int q = grid.linear(n);
+          if (knowledge(q) != PointKnowledge::source || !admissible(q))
+            continue;
+          const double d = Utilities::distance(grid.position(n), hip);
+          if (source < 0 || d < best || (d == best && q < unsigned(source)))
+            source = q, best = d;
+        }
+      return source;
+    };
+    // Whether g has an unknown axis neighbour accepted by @p wanted.
+    const auto leads_to = [&](const GridIndex &g, const auto &wanted) {
+      for (const auto &a : axis)
+        {
+          const GridIndex n{{g[0] + a[0], g[1] + a[1], g[2] + a[2]}};
+          if (grid.contains(n) &&
+              knowledge(grid.linear(n)) == PointKnowledge::unknown &&
+              wanted(grid.linear(n)))
+            return true;
+        }
+      return false;
+    };
+    const auto any = [](const unsigned int) { return true; };
+
+    // The cloud: unknown points, and points whose whole state was dropped
+    // (memory budget) where the cloud needs it again as a source.
+    unsigned int unreached = 0, under_way = 0;
     for (int k = low[2]; k <= high[2]; ++k)
       for (int j = low[1]; j <= high[1]; ++j)
         for (int i = low[0]; i <= high[0]; ++i)
           {
-            const GridIndex    g{{i, j, k}};
-            const unsigned int p = grid.linear(g);
-            if (knowledge(p) != PointKnowledge::unknown)
+            const GridIndex      g{{i, j, k}};
+            const unsigned int   p     = grid.linear(g);
+            const PointKnowledge known = knowledge(p);
+            if (known != PointKnowledge::unknown &&
+                known != PointKnowledge::computed &&
+                known != PointKnowledge::in_progress)
               continue;
-            const double distance =
-              distance_to_path(grid.position(g), hip, velocity);
-            if (distance > radius)
+            const double d = distance(p);
+            if (d > radius)
               continue;
-            // Source: the axis neighbour with a held state nearest the HIP.
-            int    source = -1;
-            double best   = 0;
-            for (const auto &a : axis)
+            if (known == PointKnowledge::in_progress)
               {
-                const GridIndex n{{i + a[0], j + a[1], k + a[2]}};
-                if (!grid.contains(n))
-                  continue;
-                const unsigned int q = grid.linear(n);
-                if (knowledge(q) != PointKnowledge::source)
-                  continue;
-                const double d = Utilities::distance(grid.position(n), hip);
-                if (source < 0 || d < best - 1e-15 ||
-                    (std::abs(d - best) <= 1e-15 && q < unsigned(source)))
-                  source = q, best = d;
+                ++under_way;
+                continue;
               }
+            if (known == PointKnowledge::computed &&
+                !leads_to(g, [&](const unsigned int q) {
+                  return distance(q) <= radius;
+                }))
+              continue;
+            const int source = find_source(g, any);
             if (source >= 0)
               candidates.push_back(
-                {p,
-                 static_cast<unsigned int>(source),
-                 in_current_cell(g) ? distance - 1.0 : distance});
+                {p, static_cast<unsigned int>(source), d, in_current_cell(g)});
+            else if (known == PointKnowledge::unknown)
+              ++unreached;
           }
 
-    // Nothing in the cloud can be reached from what is computed (the HIP
-    // jumped, or outran the computed front): build a bridge, the frontier
-    // points (unknown, next to a held state) nearest the HIP's path.
-    if (candidates.empty())
+    // Points of the cloud are unknown, none can be reached from what is
+    // held and none is under way (the HIP jumped, or outran the computed
+    // front): build a bridge, points next to held states that are nearer
+    // to the HIP's path than their source, even outside the cloud. Only
+    // steps toward the path: a bridge ends where the cloud begins, and
+    // cloud points walled off by failure points do not make it grow.
+    if (allow_bridge && candidates.empty() && unreached > 0 && under_way == 0)
       for (unsigned int p = 0; p < grid.size(); ++p)
         {
-          if (knowledge(p) != PointKnowledge::unknown)
+          const PointKnowledge known = knowledge(p);
+          if (known != PointKnowledge::unknown &&
+              known != PointKnowledge::computed)
             continue;
-          const GridIndex g      = grid.index(p);
-          int             source = -1;
-          double          best   = 0;
-          for (const auto &a : axis)
-            {
-              const GridIndex n{{g[0] + a[0], g[1] + a[1], g[2] + a[2]}};
-              if (!grid.contains(n))
-                continue;
-              const unsigned int q = grid.linear(n);
-              if (knowledge(q) != PointKnowledge::source)
-                continue;
-              const double d = Utilities::distance(grid.position(n), hip);
-              if (source < 0 || d < best - 1e-15 ||
-                  (std::abs(d - best) <= 1e-15 && q < unsigned(source)))
-                source = q, best = d;
-            }
-          // Only steps toward the path: a bridge ends where the cloud
-          // begins, and points the cloud cannot reach because failure
-          // points wall them off do not make it grow without bound.
-          const double distance =
-            distance_to_path(grid.position(g), hip, velocity);
-          if (source >= 0 &&
-              distance < distance_to_path(grid.position(
-                                            static_cast<unsigned int>(source)),
-                                          hip,
-                                          velocity) -
-                           1e-12)
-            candidates.push_back(
-              {p, static_cast<unsigned int>(source), distance});
+          const GridIndex g = grid.index(p);
+          const double    d = distance(p);
+          if (known == PointKnowledge::computed &&
+              !leads_to(g, [&](const unsigned int q) {
+                return distance(q) < d - 1e-12;
+              }))
+            continue;
+          const int source = find_source(g, [&](const unsigned int q) {
+            return d < distance(q) - 1e-12;
+          });
+          if (source >= 0)
+            candidates.push_back({p, static_cast<unsigned int>(source), d});
         }
 
+    // Most urgent first: the HIP's cell, then the distance from the path
+    // (to the nanometre, so that the order is a strict weak ordering and
+    // does not depend on round-off), then the grid number.
     const auto order = [](const Task &a, const Task &b) {
-      if (std::abs(a.priority - b.priority) > 1e-12)
-        return a.priority < b.priority;
+      if (a.corner != b.corner)
+        return a.corner;
+      const long long da = std::llround(a.priority * 1e9),
+                      db = std::llround(b.priority * 1e9);
+      if (da != db)
+        return da < db;
       return a.target < b.target;
     };
     if (candidates.size() > max_tasks)

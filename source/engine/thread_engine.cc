@@ -47,16 +47,18 @@ namespace palpate
       , scheduler(grid, p.scheduler.cloud_radius, p.scheduler.look_ahead_time)
       , in_progress(grid.size(), 0)
     {
-      build_solvers();
+      build_solvers(parameters);
     }
 
+    /** One solver per worker for @p p; the current ones stay if this
+     * throws. */
     void
-    build_solvers()
+    build_solvers(const Parameters::AllParameters &p)
     {
-      solvers.clear();
-      for (unsigned int w = 0; w < parameters.engine.workers; ++w)
-        solvers.push_back(
-          std::make_unique<StateSolver>(mesh, nodes, parameters));
+      std::vector<std::unique_ptr<StateSolver>> built;
+      for (unsigned int w = 0; w < p.engine.workers; ++w)
+        built.push_back(std::make_unique<StateSolver>(mesh, nodes, p));
+      solvers.swap(built);
     }
 
     /** The scheduler's view of a point (call with the mutex held). */
@@ -104,11 +106,21 @@ namespace palpate
     std::vector<std::uint8_t> in_progress;
     unsigned int              busy            = 0;
     bool                      nothing_to_plan = false;
-    std::atomic<bool>         is_running{false};
-    std::vector<std::thread>  workers;
-    std::thread               scheduler_thread;
-    Clock::time_point         t0;
-    EngineStatistics          stats;
+    // Tasks finished so far, and how many had finished when the last plan
+    // was made: the engine is idle only if that plan saw all of them.
+    std::uint64_t finished = 0, finished_at_plan = 0;
+    // A worker finished: plan again before the next tick.
+    bool replan = false;
+    // The bridge found nothing with this many tasks finished and the HIP
+    // in this cell: do not scan the grid again until one changes.
+    std::uint64_t            bridge_failed_at = ~std::uint64_t(0);
+    GridIndex                bridge_failed_cell{{0, 0, 0}};
+    std::atomic<bool>        is_running{false};
+    bool                     started_once = false;
+    std::vector<std::thread> workers;
+    std::thread              scheduler_thread;
+    Clock::time_point        t0;
+    EngineStatistics         stats;
   };
 
 
@@ -116,42 +128,57 @@ namespace palpate
   void
   ThreadEngine::Impl::scheduler_loop()
   {
-    const auto period =
-      std::chrono::duration<double>(1.0 / parameters.scheduler.rate);
-    auto next = Clock::now();
-    while (is_running.load())
+    const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / parameters.scheduler.rate));
+    auto next = Clock::now() + period; // the next regular tick
+    std::unique_lock<std::mutex> lock(mutex);
+    while (is_running)
       {
+        lock.unlock();
         Utilities::Point3 position, velocity;
         hip.read(position, velocity);
         cache.set_focus(position);
-        {
-          std::unique_lock<std::mutex> lock(mutex);
-          const auto                   plan = scheduler.plan(
-            position,
-            velocity,
-            [this](const unsigned int p) { return knowledge(p); },
-            2 * solvers.size());
-          // Tasks planned before that are no longer wanted are dropped.
-          // Queued tasks that are neither in the new plan nor in the cloud
-          // any more are dropped.
-          for (const Task &old : queue)
-            if (!scheduler.in_cloud(old.target, position, velocity) &&
-                std::none_of(plan.begin(), plan.end(), [&](const Task &t) {
-                  return t.target == old.target;
-                }))
-              ++stats.dropped;
-          queue.assign(plan.begin(), plan.end());
-          nothing_to_plan = plan.empty();
-        }
+        GridIndex             cell;
+        std::array<double, 3> local;
+        grid.locate(position, cell, local);
+        lock.lock();
+
+        const bool allow_bridge =
+          !(finished == bridge_failed_at && cell == bridge_failed_cell);
+        const auto plan = scheduler.plan(
+          position,
+          velocity,
+          [this](const unsigned int p) { return knowledge(p); },
+          2 * solvers.size(),
+          allow_bridge);
+        if (plan.empty() && allow_bridge)
+          {
+            bridge_failed_at   = finished;
+            bridge_failed_cell = cell;
+          }
+        // Queued tasks that are neither in the new plan nor in the cloud
+        // any more are dropped.
+        for (const Task &old : queue)
+          if (!scheduler.in_cloud(old.target, position, velocity) &&
+              std::none_of(plan.begin(), plan.end(), [&](const Task &t) {
+                return t.target == old.target;
+              }))
+            ++stats.dropped;
+        queue.assign(plan.begin(), plan.end());
+        nothing_to_plan  = plan.empty();
+        finished_at_plan = finished;
+        replan           = false;
         work_available.notify_all();
 
-        // Next tick, or earlier when a worker finishes (so a free worker
-        // gets its next task without waiting a whole period).
-        next += std::chrono::duration_cast<Clock::duration>(period);
-        std::unique_lock<std::mutex> lock(mutex);
-        work_done.wait_until(lock, next, [this] { return !is_running.load(); });
-        if (Clock::now() > next)
-          next = Clock::now();
+        // Plan again at the next tick, or earlier when a worker finishes
+        // (so that a free worker gets its next task without waiting); an
+        // early plan does not move the regular ticks.
+        work_done.wait_until(lock, next, [this] {
+          return !is_running || replan;
+        });
+        const auto now = Clock::now();
+        if (now >= next)
+          next = std::max(next + period, now);
       }
   }
 
@@ -169,45 +196,71 @@ namespace palpate
         std::uint64_t generation;
         {
           std::unique_lock<std::mutex> lock(mutex);
-          work_available.wait(lock, [this] {
-            return !is_running.load() || !queue.empty();
-          });
-          if (!is_running.load())
+          work_available.wait(lock,
+                              [this] { return !is_running || !queue.empty(); });
+          if (!is_running)
             return;
           task = queue.front();
           queue.pop_front();
           // Planned against what was known at the last tick: skip what has
           // changed since (computed, taken by another worker).
-          if (knowledge(task.target) != PointKnowledge::unknown)
+          if (!schedulable(knowledge(task.target)))
             continue;
           in_progress[task.target] = 1;
           ++busy;
           generation = cache.generation();
         }
 
-        const double start  = now();
-        const auto   source = cache.state(task.source);
+        // solve() reports numerical failures as failure points; anything
+        // else that goes wrong (out of memory, a library error) must not
+        // take the process down while a device renders forces: it becomes
+        // a failure point too, and is counted and reported.
+        const double start = now();
         State        result;
-        if (source)
-          result = solver.solve(*source, grid.position(task.target));
-        const double duration = now() - start;
-
-        if (source && result.converged)
+        bool         solved = false;
+        std::string  error;
+        try
           {
-            result.history.clear();
-            result.history.shrink_to_fit();
-            cache.publish(task.target,
-                          std::make_shared<const State>(std::move(result)),
-                          generation);
+            if (const auto source = cache.state(task.source))
+              {
+                result = solver.solve(*source, grid.position(task.target));
+                solved = true;
+                if (result.converged)
+                  {
+                    result.history.clear();
+                    result.history.shrink_to_fit();
+                    cache.publish(task.target,
+                                  std::make_shared<const State>(
+                                    std::move(result)),
+                                  generation);
+                  }
+                else
+                  cache.publish_failure(task.target, generation);
+              }
           }
-        else if (source)
-          cache.publish_failure(task.target, generation);
+        catch (const std::exception &e)
+          {
+            error = e.what();
+          }
+        catch (...)
+          {
+            error = "unknown exception";
+          }
+        if (!error.empty())
+          {
+            solved           = true;
+            result.converged = false;
+            cache.publish_failure(task.target, generation);
+          }
+        const double duration = now() - start;
 
         {
           std::lock_guard<std::mutex> lock(mutex);
           in_progress[task.target] = 0;
           --busy;
-          if (source)
+          ++finished;
+          replan = true;
+          if (solved)
             {
               if (generation != cache.generation())
                 ++stats.discarded;
@@ -215,6 +268,11 @@ namespace palpate
                 ++stats.computed;
               else
                 ++stats.failed;
+              if (!error.empty())
+                {
+                  ++stats.errors;
+                  stats.last_error = error;
+                }
               stats.busy_time += duration;
               stats.tasks.push_back({task.target,
                                      task.source,
@@ -263,9 +321,16 @@ namespace palpate
                       std::make_shared<const State>(
                         s.solvers.front()->rest_state()),
                       s.cache.generation());
-    s.t0 = Clock::now();
-    s.is_running.store(true);
-    s.nothing_to_plan = false;
+    {
+      std::lock_guard<std::mutex> lock(s.mutex);
+      if (!s.started_once)
+        s.t0 = Clock::now(); // task times count from the first attach
+      s.started_once     = true;
+      s.is_running       = true;
+      s.nothing_to_plan  = false;
+      s.replan           = false;
+      s.bridge_failed_at = ~std::uint64_t(0);
+    }
     for (unsigned int w = 0; w < s.solvers.size(); ++w)
       s.workers.emplace_back([&s, w] { s.worker_loop(w); });
     s.scheduler_thread = std::thread([&s] { s.scheduler_loop(); });
@@ -277,8 +342,14 @@ namespace palpate
   ThreadEngine::stop()
   {
     Impl &s = *impl;
-    if (!s.is_running.exchange(false))
-      return;
+    {
+      // Under the mutex, so that no thread can test the flag, miss the
+      // notification and then wait for ever.
+      std::lock_guard<std::mutex> lock(s.mutex);
+      if (!s.is_running)
+        return;
+      s.is_running = false;
+    }
     s.work_available.notify_all();
     s.work_done.notify_all();
     if (s.scheduler_thread.joinable())
@@ -308,9 +379,12 @@ namespace palpate
       throw std::logic_error(
         "parameters can change only while no contact is active "
         "(detach first)");
-    s.parameters = parameters;
-    s.build_solvers();
+    // Nothing computed for the old parameters is used again, whatever
+    // happens next; if the new solvers cannot be built, the old ones stay
+    // (and the caller restores the old scene).
     s.cache.invalidate();
+    s.build_solvers(parameters);
+    s.parameters = parameters;
   }
 
 
@@ -319,7 +393,8 @@ namespace palpate
   ThreadEngine::idle() const
   {
     std::lock_guard<std::mutex> lock(impl->mutex);
-    return impl->busy == 0 && impl->queue.empty() && impl->nothing_to_plan;
+    return impl->busy == 0 && impl->queue.empty() && impl->nothing_to_plan &&
+           impl->finished_at_plan == impl->finished;
   }
 
 

@@ -89,7 +89,7 @@ namespace palpate
             {
               const Task task = queue.front();
               queue.pop_front();
-              if (known[task.target] != PointKnowledge::unknown)
+              if (!schedulable(known[task.target]))
                 continue;
               known[task.target] = PointKnowledge::in_progress;
               busy[w].push_back({task.target, t + task_duration});

@@ -17,13 +17,14 @@ namespace palpate
     std::array<double, 3> local;
     if (!grid.locate(x, lower, local))
       return sample;
-    sample.corners      = grid.corners(lower);
-    const auto        w = trilinear_weights(local);
-    Utilities::Point3 sum{{0, 0, 0}};
+    sample.corners        = grid.corners(lower);
+    const auto          w = trilinear_weights(local);
+    Utilities::Point3   sum{{0, 0, 0}};
+    const std::uint64_t generation = cache.generation();
     for (unsigned int k = 0; k < 8; ++k)
       {
         Utilities::Point3 f;
-        if (cache.read_force(sample.corners[k], f))
+        if (cache.read_force(sample.corners[k], generation, f))
           {
             ++sample.hits;
             for (unsigned int d = 0; d < 3; ++d)

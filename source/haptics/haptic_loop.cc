@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -117,10 +118,11 @@ namespace palpate
     const double           rate;
     const std::size_t      capacity;
     std::vector<double>    period, lateness, interpolation; // seconds
-    std::size_t            n               = 0;
-    std::uint64_t          misses          = 0;
-    bool                   realtime        = false;
-    double                 motion_duration = 0;
+    std::size_t            n        = 0;
+    std::uint64_t          misses   = 0;
+    bool                   realtime = false, locked = false, truncated = false;
+    double                 motion_duration = 0, motion_elapsed = 0;
+    std::atomic<bool>      motion_requested{false};
     std::atomic<long long> motion_start_ns{
       -1};                            // since the loop started; -1: not yet
     std::atomic<long long> t0_ns{-1}; // the loop's start (CLOCK_MONOTONIC)
@@ -176,7 +178,7 @@ namespace palpate
     // No page fault inside the loop: lock what is mapped now (the solvers
     // and the statistics arrays were allocated before), touch a stack
     // reserve, and run the force path once before the first deadline.
-    mlockall(MCL_CURRENT);
+    locked = mlockall(MCL_CURRENT) == 0;
     {
       volatile char stack[256 * 1024];
       for (std::size_t i = 0; i < sizeof(stack); i += 4096)
@@ -191,11 +193,20 @@ namespace palpate
     const long long t0 = nanoseconds(now);
     t0_ns.store(t0, std::memory_order_release);
     long long deadline = t0, previous_wake = t0;
-    while (n < capacity && !stop.load(std::memory_order_relaxed))
+    bool      motion_over = false;
+    while (!stop.load(std::memory_order_relaxed))
       {
+        if (n == capacity)
+          {
+            truncated = !motion_over;
+            break;
+          }
         deadline += period_ns;
         const timespec next = to_timespec(deadline);
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+        while (
+          clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) ==
+          EINTR)
+          {} // a signal: sleep on until the deadline
         clock_gettime(CLOCK_MONOTONIC, &now);
         const long long wake = nanoseconds(now);
         lateness[n]          = 1e-9 * (wake - deadline);
@@ -203,10 +214,26 @@ namespace palpate
         previous_wake        = wake;
         if (lateness[n] > 0.5e-3)
           ++misses;
+        // After a stall, no burst of catch-up ticks (each would be allowed
+        // the maximum force change): the deadlines that passed are missed.
+        if (wake - deadline >= period_ns)
+          {
+            const long long passed = (wake - deadline) / period_ns;
+            deadline += passed * period_ns;
+            misses += passed;
+          }
 
-        // The device's clock: the motion starts when told to.
-        const long long start = motion_start_ns.load(std::memory_order_acquire);
-        const double    t     = start < 0 ? 0.0 : 1e-9 * (wake - t0 - start);
+        // The device's clock: the motion starts at the first tick after
+        // start_motion().
+        long long start = motion_start_ns.load(std::memory_order_relaxed);
+        if (start < 0 && motion_requested.load(std::memory_order_acquire))
+          {
+            start             = wake - t0;
+            motion_started_at = 1e-9 * start;
+            motion_start_ns.store(start, std::memory_order_release);
+          }
+        const double t = start < 0 ? 0.0 : 1e-9 * (wake - t0 - start);
+        motion_elapsed = std::min(t, motion_duration);
         const Utilities::Point3 x = device.position(t);
 
         timespec a, b;
@@ -218,7 +245,10 @@ namespace palpate
         ++n;
 
         if (start >= 0 && t > motion_duration)
-          break;
+          {
+            motion_over = true;
+            break;
+          }
       }
     done.store(true, std::memory_order_release);
   }
@@ -253,14 +283,9 @@ namespace palpate
   void
   HapticLoop::start_motion() noexcept
   {
-    const long long t0 = impl->t0_ns.load(std::memory_order_acquire);
-    if (impl->motion_start_ns.load() >= 0 || t0 < 0)
-      return;
-    timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    const long long since_start = nanoseconds(now) - t0;
-    impl->motion_started_at     = 1e-9 * since_start;
-    impl->motion_start_ns.store(since_start, std::memory_order_release);
+    // The loop thread starts the motion at its next tick (it may still be
+    // setting itself up).
+    impl->motion_requested.store(true, std::memory_order_release);
   }
 
 
@@ -321,7 +346,9 @@ namespace palpate
                                 1000 * *std::max_element(period.begin(), period.end());
     r.interpolation_p50_us  = 1e6 * percentile(interpolation, 0.5);
     r.interpolation_p999_us = 1e6 * percentile(interpolation, 0.999);
+    r.memory_locked         = s.locked;
+    r.loop_truncated        = s.truncated;
     r.motion_start    = s.motion_start_ns.load() < 0 ? 0 : s.motion_started_at;
-    r.motion_duration = s.motion_duration;
+    r.motion_duration = s.motion_elapsed;
   }
 } // namespace palpate

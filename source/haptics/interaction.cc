@@ -90,7 +90,9 @@ namespace palpate
     Impl &s = *impl;
     if (s.is_attached.load())
       return;
-    s.hip.write({{0, 0, 0}}, {{0, 0, 0}});
+    // The HIP channel has one writer, force(): the cloud is computed around
+    // where force() last saw the HIP (the rest position before its first
+    // call).
     s.initial_done.store(false);
     s.attach_time = Clock::now();
     s.reset.store(
@@ -282,9 +284,23 @@ namespace palpate
     changed.validate();
     NodeSelection nodes = NodeSelection::create(changed, s.mesh);
 
-    s.scene = std::move(changed);
-    s.nodes = std::move(nodes); // the engine's solvers refer to s.nodes
-    s.engine->change_parameters(parameters);
+    // The engine's solvers are built from s.nodes: commit, and restore the
+    // old scene if the engine cannot take the new one (the cache is
+    // invalidated either way, so nothing computed before is used again).
+    Scene         old_scene = std::move(s.scene);
+    NodeSelection old_nodes = std::move(s.nodes);
+    s.scene                 = std::move(changed);
+    s.nodes                 = std::move(nodes);
+    try
+      {
+        s.engine->change_parameters(parameters);
+      }
+    catch (...)
+      {
+        s.scene = std::move(old_scene);
+        s.nodes = std::move(old_nodes);
+        throw;
+      }
   }
 
 
@@ -326,6 +342,8 @@ namespace palpate
     r.states_failed          = e.failed;
     r.tasks_dropped          = e.dropped;
     r.results_discarded      = e.discarded;
+    r.solver_errors          = e.errors;
+    r.last_solver_error      = e.last_error;
     std::vector<double> times;
     double              span = 0;
     for (const auto &t : e.tasks)

@@ -34,6 +34,7 @@ namespace palpate
               {"states_failed", number(s.states_failed)},
               {"tasks_dropped", number(s.tasks_dropped)},
               {"results_discarded", number(s.results_discarded)},
+              {"solver_errors", number(s.solver_errors)},
               {"median_state_ms", number(s.median_state_ms)},
               {"worker_busy_fraction", number(s.worker_busy_fraction)},
               {"states_used", number(s.states_used)},
@@ -46,6 +47,8 @@ namespace palpate
               {"largest_force_change_N", number(s.largest_force_change)},
               {"loop_ran", s.loop_ran ? "true" : "false"},
               {"realtime_priority", s.realtime_priority ? "true" : "false"},
+              {"memory_locked", s.memory_locked ? "true" : "false"},
+              {"loop_truncated", s.loop_truncated ? "true" : "false"},
               {"loop_rate_Hz", number(s.loop_rate)},
               {"motion_start_s", number(s.motion_start)},
               {"motion_duration_s", number(s.motion_duration)},
@@ -88,12 +91,18 @@ namespace palpate
       << "  forces:            largest " << largest_force
       << " N, largest change per tick " << largest_force_change
       << " N, non-finite " << non_finite_forces << "\n";
+    if (solver_errors > 0)
+      s << "  solver errors:     " << solver_errors
+        << " solves threw (counted as failure points); the last: "
+        << last_solver_error << "\n";
     if (loop_ran)
       s << "  haptic loop:       " << ticks << " ticks at " << loop_rate
         << " Hz, "
         << (realtime_priority ?
               "real-time priority (SCHED_FIFO)" :
               "normal priority (no real-time scheduling permitted)")
+        << (memory_locked ? ", memory locked" :
+                            ", memory not locked (page faults possible)")
         << "\n"
         << "  loop period:       p50 " << period_p50_ms << " ms, p99 "
         << period_p99_ms << " ms, p99.9 " << period_p999_ms << " ms, max "
@@ -103,7 +112,11 @@ namespace palpate
         << "  interpolation:     p50 " << interpolation_p50_us << " us, p99.9 "
         << interpolation_p999_us << " us\n"
         << "  motion:            started " << motion_start
-        << " s after attach, lasted " << motion_duration << " s\n";
+        << " s after attach, lasted " << motion_duration << " s"
+        << (loop_truncated ?
+              "  <-- cut short: the loop reached its time bound" :
+              "")
+        << "\n";
     if (shape_frames > 0)
       s << "  shape output:      " << shape_frames << " frames\n";
     out << s.str();

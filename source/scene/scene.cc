@@ -602,6 +602,20 @@ namespace palpate
                   "grid has no cell",
                   "make Extent at least Grid spacing (typically 0.1 m, the "
                   "paper's largest displacement).");
+    {
+      // Every grid point costs about 70 bytes of bookkeeping, computed or
+      // not: 2e7 points are 1.4 GB.
+      const double side =
+        2 * std::floor(p.state_space.extent / p.state_space.grid_spacing) + 1;
+      if (side * side * side > 2e7)
+        throw error("State space/Extent",
+                    "the grid would have " + Utilities::to_string(side, 6) +
+                      "^3 = " + Utilities::to_string(side * side * side, 3) +
+                      " points; at most 2e7 are allowed (about 70 bytes "
+                      "each, computed or not)",
+                    "reduce Extent or increase Grid spacing (0.1 m with "
+                    "0.005 m gives 41^3 = 68921 points).");
+    }
     if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
       throw error(
         "Scheduler/Cloud radius",

@@ -4,6 +4,8 @@
 #include <palpate/hyperelastic/state.h>
 #include <palpate/state_space/state_cache.h>
 
+#include <algorithm>
+
 namespace palpate
 {
   /**
@@ -19,7 +21,13 @@ namespace palpate
     std::atomic<std::uint64_t> generation{0};
     std::atomic<std::uint8_t>  status{0};
     std::atomic<double>        force[3] = {};
+    /** Whether the whole state is held (written under the mutex). */
+    std::atomic<bool> held{false};
   };
+
+  static_assert(std::atomic<double>::is_always_lock_free &&
+                  std::atomic<std::uint64_t>::is_always_lock_free,
+                "the real-time reads need lock-free atomics");
 
 
 
@@ -62,8 +70,11 @@ namespace palpate
   {
     std::lock_guard<std::mutex> lock(mutex);
     current_generation.fetch_add(1, std::memory_order_acq_rel);
-    for (auto &s : states)
-      s.reset();
+    for (unsigned int p = 0; p < states.size(); ++p)
+      {
+        states[p].reset();
+        entries[p].held.store(false, std::memory_order_relaxed);
+      }
     bytes = 0;
     held  = 0;
   }
@@ -78,16 +89,26 @@ namespace palpate
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return; // computed for parameters that no longer hold
-    Entry              &e = entries[point];
-    const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
-    e.sequence.store(s + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
-    for (unsigned int d = 0; d < 3; ++d)
-      e.force[d].store(state->force[d], std::memory_order_relaxed);
-    e.status.store(static_cast<std::uint8_t>(PointStatus::available),
-                   std::memory_order_relaxed);
-    e.generation.store(generation, std::memory_order_relaxed);
-    e.sequence.store(s + 2, std::memory_order_release);
+    Entry &e = entries[point];
+    // A point that is already available (a state recomputed because its
+    // whole state had been dropped) keeps its force: rewriting the same
+    // value would only make a concurrent real-time read miss it.
+    const bool available =
+      e.generation.load(std::memory_order_relaxed) == generation &&
+      e.status.load(std::memory_order_relaxed) ==
+        static_cast<std::uint8_t>(PointStatus::available);
+    if (!available)
+      {
+        const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
+        e.sequence.store(s + 1, std::memory_order_relaxed);
+        std::atomic_thread_fence(std::memory_order_release);
+        for (unsigned int d = 0; d < 3; ++d)
+          e.force[d].store(state->force[d], std::memory_order_relaxed);
+        e.status.store(static_cast<std::uint8_t>(PointStatus::available),
+                       std::memory_order_relaxed);
+        e.generation.store(generation, std::memory_order_relaxed);
+        e.sequence.store(s + 2, std::memory_order_release);
+      }
 
     if (!states[point])
       ++held;
@@ -95,24 +116,31 @@ namespace palpate
       bytes -= size_of(*states[point]);
     bytes += size_of(*state);
     states[point] = std::move(state);
+    e.held.store(true, std::memory_order_release);
 
     // Over budget: drop the states farthest from the focus (their forces
-    // stay available to the real-time side).
-    while (bytes > budget && held > 1)
+    // stay available to the real-time side), down to 90 % of the budget so
+    // that the sort is paid once per batch, not once per state.
+    if (bytes > budget && held > 1)
       {
-        unsigned int farthest = 0;
-        double       distance = -1;
+        std::vector<std::pair<double, unsigned int>> by_distance;
+        by_distance.reserve(held);
         for (unsigned int p = 0; p < states.size(); ++p)
           if (states[p] && p != point)
-            if (const double d = Utilities::distance(grid.position(p), focus);
-                d > distance)
-              distance = d, farthest = p;
-        if (distance < 0)
-          break;
-        bytes -= size_of(*states[farthest]);
-        states[farthest].reset();
-        --held;
-        ++evicted;
+            by_distance.emplace_back(Utilities::distance(grid.position(p),
+                                                         focus),
+                                     p);
+        std::sort(by_distance.begin(), by_distance.end());
+        while (bytes > 0.9 * budget && !by_distance.empty())
+          {
+            const unsigned int p = by_distance.back().second;
+            by_distance.pop_back();
+            bytes -= size_of(*states[p]);
+            states[p].reset();
+            entries[p].held.store(false, std::memory_order_release);
+            --held;
+            ++evicted;
+          }
       }
   }
 
@@ -143,7 +171,7 @@ namespace palpate
   StateCache::status(const unsigned int point) const noexcept
   {
     const Entry &e = entries[point];
-    for (unsigned int attempt = 0; attempt < 4; ++attempt)
+    for (unsigned int attempt = 0; attempt < 16; ++attempt)
       {
         const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
         if (s1 & 1)
@@ -158,14 +186,22 @@ namespace palpate
                  static_cast<PointStatus>(status) :
                  PointStatus::missing;
       }
-    return PointStatus::missing;
+    // A writer is slow (preempted mid-write): writers hold the mutex for
+    // the whole write, so under it the entry is consistent.
+    std::lock_guard<std::mutex> lock(mutex);
+    return e.generation.load(std::memory_order_relaxed) ==
+               current_generation.load(std::memory_order_relaxed) ?
+             static_cast<PointStatus>(
+               e.status.load(std::memory_order_relaxed)) :
+             PointStatus::missing;
   }
 
 
 
   bool
-  StateCache::read_force(const unsigned int point,
-                         Utilities::Point3 &force) const noexcept
+  StateCache::read_force(const unsigned int  point,
+                         const std::uint64_t generation_read,
+                         Utilities::Point3  &force) const noexcept
   {
     const Entry        &e  = entries[point];
     const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
@@ -178,7 +214,7 @@ namespace palpate
       f[d] = e.force[d].load(std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_acquire);
     if (e.sequence.load(std::memory_order_relaxed) != s1 ||
-        generation != current_generation.load(std::memory_order_acquire) ||
+        generation != generation_read ||
         status != static_cast<std::uint8_t>(PointStatus::available))
       return false;
     force = f;
@@ -199,8 +235,7 @@ namespace palpate
   bool
   StateCache::has_state(const unsigned int point) const
   {
-    std::lock_guard<std::mutex> lock(mutex);
-    return states[point] != nullptr;
+    return entries[point].held.load(std::memory_order_acquire);
   }
 
 

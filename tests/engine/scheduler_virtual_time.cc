@@ -157,6 +157,27 @@ main(int argc, char **argv)
           << " failed), " << outside << " outside the cloud, " << behind
           << " behind the wall left unknown" << std::endl;
 
+  // States dropped for the memory budget: held states for i <= -1, the
+  // plane i = 0 computed but no longer held, unknown beyond. The cloud
+  // beyond can only be reached through i = 0: those points are planned
+  // again (from their held neighbours), nothing beyond yet.
+  const auto evicted = [&](const unsigned int p) {
+    const int i = grid.index(p)[0];
+    return i <= -1 ? palpate::PointKnowledge::source :
+           i == 0  ? palpate::PointKnowledge::computed :
+                     palpate::PointKnowledge::unknown;
+  };
+  const auto   replan = scheduler.plan({{0, 0, 0}}, {{0, 0, 0}}, evicted, 1000);
+  unsigned int plane = 0, from_held = 0;
+  for (const auto &t : replan)
+    {
+      plane += grid.index(t.target)[0] == 0;
+      from_held += grid.index(t.source)[0] == -1;
+    }
+  deallog << "states dropped on the way: " << replan.size() << " planned, "
+          << plane << " of them recomputations on the plane i = 0, "
+          << from_held << " from held states" << std::endl;
+
   // Where the HIP is at the end, its cell is complete.
   grid.locate(hip(1.5), lower, local);
   bool complete = true;

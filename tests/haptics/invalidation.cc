@@ -3,7 +3,8 @@
 
 // The embedding API on the beam scene (2 mm grid, 4.5 mm cloud, 2 solver
 // threads), and on-the-fly parameter changes:
-// - after attach() the initial cloud is computed, and the force at a point
+// - after attach() the initial cloud around the HIP (where force() last
+//   saw it, before attaching) is computed, and the force at a point
 //   of a cell is the trilinear interpolation of independently computed
 //   states at its corners (relative difference < 1e-6: different staging
 //   paths, Newton tolerance 1e-8);

@@ -45,6 +45,10 @@ namespace palpate
     unsigned int dropped   = 0; // queued tasks that fell out of the cloud
     unsigned int discarded = 0; // results for a generation that changed
     double       busy_time = 0; // seconds workers spent solving
+    /** Solves that threw (out of memory, a library error): counted as
+     * failure points too; the last message. */
+    unsigned int            errors = 0;
+    std::string             last_error;
     std::vector<TaskRecord> tasks;
   };
 

@@ -40,7 +40,18 @@ namespace palpate
     /** Lower is more urgent: the distance (m) of the target from the
      * HIP's predicted path. */
     double priority;
+    /** A corner of the HIP's cell: before every other task. */
+    bool corner = false;
   };
+
+  /** Whether a point in this state can be the target of a task: unknown,
+   * or computed but its whole state dropped (it is then recomputed when
+   * the cloud needs it as a source again). */
+  inline bool
+  schedulable(const PointKnowledge k)
+  {
+    return k == PointKnowledge::unknown || k == PointKnowledge::computed;
+  }
 
   /**
    * The scheduling policy: which states to compute next.
@@ -51,16 +62,21 @@ namespace palpate
    * or look-ahead, the paper's sphere around the HIP). Points of the cloud
    * that are not computed, not failed and not under way are candidates;
    * each needs a source, an axis neighbour whose state is held (the one
-   * nearest the HIP). The corners of the cell the HIP is in come first
+   * nearest the HIP). A point whose whole state was dropped for the memory
+   * budget is a candidate again where an unknown cloud point needs it as a
+   * source. The corners of the cell the HIP is in come first
    * (interaction can start, or go on, as soon as they exist); then
    * candidates by their distance from the predicted path (ties by grid
    * number), so that the cells the HIP is about to enter come before the
-   * rest of the cloud. If no point of the cloud can be reached (the HIP
-   * jumped, or outran the computed front), the plan builds a bridge: the
-   * points next to computed ones that are nearest the HIP's path, even
-   * outside the cloud, each nearer to the path than its source (so a
-   * bridge only ever leads toward the cloud, and cloud points walled off
-   * by failure points do not make it grow).
+   * rest of the cloud. If unknown points of the cloud remain but none can
+   * be reached and none is under way (the HIP jumped, or outran the
+   * computed front), the plan builds a bridge: the points next to held
+   * states that are nearest the HIP's path, even outside the cloud, each
+   * nearer to the path than its source (so a bridge only ever leads toward
+   * the cloud, and cloud points walled off by failure points do not make it
+   * grow). The bridge scans the whole grid; @p allow_bridge = false skips
+   * it (the engine does when nothing changed since a bridge found
+   * nothing).
    *
    * The class holds no state between calls: the same inputs give the same
    * plan, which is what the virtual-time tests check.
@@ -73,15 +89,16 @@ namespace palpate
               const double     cloud_radius,
               const double     look_ahead_time);
 
-    /**
-     * The most urgent tasks (at most @p max_tasks) for the HIP at @p hip
+    /*     * The most urgent tasks (at most @p max_tasks) for the HIP at @p hip
      * moving with @p velocity (m/s), given what is known about each point.
+     * The bridge is built only if @p allow_bridge.
      */
     std::vector<Task>
     plan(const Utilities::Point3                           &hip,
          const Utilities::Point3                           &velocity,
          const std::function<PointKnowledge(unsigned int)> &knowledge,
-         const unsigned int                                 max_tasks) const;
+         const unsigned int                                 max_tasks,
+         const bool allow_bridge = true) const;
 
     /** Whether @p point belongs to the cloud for this HIP and velocity. */
     bool

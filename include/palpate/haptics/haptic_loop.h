@@ -104,7 +104,7 @@ namespace palpate
     void
     start(const double motion_duration);
 
-    /** Start the device's motion now. */
+    /** Start the device's motion at the loop's next tick. */
     void
     start_motion() noexcept;
 

@@ -57,7 +57,8 @@ namespace palpate
 
     ~Interaction();
 
-    /** Contact: start computing the cloud around the rest position. */
+    /** Contact: start computing the cloud around the HIP, where force()
+     * last saw it (the rest position if force() was never called). */
     void
     attach();
 

@@ -22,7 +22,11 @@ namespace palpate
     // The engine.
     unsigned int states_computed = 0, states_failed = 0, tasks_dropped = 0,
                  results_discarded = 0;
-    double median_state_ms = 0, worker_busy_fraction = 0;
+    /** Solves that threw instead of converging or failing (each is also a
+     * failure point), and the last message. */
+    unsigned int solver_errors = 0;
+    std::string  last_solver_error;
+    double       median_state_ms = 0, worker_busy_fraction = 0;
 
     // What the haptic side read.
     unsigned int  states_used  = 0;
@@ -33,7 +37,11 @@ namespace palpate
     double        largest_force = 0, largest_force_change = 0;
 
     // The built-in haptic loop (zero if the host application ran its own).
-    bool          loop_ran = false, realtime_priority = false;
+    bool loop_ran = false, realtime_priority = false;
+    /** Whether the loop's memory could be locked (no page faults). */
+    bool memory_locked = false;
+    /** Whether the loop hit its time bound before the motion ended. */
+    bool          loop_truncated = false;
     double        loop_rate = 0, motion_start = 0, motion_duration = 0;
     std::uint64_t ticks = 0, deadline_misses = 0;
     double        period_p50_ms = 0, period_p99_ms = 0, period_p999_ms = 0,

@@ -75,7 +75,8 @@ namespace palpate
     void
     publish_failure(const unsigned int point, const std::uint64_t generation);
 
-    /** What is known about @p point in the current generation. Lock-free. */
+    /** What is known about @p point in the current generation. Lock-free
+     * unless a writer is preempted mid-write; not for the real-time side. */
     PointStatus
     status(const unsigned int point) const noexcept;
 
@@ -83,7 +84,8 @@ namespace palpate
     std::shared_ptr<const State>
     state(const unsigned int point) const;
 
-    /** Whether the whole state at @p point is held (usable as a source). */
+    /** Whether the whole state at @p point is held (usable as a source).
+     * Lock-free; state() may still return null if it was dropped since. */
     bool
     has_state(const unsigned int point) const;
 
@@ -93,12 +95,14 @@ namespace palpate
 
     /**
      * Real-time read of the force at @p point (N): true and @p force set if
-     * the point is available, false otherwise. Never blocks, never
-     * allocates.
+     * the point is available in generation @p generation (read once per
+     * interpolation with generation(), so that the corners of one cell never
+     * mix generations), false otherwise. Never blocks, never allocates.
      */
     bool
-    read_force(const unsigned int point,
-               Utilities::Point3 &force) const noexcept;
+    read_force(const unsigned int  point,
+               const std::uint64_t generation,
+               Utilities::Point3  &force) const noexcept;
 
     /** Number of available and of failed points in this generation. */
     std::pair<unsigned int, unsigned int>
