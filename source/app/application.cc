@@ -24,7 +24,8 @@ namespace palpate
       "device.\n"
       "\n"
       "Usage:\n"
-      "  palpate SCENE.prm               set up the scene and run it\n"
+      "  palpate SCENE.prm               set up the scene and run it (Run /\n"
+      "                                  Mode: an interaction by default)\n"
       "  palpate solve SCENE.prm [--to X,Y,Z]\n"
       "                                  compute the state with the active node\n"
       "                                  displaced by X,Y,Z metres from rest\n"
@@ -43,12 +44,14 @@ namespace palpate
     /**
      * Set up a scene (read it, build the mesh, select the nodes), report
      * it, and do what its Run / Mode says: an interaction, a static solve
-     * for the active node's prescribed displacement, or nothing more. A
-     * given @p target (palpate solve --to) always means a static solve.
+     * for the active node's prescribed displacement, or nothing more.
+     * `palpate solve` (@p solve) always means a static solve, to @p target
+     * if given (--to), else to the prescribed displacement.
      */
     int
     run_scene(const std::string               &filename,
               std::optional<Utilities::Point3> target,
+              const bool                       solve,
               std::ostream                    &out)
     {
       const Scene         scene = Scene::read(filename);
@@ -56,9 +59,9 @@ namespace palpate
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
       print_scene_report(out, scene, mesh, nodes);
       const auto &mode = scene.parameters.run.mode;
-      if (!target && mode == "set-up only")
+      if (!solve && mode == "set-up only")
         return ExitStatus::success;
-      if (!target && mode == "interaction")
+      if (!solve && mode == "interaction")
         {
           run_interaction(out, scene);
           return ExitStatus::success;
@@ -144,7 +147,7 @@ namespace palpate
                                args[i],
                                "unexpected argument '" + args[i] + "'",
                                "run 'palpate --help' for the usage.");
-          return run_scene(args[1], target, out);
+          return run_scene(args[1], target, true, out);
         }
       if (args.size() > 1)
         throw InputError("command line",
@@ -152,7 +155,7 @@ namespace palpate
                          args[1],
                          "unexpected argument '" + args[1] + "'",
                          "run 'palpate --help' for the usage.");
-      return run_scene(args[0], std::nullopt, out);
+      return run_scene(args[0], std::nullopt, false, out);
     }
   } // namespace
 

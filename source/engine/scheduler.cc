@@ -76,14 +76,52 @@ namespace palpate
           std::clamp(std::ceil((std::max(a, b) + radius) / h), -n, n));
       }
 
-    // The cell the HIP is in: its corners come before everything else.
-    GridIndex             cell;
-    std::array<double, 3> local;
-    const bool            located         = grid.locate(hip, cell, local);
-    const auto            in_current_cell = [&](const GridIndex &g) {
-      return located && g[0] - cell[0] >= 0 && g[0] - cell[0] <= 1 &&
-             g[1] - cell[1] >= 0 && g[1] - cell[1] <= 1 &&
-             g[2] - cell[2] >= 0 && g[2] - cell[2] <= 1;
+    // The cells the HIP is in and will pass through along its predicted
+    // path (located as the interpolation locates it): their corners come
+    // before everything else, in the order the HIP will need them (the arc
+    // length to the first point of the path in their cell).
+    std::vector<std::pair<unsigned int, double>> needed; // (point, arc)
+    {
+      Utilities::Point3 step;
+      for (unsigned int k = 0; k < 3; ++k)
+        step[k] = look_ahead * velocity[k];
+      const double       length = Utilities::norm(step);
+      const unsigned int samples =
+        std::min(1000u, 1u + static_cast<unsigned int>(4 * length / h));
+      for (unsigned int s = 0; s <= samples; ++s)
+        {
+          const double      t = samples > 0 ? double(s) / samples : 0.0;
+          Utilities::Point3 x;
+          for (unsigned int k = 0; k < 3; ++k)
+            x[k] = hip[k] + t * step[k];
+          GridIndex             cell;
+          std::array<double, 3> local;
+          if (!grid.locate(x, cell, local))
+            continue;
+          for (const unsigned int c : grid.corners(cell))
+            needed.emplace_back(c, t * length);
+        }
+      // The first arc for each point.
+      std::stable_sort(needed.begin(),
+                       needed.end(),
+                       [](const auto &a, const auto &b) {
+                         return a.first < b.first;
+                       });
+      needed.erase(std::unique(needed.begin(),
+                               needed.end(),
+                               [](const auto &a, const auto &b) {
+                                 return a.first == b.first;
+                               }),
+                   needed.end());
+    }
+    const auto needed_at = [&](const unsigned int p) {
+      const auto it = std::lower_bound(needed.begin(),
+                                       needed.end(),
+                                       p,
+                                       [](const auto &a, const unsigned int q) {
+                                         return a.first < q;
+                                       });
+      return it != needed.end() && it->first == p ? it->second : -1.0;
     };
 
     static const int axis[6][3] = {
@@ -151,10 +189,13 @@ namespace palpate
                   return distance(q) <= radius;
                 }))
               continue;
-            const int source = find_source(g, any);
+            const int    source = find_source(g, any);
+            const double arc    = needed_at(p);
             if (source >= 0)
-              candidates.push_back(
-                {p, static_cast<unsigned int>(source), d, in_current_cell(g)});
+              candidates.push_back({p,
+                                    static_cast<unsigned int>(source),
+                                    arc >= 0 ? arc : d,
+                                    arc >= 0});
             else if (known == PointKnowledge::unknown)
               ++unreached;
           }

@@ -65,10 +65,12 @@ namespace palpate
    * nearest the HIP). A point whose whole state was dropped for the memory
    * budget is a candidate again where an unknown cloud point needs it as a
    * source. The corners of the cell the HIP is in come first
-   * (interaction can start, or go on, as soon as they exist); then
-   * candidates by their distance from the predicted path (ties by grid
-   * number), so that the cells the HIP is about to enter come before the
-   * rest of the cloud. If unknown points of the cloud remain but none can
+   * (interaction can start, or go on, as soon as they exist), then the
+   * corners of the cells the predicted path passes through, in the order
+   * the HIP will reach them (motion prediction: a straight stroke needs
+   * only these 4 new states per cell, not the whole tube around it); then
+   * the rest of the cloud by distance from the predicted path (ties by grid
+   * number). If unknown points of the cloud remain but none can
    * be reached and none is under way (the HIP jumped, or outran the
    * computed front), the plan builds a bridge: the points next to held
    * states that are nearest the HIP's path, even outside the cloud, each
