@@ -28,13 +28,10 @@
 // Newton residual tolerance 1e-4 / 1e-6 / 1e-8 (the default), StVK, 5 mm,
 // one worker.
 
+#include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
-#include <palpate/haptics/haptic_loop.h>
-#include <palpate/haptics/interaction.h>
 #include <palpate/haptics/run_summary.h>
-#include <palpate/haptics/trajectory.h>
 #include <palpate/scene/scene.h>
-#include <palpate/state_space/state_cache.h>
 
 #include <pthread.h>
 #include <sched.h>
@@ -107,42 +104,20 @@ namespace
     return scene;
   }
 
+  /** One interaction at @p speed, exactly as `palpate scene.prm` runs it. */
   Trial
-  run_trial(const Scene &scene, const double speed, const double length)
+  run_trial(Scene scene, const double speed, const double length)
   {
-    using Clock                = std::chrono::steady_clock;
-    const double    wait_limit = 300;
-    const double    duration   = length / speed;
-    Interaction     interaction(scene);
-    SimulatedDevice device(
-      std::make_unique<StraightLine>(direction, speed, duration), 0);
-    HapticLoop loop(interaction, device, 1000, wait_limit + duration + 1);
+    scene.parameters.haptics.trajectory.speed    = speed;
+    scene.parameters.haptics.trajectory.duration = length / speed;
+    std::ostringstream quiet;
+    const RunSummary   s = run_interaction(quiet, scene);
 
     Trial t;
-    t.speed       = speed;
-    const auto t0 = Clock::now();
-    interaction.attach();
-    loop.start(duration);
-    while (!interaction.initial_cloud_complete())
-      {
-        if (std::chrono::duration<double>(Clock::now() - t0).count() >
-            wait_limit)
-          {
-            t.complete_cloud = false;
-            break;
-          }
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    t.cloud_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    t.cloud_states  = interaction.cache().counts().first;
-    loop.start_motion();
-    while (!loop.finished())
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    loop.join();
-    interaction.detach();
-
-    RunSummary s = interaction.summary();
-    loop.add_to(s);
+    t.speed           = speed;
+    t.cloud_seconds   = s.motion_start;
+    t.cloud_states    = s.initial_cloud_states;
+    t.complete_cloud  = s.initial_cloud_complete;
     t.missing         = s.missing_events;
     t.missing_seconds = s.missing_seconds;
     t.deadline_misses = s.deadline_misses;
@@ -153,6 +128,8 @@ namespace
     t.passed          = t.missing == 0 && t.complete_cloud && !s.loop_truncated;
     return t;
   }
+
+
 
   void
   print_trial(const Trial &t)

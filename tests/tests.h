@@ -89,6 +89,16 @@ shipped_scene(const std::string &name)
   return palpate::Scene::read(palpate_source_dir + "/parameters/" + name);
 }
 
+/** The whole text of the file @p name ("" if it cannot be read). */
+inline std::string
+read_file(const std::string &name)
+{
+  std::ifstream     in(name);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 /** Write @p text to the file @p name. */
 inline void
 write_file(const std::string &name, const std::string &text)

@@ -18,7 +18,7 @@
 
 namespace palpate
 {
-  void
+  RunSummary
   run_interaction(std::ostream &out, const Scene &scene)
   {
     using Clock   = std::chrono::steady_clock;
@@ -34,9 +34,8 @@ namespace palpate
     const double    max_seconds = wait_limit + duration + 1;
     SimulatedDevice device(std::move(trajectory),
                            p.effects.force_log ?
-                             static_cast<std::size_t>(max_seconds *
-                                                      p.haptics.loop_rate) +
-                               16 : // as many as the loop's ticks
+                             HapticLoop::max_ticks(p.haptics.loop_rate,
+                                                   max_seconds) :
                              0);
 
     out << "\nInteraction\n"
@@ -68,7 +67,9 @@ namespace palpate
     loop.start(duration);
     if (shape)
       shape->start();
-    bool moving = p.haptics.trajectory.start == "immediately";
+    bool         moving         = p.haptics.trajectory.start == "immediately";
+    unsigned int cloud_states   = 0;
+    bool         cloud_complete = false;
     if (moving)
       loop.start_motion();
 
@@ -76,13 +77,15 @@ namespace palpate
     // initial cloud is there.
     while (!loop.finished())
       {
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
         interaction.poll_events(out);
         const double t =
           std::chrono::duration<double>(Clock::now() - t0).count();
         if (!moving && (interaction.initial_cloud_complete() || t > wait_limit))
           {
             const auto counts = interaction.cache().counts();
+            cloud_states      = counts.first;
+            cloud_complete    = t <= wait_limit;
             out << "  initial cloud: " << counts.first << " states computed, "
                 << counts.second << " failure points, in "
                 << std::setprecision(3) << t << " s"
@@ -101,7 +104,9 @@ namespace palpate
 
     RunSummary summary = interaction.summary();
     loop.add_to(summary);
-    summary.trajectory = device.description();
+    summary.trajectory             = device.description();
+    summary.initial_cloud_states   = cloud_states;
+    summary.initial_cloud_complete = cloud_complete;
     if (shape)
       summary.shape_frames = shape->frames().first;
     out << "\n";
@@ -133,5 +138,6 @@ namespace palpate
       out << "  wrote " << p.output.directory << "/" << stem << "-shape.pvd ("
           << shape->frames().first << " frames, " << shape->frames().second
           << " skipped for missing states)\n";
+    return summary;
   }
 } // namespace palpate

@@ -134,7 +134,7 @@ namespace palpate
       : interaction(i)
       , device(d)
       , rate(r)
-      , capacity(static_cast<std::size_t>(max_seconds * r) + 16)
+      , capacity(HapticLoop::max_ticks(r, max_seconds))
       , period(capacity)
       , lateness(capacity)
       , interpolation(capacity)
@@ -261,6 +261,14 @@ namespace palpate
                          const double max_seconds)
     : impl(std::make_unique<Impl>(interaction, device, rate, max_seconds))
   {}
+
+
+
+  std::size_t
+  HapticLoop::max_ticks(const double rate, const double max_seconds)
+  {
+    return static_cast<std::size_t>(max_seconds * rate) + 16;
+  }
 
 
 

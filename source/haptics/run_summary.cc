@@ -60,6 +60,9 @@ namespace palpate
               {"period_max_ms", number(s.period_max_ms)},
               {"interpolation_p50_us", number(s.interpolation_p50_us)},
               {"interpolation_p999_us", number(s.interpolation_p999_us)},
+              {"initial_cloud_states", number(s.initial_cloud_states)},
+              {"initial_cloud_complete",
+               s.initial_cloud_complete ? "true" : "false"},
               {"shape_frames", number(s.shape_frames)}};
     }
   } // namespace

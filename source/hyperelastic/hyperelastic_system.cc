@@ -68,6 +68,23 @@ namespace palpate
                   double                    *residual,
                   double                    *matrix) const;
 
+    /** F = I + grad u at quadrature point @p q of cell @p c. */
+    Tensor<2, 3>
+    deformation_gradient(const std::vector<double> &u,
+                         const unsigned int         c,
+                         const unsigned int         q) const
+    {
+      const unsigned int *dofs = &cell_dofs[c * dofs_per_cell];
+      const double       *g =
+        &gradients[(std::size_t(c) * n_q + q) * n_nodes_per_cell * 3];
+      Tensor<2, 3> F = unit_symmetric_tensor<3>();
+      for (unsigned int k = 0; k < n_nodes_per_cell; ++k)
+        for (unsigned int a = 0; a < 3; ++a)
+          for (unsigned int b = 0; b < 3; ++b)
+            F[a][b] += u[dofs[local_dof[3 * k + a]]] * g[3 * k + b];
+      return F;
+    }
+
     /** Run @p f(c) over all cells, colour by colour, on the arena. */
     template <typename Function>
     bool
@@ -828,25 +845,12 @@ namespace palpate
   double
   HyperelasticSystem::deformed_volume(const std::vector<double> &solution) const
   {
-    const Impl  &s      = *impl;
-    double       volume = 0;
-    Tensor<2, 3> F;
+    const Impl &s      = *impl;
+    double      volume = 0;
     for (unsigned int c = 0; c < s.mesh.n_cells(); ++c)
-      {
-        const unsigned int *dofs = &s.cell_dofs[c * s.dofs_per_cell];
-        for (unsigned int q = 0; q < s.n_q; ++q)
-          {
-            const double *g = &s.gradients[(std::size_t(c) * s.n_q + q) *
-                                           s.n_nodes_per_cell * 3];
-            F               = unit_symmetric_tensor<3>();
-            for (unsigned int k = 0; k < s.n_nodes_per_cell; ++k)
-              for (unsigned int a = 0; a < 3; ++a)
-                for (unsigned int b = 0; b < 3; ++b)
-                  F[a][b] +=
-                    solution[dofs[s.local_dof[3 * k + a]]] * g[3 * k + b];
-            volume += s.JxW[c * s.n_q + q] * determinant(F);
-          }
-      }
+      for (unsigned int q = 0; q < s.n_q; ++q)
+        volume += s.JxW[c * s.n_q + q] *
+                  determinant(s.deformation_gradient(solution, c, q));
     return volume;
   }
 
@@ -1042,24 +1046,13 @@ namespace palpate
   {
     const Impl  &s      = *impl;
     double       energy = 0;
-    Tensor<2, 3> F, P;
+    Tensor<2, 3> P;
     for (unsigned int c = 0; c < s.mesh.n_cells(); ++c)
-      {
-        const unsigned int *dofs = &s.cell_dofs[c * s.dofs_per_cell];
-        for (unsigned int q = 0; q < s.n_q; ++q)
-          {
-            const double *g = &s.gradients[(std::size_t(c) * s.n_q + q) *
-                                           s.n_nodes_per_cell * 3];
-            F               = unit_symmetric_tensor<3>();
-            for (unsigned int k = 0; k < s.n_nodes_per_cell; ++k)
-              for (unsigned int a = 0; a < 3; ++a)
-                for (unsigned int b = 0; b < 3; ++b)
-                  F[a][b] +=
-                    solution[dofs[s.local_dof[3 * k + a]]] * g[3 * k + b];
-            energy +=
-              s.JxW[c * s.n_q + q] * s.material->evaluate(F, P, nullptr);
-          }
-      }
+      for (unsigned int q = 0; q < s.n_q; ++q)
+        energy += s.JxW[c * s.n_q + q] *
+                  s.material->evaluate(s.deformation_gradient(solution, c, q),
+                                       P,
+                                       nullptr);
     return energy;
   }
 

@@ -20,9 +20,8 @@
 int
 main()
 {
-  std::ifstream     beam(palpate_source_dir + "/parameters/beam.prm");
-  std::stringstream scene;
-  scene << beam.rdbuf() << R"(
+  write_file("embed.prm",
+             read_file(palpate_source_dir + "/parameters/beam.prm") + R"(
 subsection State space
   set Grid spacing = 0.002
   set Extent       = 0.014
@@ -33,8 +32,7 @@ end
 subsection Engine
   set Workers = 2
 end
-)";
-  write_file("embed.prm", scene.str());
+)");
 
   // Run the example with its standard output captured.
   std::ostringstream captured;

@@ -51,10 +51,8 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  std::ifstream     beam(palpate_source_dir + "/parameters/beam.prm");
-  std::stringstream text;
-  text << beam.rdbuf();
-  text << R"(
+  const std::string text =
+    read_file(palpate_source_dir + "/parameters/beam.prm") + R"(
 subsection Material model
   subsection St.Venant-Kirchhoff
     set Young's modulus = 1e6
@@ -92,7 +90,7 @@ subsection Output
   set Summary formats = csv, json
 end
 )";
-  write_file("realtime.prm", text.str());
+  write_file("realtime.prm", text);
   std::filesystem::remove_all("realtime-output");
 
   std::ostringstream report;
@@ -173,10 +171,8 @@ end
   for (const auto &entry :
        std::filesystem::directory_iterator("realtime-output"))
     vtus += entry.path().extension() == ".vtu";
-  std::ifstream pvd("realtime-output/realtime-shape.pvd");
-  std::string   pvd_text((std::istreambuf_iterator<char>(pvd)),
-                       std::istreambuf_iterator<char>());
-  unsigned int  datasets = 0;
+  const std::string pvd_text = read_file("realtime-output/realtime-shape.pvd");
+  unsigned int      datasets = 0;
   for (std::size_t at = pvd_text.find("<DataSet"); at != std::string::npos;
        at             = pvd_text.find("<DataSet", at + 1))
     ++datasets;

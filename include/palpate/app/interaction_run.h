@@ -4,6 +4,8 @@
 #ifndef palpate_app_interaction_run_h
 #define palpate_app_interaction_run_h
 
+#include <palpate/haptics/run_summary.h>
+
 #include <iosfwd>
 
 namespace palpate
@@ -15,9 +17,9 @@ namespace palpate
    * simulated device along the scene's trajectory with the built-in haptic
    * loop, report missing-data events as they happen, detach, and print the
    * run summary (and write it as CSV/JSON, the force log and the shape
-   * frames when the scene asks for them).
+   * frames when the scene asks for them). Returns the summary.
    */
-  void
+  RunSummary
   run_interaction(std::ostream &out, const Scene &scene);
 } // namespace palpate
 

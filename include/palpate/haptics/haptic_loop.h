@@ -100,6 +100,11 @@ namespace palpate
 
     ~HapticLoop();
 
+    /** The most ticks a loop at @p rate bounded by @p max_seconds runs
+     * (what a device's preallocated log must hold). */
+    static std::size_t
+    max_ticks(const double rate, const double max_seconds);
+
     /** Start the thread; the HIP rests until start_motion(). */
     void
     start(const double motion_duration);

@@ -48,6 +48,11 @@ namespace palpate
            period_max_ms        = 0;
     double interpolation_p50_us = 0, interpolation_p999_us = 0;
 
+    // The initial cloud (palpate's own run only): states available when
+    // the motion started, and whether the cloud was complete then.
+    unsigned int initial_cloud_states   = 0;
+    bool         initial_cloud_complete = false;
+
     // Shape output.
     unsigned int shape_frames = 0;
 
