@@ -6,6 +6,8 @@
 #include <palpate/app/scene_report.h>
 #include <palpate/app/static_solve.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/engine/mpi_engine.h>
+#include <palpate/haptics/run_summary.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
@@ -41,6 +43,50 @@ namespace palpate
       "(default.prm, liver-stvk.prm, liver-mooney-rivlin.prm, beam.prm) and\n"
       "doc/parameters.md documents every entry.\n";
 
+    /** Whether the ranks 1..N-1 of an MPI run serve this run as solver
+     * servers: an interaction with Engine / Type = mpi under mpirun. */
+    bool
+    serves(const Scene &scene, const bool solve)
+    {
+      return !solve && mpi_size() > 1 &&
+             scene.parameters.engine.type == "mpi" &&
+             scene.parameters.run.mode == "interaction";
+    }
+
+    /**
+     * A rank other than 0 of an MPI run: a solver server if the command
+     * is an interaction with the MPI engine; otherwise nothing (rank 0
+     * does the work and reports). Input errors are rank 0's to report.
+     */
+    int
+    run_server_rank(const std::vector<std::string> &args, std::ostream &err)
+    {
+      if (args.size() != 1 || args[0].empty() || args[0][0] == '-' ||
+          args[0] == "solve")
+        return ExitStatus::success;
+      try
+        {
+          const Scene scene = Scene::read(args[0]);
+          if (!serves(scene, false))
+            return ExitStatus::success;
+          const Mesh          mesh  = Mesh::create(scene);
+          const NodeSelection nodes = NodeSelection::create(scene, mesh);
+          return run_solver_server(scene, mesh, nodes) == 0 ?
+                   ExitStatus::success :
+                   ExitStatus::internal_error;
+        }
+      catch (const InputError &)
+        {
+          return ExitStatus::input_error;
+        }
+      catch (const std::exception &e)
+        {
+          err << "\npalpate (solver server, MPI rank " << mpi_rank()
+              << "): internal error: " << e.what() << "\n";
+          return ExitStatus::internal_error;
+        }
+    }
+
     /**
      * Set up a scene (read it, build the mesh, select the nodes), report
      * it, and do what its Run / Mode says: an interaction, a static solve
@@ -57,14 +103,28 @@ namespace palpate
       const Scene         scene = Scene::read(filename);
       const Mesh          mesh  = Mesh::create(scene);
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
+      const auto         &mode  = scene.parameters.run.mode;
+      // Under mpirun the other ranks got this far too; with the MPI
+      // engine they now wait as solver servers, and are released whatever
+      // happens here (the engine releases them itself when it ends).
+      struct ReleaseServers
+      {
+        ~ReleaseServers()
+        {
+          release_solver_servers();
+        }
+      };
+      std::optional<ReleaseServers> release;
+      if (serves(scene, solve))
+        release.emplace();
       print_scene_report(out, scene, mesh, nodes);
-      const auto &mode = scene.parameters.run.mode;
       if (!solve && mode == "set-up only")
         return ExitStatus::success;
       if (!solve && mode == "interaction")
         {
-          run_interaction(out, scene);
-          return ExitStatus::success;
+          const RunSummary summary = run_interaction(out, scene);
+          return summary.lost_servers.empty() ? ExitStatus::success :
+                                                ExitStatus::server_lost;
         }
       const auto &prescribed = scene.parameters.boundary_conditions.active_node
                                  .prescribed_displacement;
@@ -165,6 +225,8 @@ namespace palpate
   run_application(int argc, char **argv, std::ostream &out, std::ostream &err)
   {
     const std::vector<std::string> args(argv + 1, argv + argc);
+    if (mpi_rank() > 0)
+      return run_server_rank(args, err);
     try
       {
         return dispatch(args, out);

@@ -3,6 +3,7 @@
 
 #include <palpate/base/exceptions.h>
 #include <palpate/engine/hip_channel.h>
+#include <palpate/engine/mpi_engine.h>
 #include <palpate/engine/scheduler.h>
 #include <palpate/engine/thread_engine.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -408,6 +409,14 @@ namespace palpate
 
 
 
+  unsigned int
+  ThreadEngine::n_workers() const
+  {
+    return impl->solvers.size();
+  }
+
+
+
   std::string
   ThreadEngine::description() const
   {
@@ -428,18 +437,29 @@ namespace palpate
   {
     if (scene.parameters.engine.type == "mpi")
       {
-        const unsigned int line = scene.line_of("Engine/Type");
-        throw NotAvailableError(
-          "The MPI engine (solver servers on other machines), asked for by "
-          "Engine / Type = mpi" +
-            (scene.file().empty() ?
-               std::string() :
-               " in '" + scene.file() + "'" +
-                 (line > 0 ? ", line " + std::to_string(line) : "")) +
-            ",",
-          "Set Engine / Type = threads: it runs the same scheduler with "
-          "solver threads on this machine.");
+        if (mpi_size() < 2)
+          throw InputError(
+            scene.file(),
+            scene.line_of("Engine/Type"),
+            "Engine / Type = mpi",
+            "the MPI engine needs solver servers, and this palpate runs "
+            "alone",
+            "start it with mpirun: `mpirun -np 3 palpate " +
+              (scene.file().empty() ? std::string("SCENE.prm") : scene.file()) +
+              "` runs the haptic client and 2 solver servers (add "
+              "--oversubscribe to run more processes than cores); or set "
+              "Engine / Type = threads.");
+        return std::make_unique<MpiEngine>(scene.parameters, grid, cache, hip);
       }
+    if (mpi_size() > 1)
+      throw InputError(
+        scene.file(),
+        scene.line_of("Engine/Type"),
+        "Engine / Type = " + scene.parameters.engine.type,
+        "palpate runs under mpirun with " + std::to_string(mpi_size()) +
+          " processes, but this engine uses threads of one process",
+        "set Engine / Type = mpi to use the other processes as solver "
+        "servers, or run palpate without mpirun.");
     return std::make_unique<ThreadEngine>(
       mesh, nodes, scene.parameters, grid, cache, hip);
   }

@@ -359,9 +359,21 @@ namespace palpate
                          times.end());
         r.median_state_ms = times[times.size() / 2];
       }
-    const unsigned int workers =
-      std::max(1u, s.scene.parameters.engine.workers);
-    r.worker_busy_fraction = span > 0 ? e.busy_time / (span * workers) : 0;
+    r.messages         = e.messages;
+    r.bytes            = e.bytes;
+    r.local_sources    = e.local_sources;
+    r.fetched_sources  = e.fetched_sources;
+    r.states_to_client = e.states_to_client;
+    r.lost_servers     = e.lost_servers;
+    if (!e.transfer_seconds.empty())
+      {
+        auto t = e.transfer_seconds;
+        std::sort(t.begin(), t.end());
+        r.transfer_p50_ms = 1000 * t[t.size() / 2];
+        r.transfer_max_ms = 1000 * t.back();
+      }
+    const unsigned int workers = std::max(1u, s.engine->n_workers());
+    r.worker_busy_fraction     = span > 0 ? e.busy_time / (span * workers) : 0;
     for (unsigned int p = 0; p < s.grid.size(); ++p)
       r.states_used += s.used[p].load(std::memory_order_relaxed);
     r.corner_reads         = s.corner_reads.load();

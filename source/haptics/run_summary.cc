@@ -3,6 +3,7 @@
 
 #include <palpate/haptics/run_summary.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iomanip>
 #include <ostream>
@@ -37,6 +38,14 @@ namespace palpate
               {"solver_errors", number(s.solver_errors)},
               {"median_state_ms", number(s.median_state_ms)},
               {"worker_busy_fraction", number(s.worker_busy_fraction)},
+              {"messages", number(s.messages)},
+              {"bytes", number(s.bytes)},
+              {"local_sources", number(s.local_sources)},
+              {"fetched_sources", number(s.fetched_sources)},
+              {"states_to_client", number(s.states_to_client)},
+              {"transfer_p50_ms", number(s.transfer_p50_ms)},
+              {"transfer_max_ms", number(s.transfer_max_ms)},
+              {"lost_servers", number(s.lost_servers.size())},
               {"states_used", number(s.states_used)},
               {"corner_reads", number(s.corner_reads)},
               {"corner_hits", number(s.corner_hits)},
@@ -94,6 +103,21 @@ namespace palpate
       << "  forces:            largest " << largest_force
       << " N, largest change per tick " << largest_force_change
       << " N, non-finite " << non_finite_forces << "\n";
+    if (messages > 0)
+      {
+        const double n = std::max(1u, states_computed + states_failed);
+        s << "  messages:          " << messages / n << " per state, "
+          << bytes / n << " bytes per state (all ranks)\n"
+          << "  state transfers:   " << fetched_sources
+          << " sources fetched from another server, " << local_sources
+          << " found on the server that got the task; " << states_to_client
+          << " states sent to the client (lazy: "
+          << states_computed - std::min(states_computed, states_to_client)
+          << " never sent); needed to arrived p50 " << transfer_p50_ms
+          << " ms, max " << transfer_max_ms << " ms\n";
+      }
+    for (const auto &lost : lost_servers)
+      s << "  LOST:              " << lost << "\n";
     if (solver_errors > 0)
       s << "  solver errors:     " << solver_errors
         << " solves threw (counted as failure points); the last: "

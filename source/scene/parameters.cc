@@ -781,20 +781,39 @@ namespace palpate
                           "threads",
                           Patterns::Selection("threads|mpi"),
                           "Where states are computed: solver workers as "
-                          "threads of this process, or MPI solver servers.");
+                          "threads of this process, or MPI solver servers "
+                          "(run as `mpirun -np N palpate SCENE.prm`: rank 0 "
+                          "is the haptic client, ranks 1..N-1 are N-1 "
+                          "solver servers).");
         prm.declare_entry("Workers",
                           "2",
                           Patterns::Integer(1),
-                          "Number of solver workers, each computing one "
+                          "Number of solver threads, each computing one "
                           "state at a time with its own FE solver "
-                          "(dimensionless).");
+                          "(dimensionless). With Type = mpi the number of "
+                          "servers is set by mpirun -np, and this entry is "
+                          "not used.");
         prm.declare_entry(
           "Memory budget",
           "1024",
           Patterns::Double(1.),
-          "Memory for the whole states kept in the cache (MiB). "
-          "Beyond it, the states farthest from the HIP are "
-          "dropped; their forces stay.");
+          "Memory for the whole states kept in the cache (MiB); "
+          "with Type = mpi, on each server (and on the client, for "
+          "the states its shape output fetched). Beyond it, the "
+          "states farthest from the HIP are dropped; their forces "
+          "stay.");
+        prm.declare_entry("Server timeout",
+                          "5",
+                          Patterns::Double(0.1),
+                          "Type = mpi: a solver server that has sent "
+                          "nothing (it sends a heartbeat every 0.1 s) for "
+                          "this long is lost: it gets no more work and its "
+                          "task is planned again (s).");
+        prm.declare_entry("Task timeout",
+                          "60",
+                          Patterns::Double(0.1),
+                          "Type = mpi: a server whose task has run this "
+                          "long is treated as hung and lost (s).");
       }
       prm.leave_subsection();
     }
@@ -806,9 +825,11 @@ namespace palpate
     {
       prm.enter_subsection("Engine");
       {
-        type          = prm.get("Type");
-        workers       = prm.get_integer("Workers");
-        memory_budget = prm.get_double("Memory budget");
+        type           = prm.get("Type");
+        workers        = prm.get_integer("Workers");
+        memory_budget  = prm.get_double("Memory budget");
+        server_timeout = prm.get_double("Server timeout");
+        task_timeout   = prm.get_double("Task timeout");
       }
       prm.leave_subsection();
     }

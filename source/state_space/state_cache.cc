@@ -48,6 +48,7 @@ namespace palpate
     , entries(new Entry[grid.size()])
     , current_generation(1)
     , states(grid.size())
+    , is_wanted(grid.size(), 0)
     , budget(memory_budget)
   {}
 
@@ -77,6 +78,48 @@ namespace palpate
       }
     bytes = 0;
     held  = 0;
+    for (const unsigned int p : wanted)
+      is_wanted[p] = 0;
+    wanted.clear();
+  }
+
+
+
+  void
+  StateCache::publish_force(const unsigned int       point,
+                            const Utilities::Point3 &force,
+                            const std::uint64_t      generation)
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (generation != current_generation.load(std::memory_order_acquire))
+      return;
+    Entry &e = entries[point];
+    if (e.generation.load(std::memory_order_relaxed) == generation &&
+        e.status.load(std::memory_order_relaxed) ==
+          static_cast<std::uint8_t>(PointStatus::available))
+      return; // already available: keep the force the haptic side reads
+    const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
+    e.sequence.store(s + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    for (unsigned int d = 0; d < 3; ++d)
+      e.force[d].store(force[d], std::memory_order_relaxed);
+    e.status.store(static_cast<std::uint8_t>(PointStatus::available),
+                   std::memory_order_relaxed);
+    e.generation.store(generation, std::memory_order_relaxed);
+    e.sequence.store(s + 2, std::memory_order_release);
+  }
+
+
+
+  std::vector<unsigned int>
+  StateCache::take_wanted()
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    std::vector<unsigned int>   taken;
+    taken.swap(wanted);
+    for (const unsigned int p : taken)
+      is_wanted[p] = 0;
+    return taken;
   }
 
 
@@ -227,6 +270,18 @@ namespace palpate
   StateCache::state(const unsigned int point) const
   {
     std::lock_guard<std::mutex> lock(mutex);
+    if (!states[point] && !is_wanted[point])
+      {
+        const Entry &e = entries[point];
+        if (e.generation.load(std::memory_order_relaxed) ==
+              current_generation.load(std::memory_order_relaxed) &&
+            e.status.load(std::memory_order_relaxed) ==
+              static_cast<std::uint8_t>(PointStatus::available))
+          {
+            is_wanted[point] = 1;
+            wanted.push_back(point);
+          }
+      }
     return states[point];
   }
 

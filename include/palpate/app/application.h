@@ -21,6 +21,9 @@ namespace palpate
     constexpr int not_available = 3;
     /** A static solve ended in a failure point (no equilibrium found). */
     constexpr int solve_failed = 4;
+    /** An MPI solver server was lost during the run (the summary says
+     * which and why); what the others computed was used. */
+    constexpr int server_lost = 5;
   } // namespace ExitStatus
 
   /**

@@ -7,6 +7,7 @@
 #include <palpate/base/utilities.h>
 #include <palpate/hyperelastic/state.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,6 +51,21 @@ namespace palpate
     unsigned int            errors = 0;
     std::string             last_error;
     std::vector<TaskRecord> tasks;
+
+    /** The MPI engine's traffic (zero for the threaded engine): messages
+     * and bytes sent by all ranks. */
+    std::uint64_t messages = 0, bytes = 0;
+    /** Tasks whose source the chosen server already held (no transfer),
+     * and tasks that fetched their source from another server. */
+    unsigned int local_sources = 0, fetched_sources = 0;
+    /** Whole states sent to the client (lazy transfer: only those its
+     * shape output asked for), and seconds from "needed" to "arrived" of
+     * each transfer (server-to-server and to the client). */
+    unsigned int        states_to_client = 0;
+    std::vector<double> transfer_seconds;
+    /** Solver servers lost during the run, one sentence each (which, when,
+     * why, what was re-planned). */
+    std::vector<std::string> lost_servers;
   };
 
   /**
@@ -92,6 +108,11 @@ namespace palpate
     /** A copy of the counters and the task log. */
     virtual EngineStatistics
     statistics() const = 0;
+
+    /** How many states can be computed at once (solver threads or
+     * servers). */
+    virtual unsigned int
+    n_workers() const = 0;
 
     /** A description, e.g. "2 solver threads". */
     virtual std::string

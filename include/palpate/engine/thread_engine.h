@@ -50,6 +50,9 @@ namespace palpate
     EngineStatistics
     statistics() const override;
 
+    unsigned int
+    n_workers() const override;
+
     std::string
     description() const override;
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace palpate
 {
@@ -27,6 +28,17 @@ namespace palpate
     unsigned int solver_errors = 0;
     std::string  last_solver_error;
     double       median_state_ms = 0, worker_busy_fraction = 0;
+
+    // The MPI engine's traffic (zero with threads): messages and bytes
+    // sent by all ranks, sources found on the chosen server and fetched
+    // from another, whole states sent to the client, and the time from
+    // "needed" to "arrived" of a transfer (median and largest, ms).
+    std::uint64_t messages = 0, bytes = 0;
+    unsigned int  local_sources = 0, fetched_sources = 0, states_to_client = 0;
+    double        transfer_p50_ms = 0, transfer_max_ms = 0;
+    /** Solver servers lost, one sentence each (the run then exits with a
+     * non-zero status). */
+    std::vector<std::string> lost_servers;
 
     // What the haptic side read.
     unsigned int  states_used  = 0;

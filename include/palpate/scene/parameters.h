@@ -241,8 +241,13 @@ namespace palpate
       /** "threads" or "mpi". */
       std::string  type;
       unsigned int workers;
-      /** Memory for whole states in the cache, MiB. */
+      /** Memory for whole states in the cache, MiB (per server under
+       * MPI). */
       double memory_budget;
+      /** MPI: seconds of silence after which a server is lost. */
+      double server_timeout;
+      /** MPI: seconds one task may take before its server is lost. */
+      double task_timeout;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);

@@ -71,6 +71,25 @@ namespace palpate
             std::shared_ptr<const State> state,
             const std::uint64_t          generation);
 
+    /**
+     * Make @p point available with force @p force (N) only, for
+     * @p generation: its whole state is held elsewhere (a solver server of
+     * the MPI engine) and travels here only when state() asks for it.
+     */
+    void
+    publish_force(const unsigned int       point,
+                  const Utilities::Point3 &force,
+                  const std::uint64_t      generation);
+
+    /**
+     * The available points whose whole state was asked for by state() but
+     * is not held here, since the last call (each once). An engine that
+     * holds states elsewhere fetches them and publish()es them (lazy state
+     * transfer); the caller of state() asks again later.
+     */
+    std::vector<unsigned int>
+    take_wanted();
+
     /** Record @p point as a failure point (for @p generation). */
     void
     publish_failure(const unsigned int point, const std::uint64_t generation);
@@ -80,7 +99,9 @@ namespace palpate
     PointStatus
     status(const unsigned int point) const noexcept;
 
-    /** The whole state at @p point, or null if missing, failed or evicted. */
+    /** The whole state at @p point, or null if missing, failed or not held
+     * here (an available point that is not held is remembered as wanted,
+     * see take_wanted()). */
     std::shared_ptr<const State>
     state(const unsigned int point) const;
 
@@ -124,9 +145,13 @@ namespace palpate
     std::atomic<std::uint64_t>                current_generation;
     mutable std::mutex                        mutex;
     std::vector<std::shared_ptr<const State>> states;
-    std::size_t                               bytes = 0, budget;
-    unsigned int                              held = 0, evicted = 0;
-    Utilities::Point3                         focus = {{0, 0, 0}};
+    // Available points asked for by state() but not held (mutable: asking
+    // is a read), and whether each is already in the list.
+    mutable std::vector<unsigned int> wanted;
+    mutable std::vector<std::uint8_t> is_wanted;
+    std::size_t                       bytes = 0, budget;
+    unsigned int                      held = 0, evicted = 0;
+    Utilities::Point3                 focus = {{0, 0, 0}};
   };
 } // namespace palpate
 

@@ -1,0 +1,685 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The client side of the MPI engine (rank 0). See mpi_engine.h for the
+// design; the servers are in mpi_server.cc, the messages in
+// mpi_protocol.h.
+
+#include <palpate/base/exceptions.h>
+#include <palpate/engine/hip_channel.h>
+#include <palpate/engine/mpi_engine.h>
+#include <palpate/engine/mpi_protocol.h>
+#include <palpate/engine/scheduler.h>
+#include <palpate/hyperelastic/state.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <iomanip>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+namespace palpate
+{
+  using namespace MpiProtocol;
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    // Whether some MpiEngine shut the servers down already (or there are
+    // none): release_solver_servers() then has nothing to do.
+    std::atomic<bool> servers_released{false};
+
+    void
+    send_shutdown(Messenger &messenger, const std::vector<bool> &lost)
+    {
+      Header h;
+      h.kind = Kind::shutdown;
+      for (int r = 1; r < messenger.size(); ++r)
+        if (r >= static_cast<int>(lost.size()) || !lost[r])
+          messenger.send(r, pack(h));
+      messenger.flush(5);
+      servers_released = true;
+    }
+  } // namespace
+
+
+
+  int
+  mpi_rank()
+  {
+    int initialized = 0, rank = 0;
+    MPI_Initialized(&initialized);
+    if (initialized)
+      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    return rank;
+  }
+
+
+
+  int
+  mpi_size()
+  {
+    int initialized = 0, size = 1;
+    MPI_Initialized(&initialized);
+    if (initialized)
+      MPI_Comm_size(MPI_COMM_WORLD, &size);
+    return size;
+  }
+
+
+
+  void
+  release_solver_servers()
+  {
+    if (servers_released.exchange(true) || mpi_rank() != client_rank ||
+        mpi_size() < 2)
+      return;
+    Messenger messenger(MPI_COMM_WORLD);
+    send_shutdown(messenger, {});
+  }
+
+
+
+  struct MpiEngine::Impl
+  {
+    Impl(const Parameters::AllParameters &p,
+         const StateGrid                 &grid,
+         StateCache                      &cache,
+         const HipChannel                &hip)
+      : parameters(p)
+      , grid(grid)
+      , cache(cache)
+      , hip(hip)
+      , scheduler(grid, p.scheduler.cloud_radius, p.scheduler.look_ahead_time)
+      , messenger(MPI_COMM_WORLD)
+      , origin(grid.linear({{0, 0, 0}}))
+      , holders(grid.size(), 0)
+      , in_progress(grid.size(), 0)
+      , t0(Clock::now())
+    {}
+
+    /** One solver server, as the client sees it. */
+    struct Server
+    {
+      bool              ready = false, lost = false;
+      int               task = -1; // the target it computes, or -1
+      Clock::time_point task_start, last_heard;
+      // Its counters, as it last reported them.
+      std::uint64_t messages_sent = 0, bytes_sent = 0;
+    };
+
+    double
+    now() const
+    {
+      return std::chrono::duration<double>(Clock::now() - t0).count();
+    }
+
+    std::uint64_t
+    bit(const int rank) const
+    {
+      return std::uint64_t(1) << (rank - 1);
+    }
+
+    /** The scheduler's view of a point (call with the mutex held). */
+    PointKnowledge
+    knowledge(const unsigned int p) const
+    {
+      if (in_progress[p])
+        return PointKnowledge::in_progress;
+      switch (cache.status(p))
+        {
+          case PointStatus::available:
+            return holders[p] != 0 ? PointKnowledge::source :
+                                     PointKnowledge::computed;
+          case PointStatus::failed:
+            return PointKnowledge::failed;
+          default:
+            return PointKnowledge::unknown;
+        }
+    }
+
+    void
+    wait_for_servers();
+
+    void
+    loop();
+
+    void
+    handle(const int from, const std::vector<char> &message);
+
+    void
+    plan_and_dispatch();
+
+    void
+    lose(const int rank, const std::string &why);
+
+    void
+    fetch_wanted_states();
+
+    Parameters::AllParameters parameters;
+    const StateGrid          &grid;
+    StateCache               &cache;
+    const HipChannel         &hip;
+    Scheduler                 scheduler;
+    Messenger                 messenger;
+    const unsigned int        origin;
+    std::vector<Server>       servers; // by rank; [0] unused
+    std::string               linear_solver;
+
+    // Which servers hold the whole state of each point (bit r-1 for rank
+    // r), and which server computes it (its rank, or 0).
+    std::vector<std::uint64_t> holders;
+    std::vector<int>           in_progress;
+    // States the client asked for (lazy transfer to the shape output):
+    // when, and from whom.
+    std::map<unsigned int, std::pair<Clock::time_point, int>> requested;
+
+    mutable std::mutex      mutex;
+    std::condition_variable stopped;
+    std::atomic<bool>       attached{false}, quit{false};
+    unsigned int            busy            = 0;
+    bool                    nothing_to_plan = false, replan = false;
+    std::uint64_t           finished = 0, finished_at_plan = 0;
+    std::uint64_t           bridge_failed_at = ~std::uint64_t(0);
+    GridIndex               bridge_failed_cell{{0, 0, 0}};
+    Clock::time_point       next_tick;
+    std::thread             thread;
+    Clock::time_point       t0;
+    EngineStatistics        stats;
+  };
+
+
+
+  void
+  MpiEngine::Impl::wait_for_servers()
+  {
+    servers.assign(messenger.size(), Server());
+    // Each server builds the mesh and its solver as the client did; a
+    // large mesh takes a while, a server that never reports is lost.
+    const auto        deadline = Clock::now() + std::chrono::seconds(600);
+    unsigned int      ready    = 0;
+    std::vector<char> message;
+    while (ready + 1 < servers.size())
+      {
+        int from = 0;
+        if (messenger.receive(from, message))
+          {
+            const Header h = header_of(message);
+            if (h.kind != Kind::ready || servers[from].ready)
+              continue;
+            if (h.flags & Flags::error)
+              {
+                std::vector<bool> lost(servers.size(), false);
+                send_shutdown(messenger, lost);
+                throw std::runtime_error(
+                  "MPI solver server " + std::to_string(from) +
+                  " could not set up its solver: " + h.text);
+              }
+            servers[from].ready      = true;
+            servers[from].last_heard = Clock::now();
+            linear_solver            = h.text;
+            ++ready;
+          }
+        else if (Clock::now() > deadline)
+          {
+            std::vector<bool> lost(servers.size(), false);
+            send_shutdown(messenger, lost);
+            throw std::runtime_error(
+              "MPI engine: only " + std::to_string(ready) + " of " +
+              std::to_string(servers.size() - 1) +
+              " solver servers reported ready within 600 s");
+          }
+        else
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
+      }
+    // The rest state is known everywhere without computing.
+    for (unsigned int r = 1; r < servers.size(); ++r)
+      holders[origin] |= bit(r);
+  }
+
+
+
+  void
+  MpiEngine::Impl::lose(const int rank, const std::string &why)
+  {
+    Server &s = servers[rank];
+    if (s.lost)
+      return;
+    s.lost = true;
+    std::ostringstream what;
+    what << "solver server " << rank << " lost at t = " << std::fixed
+         << std::setprecision(2) << now() << " s: " << why;
+    if (s.task >= 0)
+      {
+        what << "; its task (grid point " << s.task << ") was planned again";
+        in_progress[s.task] = 0;
+        s.task              = -1;
+        --busy;
+        ++finished;
+      }
+    unsigned int orphans = 0;
+    for (auto &h : holders)
+      if (h & bit(rank))
+        {
+          h &= ~bit(rank);
+          orphans += (h == 0);
+        }
+    if (orphans > 0)
+      what << "; " << orphans
+           << " states only it held are recomputed when needed";
+    stats.lost_servers.push_back(what.str());
+    replan = true;
+  }
+
+
+
+  void
+  MpiEngine::Impl::handle(const int from, const std::vector<char> &message)
+  {
+    if (from <= 0 || from >= static_cast<int>(servers.size()) ||
+        servers[from].lost)
+      return; // a lost server's late words are not trusted
+    Server &server    = servers[from];
+    server.last_heard = Clock::now();
+    const Header h    = header_of(message);
+    switch (h.kind)
+      {
+        case Kind::heartbeat:
+          server.messages_sent = h.messages_sent;
+          server.bytes_sent    = h.bytes_sent;
+          break;
+        case Kind::dropped:
+          holders[h.point] &= ~bit(from);
+          break;
+        case Kind::result:
+          {
+            server.messages_sent = h.messages_sent;
+            server.bytes_sent    = h.bytes_sent;
+            if (server.task != static_cast<int>(h.point))
+              break; // not what we asked it for (cannot happen)
+            server.task          = -1;
+            in_progress[h.point] = 0;
+            --busy;
+            ++finished;
+            replan = true;
+            if (h.flags & Flags::source_missing)
+              {
+                // The holder dropped it (or died) after the plan: not a
+                // failure point, just plan again without that holder.
+                holders[h.source] &= ~(h.source == origin ? 0 : bit(h.holder));
+                break;
+              }
+            if (h.fetch_seconds > 0 && (h.flags & Flags::fetched_source))
+              {
+                ++stats.fetched_sources;
+                stats.transfer_seconds.push_back(h.fetch_seconds);
+                holders[h.source] |= bit(from);
+              }
+            const bool converged = h.flags & Flags::converged;
+            if (h.generation != cache.generation())
+              ++stats.discarded;
+            else if (converged)
+              {
+                holders[h.point] |= bit(from);
+                cache.publish_force(h.point,
+                                    {{h.force[0], h.force[1], h.force[2]}},
+                                    h.generation);
+                ++stats.computed;
+              }
+            else
+              {
+                cache.publish_failure(h.point, h.generation);
+                ++stats.failed;
+              }
+            if (h.flags & Flags::error)
+              {
+                ++stats.errors;
+                stats.last_error = h.text;
+              }
+            const double start =
+              std::chrono::duration<double>(server.task_start - t0).count();
+            stats.busy_time += h.duration;
+            stats.tasks.push_back({h.point,
+                                   h.source,
+                                   start,
+                                   h.duration,
+                                   converged,
+                                   static_cast<SolveStatus>(h.status),
+                                   h.newton_iterations,
+                                   static_cast<unsigned int>(from)});
+            break;
+          }
+        case Kind::state:
+          {
+            const auto r = requested.find(h.point);
+            if (r == requested.end())
+              break;
+            stats.transfer_seconds.push_back(
+              std::chrono::duration<double>(Clock::now() - r->second.first)
+                .count());
+            ++stats.states_to_client;
+            requested.erase(r);
+            auto state = std::make_shared<State>(state_of(message));
+            cache.publish(h.point, std::move(state), h.generation);
+            break;
+          }
+        case Kind::state_missing:
+          holders[h.point] &= ~(h.point == origin ? 0 : bit(from));
+          requested.erase(h.point);
+          break;
+        default:
+          break;
+      }
+  }
+
+
+
+  void
+  MpiEngine::Impl::fetch_wanted_states()
+  {
+    for (const unsigned int p : cache.take_wanted())
+      {
+        if (requested.count(p) || holders[p] == 0)
+          continue; // asked already, or nobody has it (recomputed later)
+        int holder = 0;
+        for (unsigned int r = 1; r < servers.size() && holder == 0; ++r)
+          if ((holders[p] & bit(r)) && !servers[r].lost)
+            holder = r;
+        if (holder == 0)
+          continue;
+        Header request;
+        request.kind       = Kind::request_state;
+        request.point      = p;
+        request.generation = cache.generation();
+        if (messenger.send(holder, pack(request)))
+          requested[p] = {Clock::now(), holder};
+      }
+  }
+
+
+
+  void
+  MpiEngine::Impl::plan_and_dispatch()
+  {
+    Utilities::Point3 position, velocity;
+    hip.read(position, velocity);
+    cache.set_focus(position);
+    GridIndex             cell;
+    std::array<double, 3> local;
+    grid.locate(position, cell, local);
+
+    std::vector<int> free;
+    for (unsigned int r = 1; r < servers.size(); ++r)
+      if (servers[r].ready && !servers[r].lost && servers[r].task < 0)
+        free.push_back(r);
+    const unsigned int alive =
+      std::count_if(servers.begin() + 1, servers.end(), [](const Server &s) {
+        return !s.lost;
+      });
+
+    const bool allow_bridge =
+      !(finished == bridge_failed_at && cell == bridge_failed_cell);
+    const auto plan = scheduler.plan(
+      position,
+      velocity,
+      [this](const unsigned int p) { return knowledge(p); },
+      2 * std::max(1u, alive),
+      allow_bridge);
+    if (plan.empty() && allow_bridge)
+      {
+        bridge_failed_at   = finished;
+        bridge_failed_cell = cell;
+      }
+    nothing_to_plan  = plan.empty();
+    finished_at_plan = finished;
+    replan           = false;
+
+    // Most urgent first; each to a free server that holds its source if
+    // there is one (no transfer), else to the first free server, told
+    // which server to fetch the source from.
+    for (const Task &task : plan)
+      {
+        if (free.empty())
+          break;
+        if (!schedulable(knowledge(task.target)) || holders[task.source] == 0)
+          continue;
+        auto       chosen = std::find_if(free.begin(), free.end(), [&](int r) {
+          return (holders[task.source] & bit(r)) != 0;
+        });
+        const bool local  = chosen != free.end();
+        if (!local)
+          chosen = free.begin();
+        const int rank   = *chosen;
+        int       holder = rank;
+        if (!local)
+          for (unsigned int r = 1; r < servers.size(); ++r)
+            if ((holders[task.source] & bit(r)) && !servers[r].lost)
+              {
+                holder = r;
+                break;
+              }
+        Header h;
+        h.kind       = Kind::task;
+        h.point      = task.target;
+        h.source     = task.source;
+        h.holder     = holder;
+        h.generation = cache.generation();
+        const auto x = grid.position(task.target);
+        for (unsigned int d = 0; d < 3; ++d)
+          h.position[d] = x[d];
+        if (!messenger.send(rank, pack(h)))
+          {
+            lose(rank, "MPI could not send it a task");
+            free.erase(chosen);
+            continue;
+          }
+        if (local && task.source != origin)
+          ++stats.local_sources;
+        Server &s                = servers[rank];
+        s.task                   = task.target;
+        s.task_start             = Clock::now();
+        in_progress[task.target] = rank;
+        ++busy;
+        free.erase(chosen);
+      }
+  }
+
+
+
+  void
+  MpiEngine::Impl::loop()
+  {
+    const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / parameters.scheduler.rate));
+    next_tick = Clock::now();
+    std::vector<char> message;
+    while (!quit)
+      {
+        bool activity = false;
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          int                         from = 0;
+          while (messenger.receive(from, message))
+            {
+              activity = true;
+              handle(from, message);
+            }
+          fetch_wanted_states();
+
+          // Liveness: silence, or a task that never ends.
+          const auto t = Clock::now();
+          for (unsigned int r = 1; r < servers.size(); ++r)
+            {
+              Server &s = servers[r];
+              if (s.lost)
+                continue;
+              const double silent =
+                std::chrono::duration<double>(t - s.last_heard).count();
+              if (silent > parameters.engine.server_timeout)
+                lose(r,
+                     "it sent nothing for " + Utilities::to_string(silent, 3) +
+                       " s (Engine / Server timeout)");
+              else if (s.task >= 0 &&
+                       std::chrono::duration<double>(t - s.task_start).count() >
+                         parameters.engine.task_timeout)
+                lose(r,
+                     "its task ran longer than Engine / Task timeout (" +
+                       Utilities::to_string(parameters.engine.task_timeout, 3) +
+                       " s)");
+            }
+
+          if (attached && (replan || t >= next_tick))
+            {
+              plan_and_dispatch();
+              if (t >= next_tick)
+                next_tick = std::max(next_tick + period, t);
+            }
+          if (!attached && busy == 0)
+            stopped.notify_all();
+        }
+        messenger.progress();
+        if (!activity)
+          std::this_thread::sleep_for(std::chrono::microseconds(200));
+      }
+  }
+
+
+
+  MpiEngine::MpiEngine(const Parameters::AllParameters &parameters,
+                       const StateGrid                 &grid,
+                       StateCache                      &cache,
+                       const HipChannel                &hip)
+    : impl(std::make_unique<Impl>(parameters, grid, cache, hip))
+  {
+    Impl &s = *impl;
+    if (s.messenger.size() > 65)
+      {
+        send_shutdown(s.messenger, {});
+        throw NotAvailableError(
+          "The MPI engine with " + std::to_string(s.messenger.size() - 1) +
+            " solver servers,",
+          "Run it with at most 64 servers (mpirun -np 65 or fewer).");
+      }
+    s.wait_for_servers();
+    servers_released = false;
+    s.thread         = std::thread([&s] { s.loop(); });
+  }
+
+
+
+  MpiEngine::~MpiEngine()
+  {
+    Impl &s = *impl;
+    stop();
+    s.quit = true;
+    if (s.thread.joinable())
+      s.thread.join();
+    std::vector<bool> lost(s.servers.size(), false);
+    for (unsigned int r = 1; r < s.servers.size(); ++r)
+      lost[r] = s.servers[r].lost;
+    send_shutdown(s.messenger, lost);
+  }
+
+
+
+  void
+  MpiEngine::start()
+  {
+    Impl &s = *impl;
+    if (s.attached)
+      return;
+    // The rest state is known without computing: the origin of the grid.
+    if (s.cache.status(s.origin) != PointStatus::available)
+      s.cache.publish_force(s.origin, {{0, 0, 0}}, s.cache.generation());
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.nothing_to_plan  = false;
+    s.replan           = true;
+    s.bridge_failed_at = ~std::uint64_t(0);
+    s.attached         = true;
+  }
+
+
+
+  void
+  MpiEngine::stop()
+  {
+    Impl                        &s = *impl;
+    std::unique_lock<std::mutex> lock(s.mutex);
+    if (!s.attached)
+      return;
+    s.attached = false;
+    // Running tasks finish (their servers may also be lost meanwhile).
+    s.stopped.wait(lock, [&s] { return s.busy == 0; });
+  }
+
+
+
+  bool
+  MpiEngine::running() const
+  {
+    return impl->attached.load();
+  }
+
+
+
+  void
+  MpiEngine::change_parameters(const Parameters::AllParameters &)
+  {
+    throw NotAvailableError(
+      "Changing the parameters during an interaction with Engine / Type = "
+      "mpi,",
+      "Restart palpate with the new scene, or use Engine / Type = threads.");
+  }
+
+
+
+  bool
+  MpiEngine::idle() const
+  {
+    std::lock_guard<std::mutex> lock(impl->mutex);
+    return impl->busy == 0 && impl->nothing_to_plan && !impl->replan &&
+           impl->finished_at_plan == impl->finished;
+  }
+
+
+
+  EngineStatistics
+  MpiEngine::statistics() const
+  {
+    const Impl                 &s = *impl;
+    std::lock_guard<std::mutex> lock(s.mutex);
+    EngineStatistics            e = s.stats;
+    e.messages                    = s.messenger.messages_sent;
+    e.bytes                       = s.messenger.bytes_sent;
+    for (unsigned int r = 1; r < s.servers.size(); ++r)
+      {
+        e.messages += s.servers[r].messages_sent;
+        e.bytes += s.servers[r].bytes_sent;
+      }
+    return e;
+  }
+
+
+
+  unsigned int
+  MpiEngine::n_workers() const
+  {
+    return impl->servers.size() - 1;
+  }
+
+
+
+  std::string
+  MpiEngine::description() const
+  {
+    const unsigned int n = n_workers();
+    return std::to_string(n) + " MPI solver server" + (n > 1 ? "s" : "") +
+           " (1 solver thread each), " + impl->linear_solver;
+  }
+} // namespace palpate

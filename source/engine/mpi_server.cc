@@ -1,0 +1,372 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// A solver server of the MPI engine (ranks 1..N-1). Two threads, as in the
+// paper's Fig. 2:
+// - the solver thread computes one task at a time, start to end;
+// - the communicator (this process's main thread) is the only thread that
+//   calls MPI for palpate: it receives tasks and requests, answers
+//   requests for states this server holds while the solver is busy,
+//   fetches remote sources for the solver, and sends results, drops and
+//   heartbeats. MUMPS runs on MPI_COMM_SELF in the solver thread at the
+//   same time, which is why palpate asks for MPI_THREAD_MULTIPLE.
+
+#include <palpate/engine/mpi_engine.h>
+#include <palpate/engine/mpi_protocol.h>
+#include <palpate/hyperelastic/state_solver.h>
+#include <palpate/scene/scene.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+namespace palpate
+{
+  using namespace MpiProtocol;
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    double
+    seconds_since(const Clock::time_point t)
+    {
+      return std::chrono::duration<double>(Clock::now() - t).count();
+    }
+
+    std::size_t
+    bytes_of(const State &s)
+    {
+      return sizeof(State) +
+             (s.solution.size() + s.multipliers.size()) * sizeof(double);
+    }
+
+    /**
+     * What the two threads of a server share, under one mutex.
+     */
+    struct Shared
+    {
+      std::mutex              mutex;
+      std::condition_variable wake_solver;
+      std::deque<Header>      tasks;
+      bool                    stop = false;
+
+      // The states this server holds, and their bytes; the origin's rest
+      // state is always held and never counted.
+      std::map<unsigned int, std::shared_ptr<const State>> store;
+      std::size_t                                          bytes = 0;
+
+      // A remote source the solver waits for: asked (by the solver),
+      // requested (by the communicator), then arrived or failed.
+      bool                         fetch_asked = false, fetch_sent = false;
+      unsigned int                 fetch_point  = 0;
+      int                          fetch_holder = 0;
+      std::shared_ptr<const State> fetched;
+      bool                         fetch_failed = false;
+
+      // Messages the solver thread wants sent (the communicator sends).
+      std::deque<std::pair<Header, std::shared_ptr<const State>>> outbox;
+    };
+  } // namespace
+
+
+
+  int
+  run_solver_server(const Scene         &scene,
+                    const Mesh          &mesh,
+                    const NodeSelection &nodes,
+                    const ServerFaults  &faults)
+  {
+    Messenger          messenger(MPI_COMM_WORLD);
+    const auto        &p = scene.parameters;
+    const StateGrid    grid(p.state_space.grid_spacing, p.state_space.extent);
+    const unsigned int origin = grid.linear({{0, 0, 0}});
+    const std::size_t  budget =
+      static_cast<std::size_t>(p.engine.memory_budget * 1048576.0);
+
+    // Set up; a failure is reported to the client, which tells the user.
+    std::unique_ptr<StateSolver> solver;
+    {
+      Header ready;
+      ready.kind = Kind::ready;
+      try
+        {
+          solver       = std::make_unique<StateSolver>(mesh, nodes, p);
+          ready.n_dofs = solver->rest_state().solution.size();
+          ready.set_text(solver->linear_solver_name());
+        }
+      catch (const std::exception &e)
+        {
+          ready.flags = Flags::error;
+          ready.set_text(e.what());
+        }
+      messenger.send(client_rank, pack(ready));
+      if (!solver)
+        {
+          messenger.flush(5);
+          return 1;
+        }
+    }
+    const auto rest = std::make_shared<const State>(solver->rest_state());
+
+    Shared shared;
+
+    // The solver thread: one task at a time.
+    std::thread solver_thread([&] {
+      // Below the client's haptic thread when they share a machine.
+      setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+      std::unique_lock<std::mutex> lock(shared.mutex);
+      while (true)
+        {
+          shared.wake_solver.wait(lock, [&] {
+            return shared.stop || !shared.tasks.empty();
+          });
+          if (shared.stop)
+            return;
+          const Header task = shared.tasks.front();
+          shared.tasks.pop_front();
+
+          Header result;
+          result.kind       = Kind::result;
+          result.point      = task.point;
+          result.source     = task.source;
+          result.holder     = task.holder;
+          result.generation = task.generation;
+
+          // The source: the rest state, one held here, or one fetched
+          // from its holder through the communicator.
+          std::shared_ptr<const State> source;
+          if (task.source == origin)
+            source = rest;
+          else if (const auto s = shared.store.find(task.source);
+                   s != shared.store.end())
+            source = s->second;
+          else if (task.holder != messenger.rank())
+            {
+              const auto asked    = Clock::now();
+              shared.fetch_asked  = true;
+              shared.fetch_sent   = false;
+              shared.fetch_point  = task.source;
+              shared.fetch_holder = task.holder;
+              shared.fetched.reset();
+              shared.fetch_failed = false;
+              // The holder answers within a round trip; a holder that
+              // died never does, and the task then ends as
+              // source_missing for the client to plan again.
+              shared.wake_solver.wait_for(lock, std::chrono::seconds(10), [&] {
+                return shared.stop || shared.fetched || shared.fetch_failed;
+              });
+              shared.fetch_asked = false;
+              if (shared.stop)
+                return;
+              source               = shared.fetched;
+              result.fetch_seconds = seconds_since(asked);
+              if (source)
+                {
+                  result.flags |= Flags::fetched_source;
+                  shared.bytes += bytes_of(*source);
+                  shared.store[task.source] = source;
+                }
+            }
+          if (!source)
+            {
+              result.flags |= Flags::source_missing;
+              shared.outbox.emplace_back(result, nullptr);
+              continue;
+            }
+
+          // Solve, with the lock released: the communicator answers
+          // requests meanwhile.
+          lock.unlock();
+          const Utilities::Point3 target{
+            {task.position[0], task.position[1], task.position[2]}};
+          const auto start = Clock::now();
+          State      state;
+          try
+            {
+              state = solver->solve(*source, target);
+            }
+          catch (const std::exception &e)
+            {
+              state.converged = false;
+              result.flags |= Flags::error;
+              result.set_text(e.what());
+            }
+          result.duration          = seconds_since(start);
+          result.status            = static_cast<std::int32_t>(state.status);
+          result.newton_iterations = state.newton_iterations;
+          lock.lock();
+
+          if (state.converged)
+            {
+              result.flags |= Flags::converged;
+              for (unsigned int d = 0; d < 3; ++d)
+                result.force[d] = state.force[d];
+              state.history.clear();
+              state.history.shrink_to_fit();
+              auto held = std::make_shared<const State>(std::move(state));
+              shared.bytes += bytes_of(*held);
+              shared.store[task.point] = std::move(held);
+            }
+          shared.outbox.emplace_back(result, nullptr);
+
+          // Over budget: drop the states farthest from this task's target
+          // (the HIP is near it), and tell the client.
+          if (shared.bytes > budget)
+            {
+              std::vector<std::pair<double, unsigned int>> by_distance;
+              for (const auto &s : shared.store)
+                if (s.first != task.point)
+                  by_distance.emplace_back(
+                    Utilities::distance(grid.position(s.first), target),
+                    s.first);
+              std::sort(by_distance.begin(), by_distance.end());
+              while (shared.bytes > 0.9 * budget && !by_distance.empty())
+                {
+                  const unsigned int q = by_distance.back().second;
+                  by_distance.pop_back();
+                  shared.bytes -= bytes_of(*shared.store[q]);
+                  shared.store.erase(q);
+                  Header dropped;
+                  dropped.kind  = Kind::dropped;
+                  dropped.point = q;
+                  shared.outbox.emplace_back(dropped, nullptr);
+                }
+            }
+        }
+    });
+
+    // The communicator.
+    auto              last_heartbeat = Clock::now() - std::chrono::seconds(1);
+    unsigned int      tasks_received = 0;
+    std::uint64_t     states_sent    = 0;
+    bool              running        = true;
+    std::vector<char> message;
+    while (running)
+      {
+        bool activity = false;
+        int  from     = 0;
+        while (messenger.receive(from, message))
+          {
+            activity       = true;
+            const Header h = header_of(message);
+            switch (h.kind)
+              {
+                case Kind::task:
+                  {
+                    ++tasks_received;
+                    if (faults.die_after_tasks > 0 &&
+                        tasks_received >= faults.die_after_tasks)
+                      std::raise(SIGKILL); // a crashed machine, for tests
+                    std::lock_guard<std::mutex> lock(shared.mutex);
+                    shared.tasks.push_back(h);
+                    shared.wake_solver.notify_all();
+                    break;
+                  }
+                case Kind::request_state:
+                  {
+                    std::shared_ptr<const State> s;
+                    {
+                      std::lock_guard<std::mutex> lock(shared.mutex);
+                      if (h.point == origin)
+                        s = rest;
+                      else if (const auto i = shared.store.find(h.point);
+                               i != shared.store.end())
+                        s = i->second;
+                    }
+                    Header reply = h;
+                    reply.kind   = s ? Kind::state : Kind::state_missing;
+                    reply.holder = messenger.rank();
+                    if (s)
+                      ++states_sent;
+                    messenger.send(from, s ? pack(reply, *s) : pack(reply));
+                    break;
+                  }
+                case Kind::state:
+                case Kind::state_missing:
+                  {
+                    std::lock_guard<std::mutex> lock(shared.mutex);
+                    if (shared.fetch_asked && h.point == shared.fetch_point)
+                      {
+                        if (h.kind == Kind::state)
+                          shared.fetched =
+                            std::make_shared<const State>(state_of(message));
+                        else
+                          shared.fetch_failed = true;
+                        shared.wake_solver.notify_all();
+                      }
+                    break;
+                  }
+                case Kind::shutdown:
+                  running = false;
+                  break;
+                default:
+                  break;
+              }
+          }
+
+        // What the solver thread asked for: a fetch, results, drops.
+        {
+          std::unique_lock<std::mutex> lock(shared.mutex);
+          if (shared.fetch_asked && !shared.fetch_sent)
+            {
+              Header request;
+              request.kind  = Kind::request_state;
+              request.point = shared.fetch_point;
+              if (!messenger.send(shared.fetch_holder, pack(request)))
+                {
+                  shared.fetch_failed = true;
+                  shared.wake_solver.notify_all();
+                }
+              shared.fetch_sent = true;
+            }
+          auto outbox = std::move(shared.outbox);
+          shared.outbox.clear();
+          lock.unlock();
+          for (auto &[h, s] : outbox)
+            {
+              // The counters ride on every result: the client adds up the
+              // traffic of all ranks.
+              h.messages_sent = messenger.messages_sent + 1;
+              h.bytes_sent    = messenger.bytes_sent + sizeof(Header);
+              h.states_sent   = states_sent;
+              messenger.send(client_rank, pack(h));
+              activity = true;
+            }
+        }
+        if (seconds_since(last_heartbeat) >= 0.1)
+          {
+            Header beat;
+            beat.kind          = Kind::heartbeat;
+            beat.messages_sent = messenger.messages_sent + 1;
+            beat.bytes_sent    = messenger.bytes_sent + sizeof(Header);
+            beat.states_sent   = states_sent;
+            messenger.send(client_rank, pack(beat));
+            last_heartbeat = Clock::now();
+          }
+        messenger.progress();
+        if (!activity)
+          std::this_thread::sleep_for(std::chrono::microseconds(200));
+      }
+
+    {
+      std::lock_guard<std::mutex> lock(shared.mutex);
+      shared.stop = true;
+      shared.wake_solver.notify_all();
+    }
+    solver_thread.join();
+    messenger.flush(5);
+    return 0;
+  }
+} // namespace palpate
