@@ -123,8 +123,17 @@ namespace palpate
       if (!solve && mode == "interaction")
         {
           const RunSummary summary = run_interaction(out, scene);
-          return summary.lost_servers.empty() ? ExitStatus::success :
-                                                ExitStatus::server_lost;
+          if (summary.lost_servers.empty())
+            return ExitStatus::success;
+          // mpirun --enable-recovery (needed to survive a dead server)
+          // itself exits 0 whatever the ranks return: say it plainly.
+          out.flush();
+          std::cerr << "\npalpate: " << summary.lost_servers.size()
+                    << " MPI solver server(s) lost during the run (LOST in the "
+                       "summary above); the interaction went on with the "
+                       "others. Exit status "
+                    << ExitStatus::server_lost << ".\n";
+          return ExitStatus::server_lost;
         }
       const auto &prescribed = scene.parameters.boundary_conditions.active_node
                                  .prescribed_displacement;
