@@ -18,6 +18,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <iomanip>
 #include <map>
 #include <mutex>
@@ -107,9 +108,12 @@ namespace palpate
     /** One solver server, as the client sees it. */
     struct Server
     {
-      bool              ready = false, lost = false;
-      int               task = -1; // the target it computes, or -1
-      Clock::time_point task_start, last_heard;
+      bool ready = false, lost = false;
+      // The targets it was given, in order: the first is being computed
+      // (since task_start), the next waits on the server so that it never
+      // idles for a round trip between two tasks.
+      std::deque<unsigned int> tasks;
+      Clock::time_point        task_start, last_heard;
       // Its counters, as it last reported them.
       std::uint64_t messages_sent = 0, bytes_sent = 0;
     };
@@ -255,13 +259,19 @@ namespace palpate
     std::ostringstream what;
     what << "solver server " << rank << " lost at t = " << std::fixed
          << std::setprecision(2) << now() << " s: " << why;
-    if (s.task >= 0)
+    if (!s.tasks.empty())
       {
-        what << "; its task (grid point " << s.task << ") was planned again";
-        in_progress[s.task] = 0;
-        s.task              = -1;
-        --busy;
-        ++finished;
+        what << "; its task" << (s.tasks.size() > 1 ? "s" : "")
+             << " (grid point";
+        for (const unsigned int t : s.tasks)
+          {
+            what << " " << t;
+            in_progress[t] = 0;
+            --busy;
+            ++finished;
+          }
+        what << ") planned again";
+        s.tasks.clear();
       }
     unsigned int orphans = 0;
     for (auto &h : holders)
@@ -301,9 +311,12 @@ namespace palpate
           {
             server.messages_sent = h.messages_sent;
             server.bytes_sent    = h.bytes_sent;
-            if (server.task != static_cast<int>(h.point))
+            if (server.tasks.empty() || server.tasks.front() != h.point)
               break; // not what we asked it for (cannot happen)
-            server.task          = -1;
+            const double start =
+              std::chrono::duration<double>(server.task_start - t0).count();
+            server.tasks.pop_front();
+            server.task_start    = Clock::now(); // the next one starts now
             in_progress[h.point] = 0;
             --busy;
             ++finished;
@@ -342,8 +355,6 @@ namespace palpate
                 ++stats.errors;
                 stats.last_error = h.text;
               }
-            const double start =
-              std::chrono::duration<double>(server.task_start - t0).count();
             stats.busy_time += h.duration;
             stats.tasks.push_back({h.point,
                                    h.source,
@@ -414,10 +425,13 @@ namespace palpate
     std::array<double, 3> local;
     grid.locate(position, cell, local);
 
+    // Idle servers first, then each server's second place.
     std::vector<int> free;
-    for (unsigned int r = 1; r < servers.size(); ++r)
-      if (servers[r].ready && !servers[r].lost && servers[r].task < 0)
-        free.push_back(r);
+    for (const unsigned int depth : {0u, 1u})
+      for (unsigned int r = 1; r < servers.size(); ++r)
+        if (servers[r].ready && !servers[r].lost &&
+            servers[r].tasks.size() <= depth)
+          free.push_back(r);
     const unsigned int alive =
       std::count_if(servers.begin() + 1, servers.end(), [](const Server &s) {
         return !s.lost;
@@ -481,9 +495,10 @@ namespace palpate
           }
         if (local && task.source != origin)
           ++stats.local_sources;
-        Server &s                = servers[rank];
-        s.task                   = task.target;
-        s.task_start             = Clock::now();
+        Server &s = servers[rank];
+        if (s.tasks.empty())
+          s.task_start = Clock::now();
+        s.tasks.push_back(task.target);
         in_progress[task.target] = rank;
         ++busy;
         free.erase(chosen);
@@ -525,7 +540,7 @@ namespace palpate
                 lose(r,
                      "it sent nothing for " + Utilities::to_string(silent, 3) +
                        " s (Engine / Server timeout)");
-              else if (s.task >= 0 &&
+              else if (!s.tasks.empty() &&
                        std::chrono::duration<double>(t - s.task_start).count() >
                          parameters.engine.task_timeout)
                 lose(r,
@@ -545,7 +560,7 @@ namespace palpate
         }
         messenger.progress();
         if (!activity)
-          std::this_thread::sleep_for(std::chrono::microseconds(200));
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
       }
   }
 

@@ -356,8 +356,12 @@ namespace palpate
             last_heartbeat = Clock::now();
           }
         messenger.progress();
+        // Polling every millisecond costs the solver thread (which may
+        // share the core) little and delays a reply by at most that; the
+        // client keeps a second task waiting here, so the solver never
+        // waits for the communicator between two tasks.
         if (!activity)
-          std::this_thread::sleep_for(std::chrono::microseconds(200));
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
 
     {
