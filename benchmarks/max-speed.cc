@@ -3,6 +3,7 @@
 
 // benchmarks/run max-speed [--quick] [--material stvk|mr|all]
 //                          [--spacing 5,10] [--workers 1,2]
+//                          [--engine threads|mpi|all]
 //                          [--length CM] [--no-studies]
 //
 // The paper's headline experiment, measured: the largest speed at which the
@@ -24,13 +25,22 @@
 // ("fast"). Target: >= 28 mm/s for both materials on this 2-core machine,
 // with zero deadline misses (ticks > 0.5 ms late).
 //
+// Engines: solver threads in the client's process (1 and 2 workers), and
+// the MPI engine, 1 client + 2 solver servers on the same 2 cores
+// (mpirun --oversubscribe -np 3; each trial re-runs this program under
+// mpirun, rank 0 measuring). Target (issue 8): MPI >= 150 mm/s StVK and
+// >= 120 mm/s Mooney-Rivlin at h = 5 mm.
+//
 // Study (unless --no-studies or --quick): what accuracy costs in speed, the
 // Newton residual tolerance 1e-4 / 1e-6 / 1e-8 (the default), StVK, 5 mm,
 // one worker.
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
+#include <palpate/engine/mpi_engine.h>
 #include <palpate/haptics/run_summary.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 
 #include <pthread.h>
@@ -48,6 +58,8 @@
 #include <thread>
 #include <vector>
 
+#include "mpi_child.h"
+
 using namespace palpate;
 using Utilities::Point3;
 
@@ -59,6 +71,7 @@ namespace
     std::vector<std::string>  materials = {"stvk", "mr"};
     std::vector<double>       spacings  = {5, 10};
     std::vector<unsigned int> workers   = {1, 2};
+    std::vector<std::string>  engines   = {"threads", "mpi"};
     double                    length    = 0.08; // m
     bool                      studies   = true;
   };
@@ -80,6 +93,7 @@ namespace
     double       spacing_mm;
     unsigned int workers;
     double       tolerance;
+    std::string  engine = "threads";
   };
 
   const Point3 direction{{-1, 0, 0}};
@@ -93,6 +107,7 @@ namespace
     auto &p                               = scene.parameters;
     p.state_space.grid_spacing            = 1e-3 * c.spacing_mm;
     p.engine.workers                      = c.workers;
+    p.engine.type                         = c.engine;
     p.nonlinear_solver.residual_tolerance = c.tolerance;
     p.haptics.loop_rate                   = 1000;
     p.haptics.trajectory.type             = "straight line";
@@ -108,6 +123,34 @@ namespace
   Trial
   run_trial(Scene scene, const double speed, const double length)
   {
+    if (scene.parameters.engine.type == "mpi" && mpi_size() == 1)
+      {
+        // Under mpirun, as `mpirun -np 3 palpate scene.prm` runs it: this
+        // program again, as a child (see child() below).
+        const auto        &p = scene.parameters;
+        std::ostringstream a;
+        a << std::setprecision(17) << "--child "
+          << (p.material_model.model_name == "St.Venant-Kirchhoff" ? "stvk" :
+                                                                     "mr")
+          << " " << 1000 * p.state_space.grid_spacing << " "
+          << p.nonlinear_solver.residual_tolerance << " " << speed << " "
+          << length;
+        const auto v = mpi_child::run(mpi_child::command(3, a.str()));
+        Trial      t;
+        t.speed           = speed;
+        t.passed          = v.at("passed") == "1";
+        t.missing         = std::stoull(v.at("missing"));
+        t.deadline_misses = std::stoull(v.at("deadline_misses"));
+        t.missing_seconds = std::stod(v.at("missing_seconds"));
+        t.state_ms        = std::stod(v.at("state_ms"));
+        t.cloud_seconds   = std::stod(v.at("cloud_seconds"));
+        t.states          = std::stoul(v.at("states"));
+        t.failures        = std::stoul(v.at("failures"));
+        t.cloud_states    = std::stoul(v.at("cloud_states"));
+        t.realtime        = v.at("realtime") == "1";
+        t.complete_cloud  = v.at("complete_cloud") == "1";
+        return t;
+      }
     scene.parameters.haptics.trajectory.speed    = speed;
     scene.parameters.haptics.trajectory.duration = length / speed;
     std::ostringstream quiet;
@@ -242,11 +285,45 @@ namespace
   }
 } // namespace
 
+namespace
+{
+  /**
+   * A trial of the MPI engine, under mpirun: rank 0 runs it and prints it
+   * as a CHILD line; the other ranks serve.
+   * Arguments: material h_mm tolerance speed length.
+   */
+  int
+  child(const std::vector<std::string> &a)
+  {
+    const Configuration c{a[0], std::stod(a[1]), 2, std::stod(a[2]), "mpi"};
+    const Scene         scene = scene_for(c);
+    if (mpi_rank() > 0)
+      {
+        const Mesh          mesh  = Mesh::create(scene);
+        const NodeSelection nodes = NodeSelection::create(scene, mesh);
+        return run_solver_server(scene, mesh, nodes);
+      }
+    const Trial t = run_trial(scene, std::stod(a[3]), std::stod(a[4]));
+    std::cout << "CHILD passed=" << t.passed << " missing=" << t.missing
+              << " deadline_misses=" << t.deadline_misses
+              << " missing_seconds=" << t.missing_seconds
+              << " state_ms=" << t.state_ms
+              << " cloud_seconds=" << t.cloud_seconds << " states=" << t.states
+              << " failures=" << t.failures
+              << " cloud_states=" << t.cloud_states
+              << " realtime=" << t.realtime
+              << " complete_cloud=" << t.complete_cloud << std::endl;
+    return 0;
+  }
+} // namespace
+
 int
 main(int argc, char **argv)
 {
   Environment env(argc, argv);
-  Options     o;
+  if (argc == 7 && std::string(argv[1]) == "--child")
+    return child(std::vector<std::string>(argv + 2, argv + argc));
+  Options o;
   for (int i = 1; i < argc; ++i)
     {
       const std::string a    = argv[i];
@@ -275,6 +352,14 @@ main(int argc, char **argv)
           for (const auto &s : Utilities::split(next(), ','))
             o.workers.push_back(std::stoul(s));
         }
+      else if (a == "--engine")
+        {
+          const std::string e = next();
+          o.engines = e == "all" ? std::vector<std::string>{"threads", "mpi"} :
+                                   std::vector<std::string>{e};
+          if (e != "all" && e != "threads" && e != "mpi")
+            throw std::invalid_argument("--engine must be threads, mpi or all");
+        }
       else if (a == "--length")
         o.length = 0.01 * std::stod(next());
       else if (a == "--no-studies")
@@ -284,7 +369,8 @@ main(int argc, char **argv)
           std::cerr
             << "max-speed: unknown option " << a
             << "\nusage: benchmarks/run max-speed [--quick] [--material stvk|mr|all] "
-               "[--spacing 5,10] [--workers 1,2] [--length CM] [--no-studies]\n";
+               "[--spacing 5,10] [--workers 1,2] [--engine threads|mpi|all] "
+               "[--length CM] [--no-studies]\n";
           return 2;
         }
     }
@@ -298,6 +384,7 @@ main(int argc, char **argv)
     {
       o.materials = {"stvk"};
       o.spacings  = {10};
+      o.workers   = {2};
       o.length    = 0.06;
       o.studies   = false;
     }
@@ -327,16 +414,19 @@ main(int argc, char **argv)
   std::vector<Row> rows;
   for (const auto &m : o.materials)
     for (const double h : o.spacings)
-      for (const unsigned int w : o.workers)
-        {
-          const Configuration c{m, h, w, 1e-8};
-          std::cout << (m == "stvk" ? "St.Venant-Kirchhoff" :
-                                      "Mooney-Rivlin (P1-P1)")
-                    << ", h = " << h << " mm, " << w << " worker"
-                    << (w > 1 ? "s" : "") << ":" << std::endl;
-          const auto [t, n] = search(c, o);
-          rows.push_back({c, t, n});
-        }
+      for (const auto &e : o.engines)
+        for (const unsigned int w :
+             e == "mpi" ? std::vector<unsigned int>{2} : o.workers)
+          {
+            const Configuration c{m, h, w, 1e-8, e};
+            std::cout << (m == "stvk" ? "St.Venant-Kirchhoff" :
+                                        "Mooney-Rivlin (P1-P1)")
+                      << ", h = " << h << " mm, " << w
+                      << (e == "mpi" ? " MPI server" : " worker")
+                      << (w > 1 ? "s" : "") << ":" << std::endl;
+            const auto [t, n] = search(c, o);
+            rows.push_back({c, t, n});
+          }
 
   std::vector<Row> study;
   if (o.studies)
@@ -351,7 +441,7 @@ main(int argc, char **argv)
       }
 
   const auto table = [](const std::vector<Row> &r, const bool with_tolerance) {
-    std::cout << "\n  material            h (mm)  workers"
+    std::cout << "\n  material            h (mm)  engine   workers"
               << (with_tolerance ? "  tolerance" : "")
               << "  max speed (mm/s)  state (ms)  deadline misses  trials\n";
     for (const auto &x : r)
@@ -359,7 +449,9 @@ main(int argc, char **argv)
                 << (x.c.material == "stvk" ? "St.Venant-Kirchhoff" :
                                              "Mooney-Rivlin P1-P1")
                 << std::right << std::setw(6) << std::setprecision(0)
-                << std::fixed << x.c.spacing_mm << std::setw(9) << x.c.workers
+                << std::fixed << x.c.spacing_mm << "  " << std::left
+                << std::setw(7) << x.c.engine << std::right << std::setw(9)
+                << x.c.workers
                 << (with_tolerance ?
                       [&] {
                         std::ostringstream s;
@@ -387,7 +479,7 @@ main(int argc, char **argv)
     std::cout << "RESULT max-speed material="
               << (x.c.material == "stvk" ? "stvk" : "mooney-rivlin")
               << " h_mm=" << std::setprecision(0) << x.c.spacing_mm
-              << " workers=" << x.c.workers
+              << " engine=" << x.c.engine << " workers=" << x.c.workers
               << " speed_mm_s=" << std::setprecision(1) << 1000 * x.t.speed
               << " state_ms=" << x.t.state_ms
               << " deadline_misses=" << x.t.deadline_misses

@@ -463,10 +463,17 @@ namespace palpate
           break;
         if (!schedulable(knowledge(task.target)) || holders[task.source] == 0)
           continue;
-        auto       chosen = std::find_if(free.begin(), free.end(), [&](int r) {
+        // Among the places of the least loaded servers (an idle server
+        // never waits while another gets a second task), one whose server
+        // holds the source.
+        const std::size_t depth = servers[free.front()].tasks.size();
+        const auto last   = std::find_if(free.begin(), free.end(), [&](int r) {
+          return servers[r].tasks.size() > depth;
+        });
+        auto       chosen = std::find_if(free.begin(), last, [&](int r) {
           return (holders[task.source] & bit(r)) != 0;
         });
-        const bool local  = chosen != free.end();
+        const bool local  = chosen != last;
         if (!local)
           chosen = free.begin();
         const int rank   = *chosen;

@@ -140,7 +140,7 @@ main(int argc, char **argv)
         "  set File name = inverted-liver.msh\n"
         "  set Scale factor = 0.039146\nend\n");
 
-  scene("an engine this version does not have (exit status 3)",
+  scene("the MPI engine without mpirun (exit status 2)",
         "mpi.prm",
         beam + "subsection Engine\n  set Type = mpi\nend\n"
                "subsection Run\n  set Mode = interaction\nend\n");
