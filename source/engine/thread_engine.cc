@@ -66,18 +66,9 @@ namespace palpate
     PointKnowledge
     knowledge(const unsigned int p) const
     {
-      if (in_progress[p])
-        return PointKnowledge::in_progress;
-      switch (cache.status(p))
-        {
-          case PointStatus::available:
-            return cache.has_state(p) ? PointKnowledge::source :
-                                        PointKnowledge::computed;
-          case PointStatus::failed:
-            return PointKnowledge::failed;
-          default:
-            return PointKnowledge::unknown;
-        }
+      return point_knowledge(in_progress[p] != 0,
+                             cache.status(p),
+                             cache.has_state(p));
     }
 
     void

@@ -5,6 +5,7 @@
 #define palpate_engine_scheduler_h
 
 #include <palpate/base/utilities.h>
+#include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
 #include <cstdint>
@@ -43,6 +44,29 @@ namespace palpate
     /** A corner of the HIP's cell: before every other task. */
     bool corner = false;
   };
+
+  /**
+   * What the scheduler knows about a point, from what an engine knows:
+   * whether a task for it is under way, its status in the cache, and
+   * whether its whole state is held somewhere (so it can be a source).
+   */
+  inline PointKnowledge
+  point_knowledge(const bool        in_progress,
+                  const PointStatus status,
+                  const bool        held)
+  {
+    if (in_progress)
+      return PointKnowledge::in_progress;
+    switch (status)
+      {
+        case PointStatus::available:
+          return held ? PointKnowledge::source : PointKnowledge::computed;
+        case PointStatus::failed:
+          return PointKnowledge::failed;
+        default:
+          return PointKnowledge::unknown;
+      }
+  }
 
   /** Whether a point in this state can be the target of a task: unknown,
    * or computed but its whole state dropped (it is then recomputed when
