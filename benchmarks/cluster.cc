@@ -50,6 +50,8 @@
 #include <thread>
 #include <vector>
 
+#include "machine.h"
+
 using namespace palpate;
 using Utilities::Point3;
 
@@ -283,20 +285,6 @@ namespace
       }
   }
 
-  std::string
-  machine()
-  {
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string   line, model = "?";
-    while (std::getline(cpuinfo, line))
-      if (line.rfind("model name", 0) == 0)
-        {
-          model = line.substr(line.find(':') + 2);
-          break;
-        }
-    return model + ", " + std::to_string(std::thread::hardware_concurrency()) +
-           " cores";
-  }
 
   std::string
   needed_text(const int n)

@@ -58,6 +58,7 @@
 #include <thread>
 #include <vector>
 
+#include "machine.h"
 #include "mpi_child.h"
 
 using namespace palpate;
@@ -269,20 +270,6 @@ namespace
     return {misses, late};
   }
 
-  std::string
-  machine()
-  {
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string   line, model = "?";
-    while (std::getline(cpuinfo, line))
-      if (line.rfind("model name", 0) == 0)
-        {
-          model = line.substr(line.find(':') + 2);
-          break;
-        }
-    return model + ", " + std::to_string(std::thread::hardware_concurrency()) +
-           " cores";
-  }
 } // namespace
 
 namespace
