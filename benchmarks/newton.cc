@@ -59,6 +59,10 @@ namespace
     unsigned int targets  = 200;
     unsigned int seed     = 1;
     bool         studies  = true;
+    /** liver501 (the paper's size) or liver2k (2059 nodes, 10223 tets,
+     * the size of the paper authors' second liver), same organ and
+     * coordinates. */
+    std::string mesh = "liver501";
   };
 
   double
@@ -79,6 +83,9 @@ namespace
     std::vector<double>                 iterations; // per converged state
     std::vector<double> assembly, solve, line_search, total; // per iteration, s
     std::vector<double> state_time; // per converged state, s
+    // Newton steps that factorised the tangent, and GMRES iterations of
+    // the steps that did not (Reuse factorization).
+    unsigned int steps = 0, factorized = 0, krylov = 0;
 
     void
     add(const State &s)
@@ -100,6 +107,9 @@ namespace
           solve.push_back(h.solve_time);
           line_search.push_back(h.line_search_time);
           total.push_back(h.assembly_time + h.solve_time + h.line_search_time);
+          ++steps;
+          factorized += h.factorized;
+          krylov += h.factorized ? 0 : h.krylov_iterations;
         }
     }
 
@@ -147,6 +157,11 @@ namespace
                                    "/parameters/liver-stvk.prm"));
       if (o.material == "nh")
         scene.parameters.material_model.model_name = "Neo-Hookean";
+      if (o.mesh != "liver501")
+        {
+          auto &file = scene.parameters.mesh.file_name;
+          file.replace(file.rfind("liver501"), 8, o.mesh);
+        }
       if (o.material == "mr")
         scene.parameters.material_model.mr_element =
           o.element == "taylor-hood" ? "Taylor-Hood" : "P1-P1";
@@ -286,6 +301,8 @@ main(int argc, char **argv)
         o.radius = std::stod(argv[++i]);
       else if (a == "--seed" && i + 1 < argc)
         o.seed = std::stoi(argv[++i]);
+      else if (a == "--mesh" && i + 1 < argc)
+        o.mesh = argv[++i];
       else if (a == "--no-studies")
         o.studies = false;
       else
@@ -296,6 +313,11 @@ main(int argc, char **argv)
     }
   if (o.quick)
     o.spacing = 0.02, o.radius = 0.06, o.targets = 50;
+  if (o.mesh != "liver501" && o.mesh != "liver2k")
+    {
+      std::cerr << "benchmarks/run newton: --mesh is liver501 or liver2k\n";
+      return 2;
+    }
   if ((o.material != "stvk" && o.material != "nh" && o.material != "mr") ||
       (o.element != "p1p1" && o.element != "taylor-hood"))
     {
@@ -309,7 +331,7 @@ main(int argc, char **argv)
   Study                    study(o);
   const auto              &p = study.scene.parameters;
   StateSolver              solver(study.mesh, study.nodes, p);
-  const std::string        mesh_name = "liver501";
+  const std::string        mesh_name = o.mesh;
   const std::string        material =
     o.material == "stvk" ?
              "St.Venant-Kirchhoff" :
@@ -379,6 +401,15 @@ main(int argc, char **argv)
             << std::setw(34) << "time per converged state" << std::setw(26)
             << "-" << ms(median(main.state_time)) << " ms (median)\n"
             << std::right;
+  std::cout << "Newton steps that factorised the tangent: " << main.factorized
+            << " of " << main.steps << "; the others took "
+            << (main.steps > main.factorized ?
+                  double(main.krylov) / (main.steps - main.factorized) :
+                  0.0)
+            << " GMRES iterations on average (Nonlinear solver / Reuse "
+               "factorization = "
+            << (p.nonlinear_solver.reuse_factorization ? "true" : "false")
+            << ")\n";
   std::cout << "Failure points by reason:";
   for (const auto &[reason, count] : main.reasons)
     std::cout << " " << reason << " " << count;
@@ -398,6 +429,73 @@ main(int argc, char **argv)
       << " max_iters=" << main.max_iterations()
       << " failure_pct=" << main.failure_percentage()
       << " state_ms=" << ms(median(main.state_time));
+    results.push_back(r.str());
+  }
+
+  // The engine's path: the cloud around rest on the engine's 5 mm grid,
+  // breadth-first, each state from a converged neighbour, by one solver
+  // that keeps its factorisation from state to state, as a worker does.
+  // Once with a factorisation at every Newton step, once reusing kept
+  // factorisations (GMRES); the forces must agree to 1e-6.
+  {
+    Options e = o;
+    e.spacing = 0.005;
+    e.radius  = o.quick ? 0.015 : 0.025;
+    std::cout << "The engine's path: the " << 1000 * e.radius
+              << " mm cloud around rest, 5 mm grid, breadth-first from "
+                 "neighbours, one solver\n"
+              << "  reuse  states  state (ms)  Newton its  factorisations  "
+                 "GMRES its   (per state, medians and averages)\n";
+    std::map<bool, std::map<std::array<int, 3>, State>> grids;
+    for (const bool reuse : {false, true})
+      {
+        Study       path(e);
+        StateSolver s(path.mesh, path.nodes, path.scene.parameters);
+        s.settings().reuse_factorization = reuse;
+        const Statistics st              = path.build_scaffold(s);
+        grids[reuse]                     = path.grid;
+        const double n                   = std::max(1u, st.states);
+        std::cout << "  " << std::left << std::setw(7) << (reuse ? "yes" : "no")
+                  << std::right << std::setw(6) << st.states << std::setw(12)
+                  << ms(median(st.state_time)) << std::setw(12)
+                  << std::setprecision(3) << st.average_iterations()
+                  << std::setw(16) << st.factorized / n << std::setw(11)
+                  << st.krylov / n << "\n";
+        std::ostringstream r;
+        r << std::setprecision(3) << "RESULT newton study=reuse material="
+          << (o.material == "mr" ? "mooney-rivlin element=" + o.element :
+                                   o.material)
+          << " mesh=" << mesh_name << " reuse=" << (reuse ? "yes" : "no")
+          << " state_ms=" << ms(median(st.state_time))
+          << " avg_iters=" << st.average_iterations()
+          << " factorizations_per_state=" << st.factorized / n
+          << " gmres_per_state=" << st.krylov / n
+          << " failure_pct=" << st.failure_percentage();
+        results.push_back(r.str());
+      }
+    double       largest  = 0;
+    unsigned int compared = 0, differ = 0;
+    for (const auto &[index, a] : grids[false])
+      if (const auto b = grids[true].find(index); b != grids[true].end())
+        {
+          ++compared;
+          const double d = Utilities::distance(a.force, b->second.force) /
+                           std::max(Utilities::norm(a.force), 1e-3);
+          largest = std::max(largest, d);
+          differ += d > 1e-6;
+        }
+    std::cout << "  forces of the " << compared
+              << " states both computed: largest relative difference "
+              << std::setprecision(2) << largest << " ("
+              << (differ == 0 ? "all within 1e-6" :
+                                std::to_string(differ) + " beyond 1e-6")
+              << "); states only one computed: "
+              << grids[false].size() + grids[true].size() - 2 * compared
+              << "\n\n";
+    std::ostringstream r;
+    r << "RESULT newton study=reuse-check compared=" << compared
+      << " max_force_rel_diff=" << std::setprecision(2) << largest
+      << " beyond_1e-6=" << differ;
     results.push_back(r.str());
   }
 

@@ -52,6 +52,120 @@ namespace palpate
         s += x * x;
       return std::sqrt(s);
     }
+
+    double
+    dot(const std::vector<double> &a, const std::vector<double> &b)
+    {
+      double s = 0;
+      for (std::size_t i = 0; i < a.size(); ++i)
+        s += a[i] * b[i];
+      return s;
+    }
+
+    /**
+     * GMRES with right preconditioning for A x = b, from x = 0: Arnoldi
+     * with modified Gram-Schmidt and Givens rotations, no restart.
+     * @p precondition applies M^-1 in place (the kept factorisation of an
+     * earlier tangent). On success @p b holds x with |b - A x| <= @p
+     * tolerance |b|, and the number of iterations is returned; 0 if it
+     * did not converge in @p max_iterations (then @p b is unchanged) or the
+     * preconditioner failed.
+     *
+     * Why GMRES: the tangent with the multiplier rows is symmetric but
+     * indefinite, and so is an LDL^T preconditioner, which rules out CG and
+     * MINRES; GMRES needs neither property, and with a preconditioner
+     * from a nearby state it converges in a few iterations.
+     */
+    unsigned int
+    gmres(const SparsityCSR                                &pattern,
+          const std::vector<double>                        &matrix,
+          const std::function<bool(std::vector<double> &)> &precondition,
+          std::vector<double>                              &b,
+          const double                                      tolerance,
+          const unsigned int                                max_iterations,
+          std::vector<std::vector<double>>                 &V,
+          std::vector<std::vector<double>>                 &Z)
+    {
+      const std::size_t n    = b.size();
+      const double      beta = norm(b);
+      if (beta == 0)
+        return 1;
+      const unsigned int m = max_iterations;
+      V.resize(m + 1);
+      Z.resize(m);
+      std::vector<double> H((m + 1) * m, 0.0), cs(m), sn(m), g(m + 1, 0.0);
+      const auto          h = [&](const unsigned int i,
+                         const unsigned int j) -> double          &{
+        return H[i * m + j];
+      };
+      V[0].resize(n);
+      for (std::size_t i = 0; i < n; ++i)
+        V[0][i] = b[i] / beta;
+      g[0] = beta;
+      for (unsigned int j = 0; j < m; ++j)
+        {
+          Z[j] = V[j];
+          if (!precondition(Z[j]))
+            return 0;
+          // w = A z_j
+          std::vector<double> &w = V[j + 1];
+          w.assign(n, 0.0);
+          for (unsigned int r = 0; r < pattern.n_rows; ++r)
+            {
+              double sum = 0;
+              for (unsigned int k = pattern.row_start[r];
+                   k < pattern.row_start[r + 1];
+                   ++k)
+                sum += matrix[k] * Z[j][pattern.column[k]];
+              w[r] = sum;
+            }
+          for (unsigned int i = 0; i <= j; ++i)
+            {
+              h(i, j) = dot(w, V[i]);
+              for (std::size_t k = 0; k < n; ++k)
+                w[k] -= h(i, j) * V[i][k];
+            }
+          h(j + 1, j) = norm(w);
+          if (!std::isfinite(h(j + 1, j)))
+            return 0;
+          if (h(j + 1, j) > 0)
+            for (double &x : w)
+              x /= h(j + 1, j);
+          for (unsigned int i = 0; i < j; ++i)
+            {
+              const double a = h(i, j), c = h(i + 1, j);
+              h(i, j)     = cs[i] * a + sn[i] * c;
+              h(i + 1, j) = -sn[i] * a + cs[i] * c;
+            }
+          const double r = std::hypot(h(j, j), h(j + 1, j));
+          if (r == 0)
+            return 0;
+          cs[j]       = h(j, j) / r;
+          sn[j]       = h(j + 1, j) / r;
+          h(j, j)     = r;
+          h(j + 1, j) = 0;
+          g[j + 1]    = -sn[j] * g[j];
+          g[j]        = cs[j] * g[j];
+          if (std::abs(g[j + 1]) <= tolerance * beta)
+            {
+              // x = Z y with H y = g (upper triangular).
+              std::vector<double> y(j + 1);
+              for (int i = j; i >= 0; --i)
+                {
+                  double sum = g[i];
+                  for (unsigned int k = i + 1; k <= j; ++k)
+                    sum -= h(i, k) * y[k];
+                  y[i] = sum / h(i, i);
+                }
+              b.assign(n, 0.0);
+              for (unsigned int i = 0; i <= j; ++i)
+                for (std::size_t k = 0; k < n; ++k)
+                  b[k] += y[i] * Z[i][k];
+              return j + 1;
+            }
+        }
+      return 0;
+    }
   } // namespace
 
 
@@ -129,6 +243,11 @@ namespace palpate
     // Work vectors, reused from solve to solve.
     std::vector<double> residual, trial_residual, best_residual, matrix, step,
       trial, best_x;
+    // Whether the linear solver holds a factorisation (of the tangent of
+    // an earlier Newton step, in this state or an earlier one), and the
+    // Krylov bases of GMRES.
+    bool                             factorized = false;
+    std::vector<std::vector<double>> krylov_v, krylov_z;
   };
 
 
@@ -152,6 +271,7 @@ namespace palpate
       }
     double       assembly_time   = seconds_since(start);
     double       last_correction = -1;
+    double       previous_norm   = -1; // |R| before the last step
     unsigned int short_steps     = 0;
 
     for (unsigned int iteration = 0;; ++iteration)
@@ -180,17 +300,75 @@ namespace palpate
         record.residual_before = system->force_residual_norm(residual) / scale;
         record.assembly_time   = assembly_time;
 
-        // The Newton step: K dx = -R.
+        // The Newton step: K dx = -R. With a kept factorisation (of an
+        // earlier tangent in this state, or of the last state this solver
+        // computed, usually a neighbour) GMRES solves it in a few
+        // preconditioned iterations, at a fraction of a factorisation. When
+        // GMRES needs more than the allowed iterations the tangent has
+        // drifted too far from the factorised one: factorise it.
+        //
+        // How exactly: an inexact Newton step with |K dx + R| <= eta |R|
+        // converges as fast as the exact one while eta follows the
+        // residual's own reduction (Eisenstat and Walker's second choice,
+        // eta = 0.9 (|R_k| / |R_k-1|)^2, at most 0.01), and solving more
+        // exactly than the final tolerance needs buys nothing. The step
+        // that first puts the active node on its target is solved to
+        // 1e-6, so that the constraints hold for the line search. The
+        // convergence test of the state is the same either way.
         start = Clock::now();
         step  = residual;
         for (double &s : step)
           s = -s;
-        if (!linear_solver->factorize(matrix) || !linear_solver->solve(step))
+        const double residual_norm = norm(residual);
+        double       eta           = 1e-6;
+        if (!(system->constraint_violation(residual) >
+              settings.increment_tolerance * system->length_scale()))
           {
-            outcome.status     = SolveStatus::linear_solver_failure;
-            outcome.iterations = iteration;
-            outcome.message    = linear_solver->message();
-            return outcome;
+            eta = previous_norm > 0 ?
+                    0.9 * std::pow(residual_norm / previous_norm, 2) :
+                    1e-2;
+            eta = std::clamp(eta,
+                             std::min(1e-2,
+                                      0.1 * settings.residual_tolerance *
+                                        scale / residual_norm),
+                             1e-2);
+          }
+        previous_norm            = residual_norm;
+        record.factorized        = true;
+        record.krylov_iterations = 0;
+        if (settings.reuse_factorization && factorized)
+          {
+            record.krylov_iterations = gmres(
+              system->sparsity(),
+              matrix,
+              [this](std::vector<double> &v) {
+                return linear_solver->solve(v);
+              },
+              step,
+              eta,
+              settings.max_krylov_iterations,
+              krylov_v,
+              krylov_z);
+            record.factorized = record.krylov_iterations == 0;
+            if (record.factorized)
+              {
+                step = residual;
+                for (double &s : step)
+                  s = -s;
+              }
+          }
+        if (record.factorized)
+          {
+            factorized = false;
+            if (!linear_solver->factorize(matrix) ||
+                !linear_solver->solve(step))
+              {
+                outcome.status     = SolveStatus::linear_solver_failure;
+                outcome.iterations = iteration;
+                outcome.message    = linear_solver->message();
+                return outcome;
+              }
+            factorized = true;
           }
         record.solve_time = seconds_since(start);
 

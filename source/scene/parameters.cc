@@ -629,6 +629,26 @@ namespace palpate
                           "Threads that assemble one state's residual and "
                           "tangent (dimensionless). Independent states run "
                           "on different workers (Engine / Workers).");
+        prm.declare_entry(
+          "Reuse factorization",
+          "false",
+          Patterns::Bool(),
+          "Solve each Newton step by GMRES, preconditioned with the last "
+          "factorisation of the tangent this solver made (in this state or "
+          "a neighbouring one), and factorise the current tangent only when "
+          "GMRES needs more than Maximum Krylov iterations. The linear "
+          "system is solved inexactly (to what the Newton residual needs), "
+          "so the states are those of the direct solve to 1e-8, but Newton "
+          "converges superlinearly instead of quadratically. Pays where a "
+          "factorisation is expensive: liver2k StVK 216 -> 180 ms per "
+          "state; liver501 17.8 -> 17.3 ms (doc/benchmarks/newton.md).");
+        prm.declare_entry("Maximum Krylov iterations",
+                          "6",
+                          Patterns::Integer(1, 100),
+                          "With Reuse factorization: GMRES iterations after "
+                          "which the kept factorisation counts as too old "
+                          "and the tangent is factorised anew "
+                          "(dimensionless).");
       }
       prm.leave_subsection();
     }
@@ -649,6 +669,8 @@ namespace palpate
         max_line_search_steps = prm.get_integer("Maximum line search steps");
         max_cutbacks          = prm.get_integer("Maximum cutbacks");
         assembly_threads      = prm.get_integer("Assembly threads");
+        reuse_factorization   = prm.get_bool("Reuse factorization");
+        max_krylov_iterations = prm.get_integer("Maximum Krylov iterations");
       }
       prm.leave_subsection();
     }

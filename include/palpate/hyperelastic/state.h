@@ -45,6 +45,10 @@ namespace palpate
     double correction;
     /** Line search step length taken (1 = full Newton step). */
     double step_length;
+    /** Whether the tangent was factorised for this step (else GMRES with
+     * a kept factorisation solved it), and GMRES iterations (0 if none). */
+    bool         factorized        = true;
+    unsigned int krylov_iterations = 0;
     /** Wall-clock seconds: residual+tangent assembly, factorisation and
      * solve, line search (residual evaluations at trial points). */
     double assembly_time, solve_time, line_search_time;

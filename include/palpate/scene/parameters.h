@@ -186,6 +186,11 @@ namespace palpate
       unsigned int max_line_search_steps;
       unsigned int max_cutbacks;
       unsigned int assembly_threads;
+      /** Solve Newton steps by GMRES preconditioned with a kept
+       * factorisation, refactorising only when GMRES needs more than
+       * max_krylov_iterations. */
+      bool         reuse_factorization;
+      unsigned int max_krylov_iterations;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
