@@ -5,6 +5,7 @@
 
 #include <deal.II/base/multithread_info.h>
 
+#include <dlfcn.h>
 #include <mpi.h>
 
 #include <cstdlib>
@@ -26,6 +27,17 @@ namespace palpate
     // direct solver would only compete with them for the cores.
     setenv("OMP_NUM_THREADS", "1", 0);
     setenv("OPENBLAS_NUM_THREADS", "1", 0);
+    // The variable is read when OpenBLAS is loaded, which happened before
+    // main(): tell the library itself. One BLAS thread per caller is also
+    // what makes OpenBLAS safe to call from two solver workers at once:
+    // the pthread build is (with one thread per call), the serial build
+    // is not (it computes wrong results), which is why palpate installs
+    // libopenblas0-pthread. Looked up at run time: another BLAS may be in
+    // use, and then there is nothing to set.
+    using SetThreads = void (*)(int);
+    if (const auto set = reinterpret_cast<SetThreads>(
+          dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+      set(1);
 
     int initialized = 0;
     MPI_Initialized(&initialized);

@@ -482,6 +482,21 @@ namespace palpate
         , comm(MPI_COMM_SELF)
       {}
 
+      ~AmesosSolver() override
+      {
+        const auto lock = mumps_guard();
+        solver.reset();
+      }
+
+      /** MUMPS's lock for Amesos_Mumps; nothing for the others. */
+      std::unique_lock<std::mutex>
+      mumps_guard() const
+      {
+        return type == "Amesos_Mumps" ?
+                 std::unique_lock<std::mutex>(mumps_lock()) :
+                 std::unique_lock<std::mutex>();
+      }
+
       void
       analyze(const SparsityCSR &pattern) override
       {
@@ -508,7 +523,11 @@ namespace palpate
         problem = std::make_unique<Epetra_LinearProblem>(matrix.get(),
                                                          x.get(),
                                                          b.get());
-        Amesos factory;
+        // Amesos_Mumps is MUMPS too, with the same global state: it takes
+        // the same lock as our own MUMPS (found by the concurrent-workers
+        // test, which crashed in MUMPS's load module without it).
+        const auto lock = mumps_guard();
+        Amesos     factory;
         solver.reset(factory.Create(type, *problem));
         if (!solver)
           throw std::runtime_error("Trilinos Amesos has no " + type);
@@ -530,6 +549,7 @@ namespace palpate
                       values.begin() + (*row_start)[i + 1],
                       v);
           }
+        const auto lock = mumps_guard();
         if (solver->NumericFactorization() != 0)
           {
             message_ = type + " numeric factorisation failed";
@@ -542,11 +562,14 @@ namespace palpate
       solve(std::vector<double> &rhs) override
       {
         std::copy(rhs.begin(), rhs.end(), &(*b)[0]);
-        if (solver->Solve() != 0)
-          {
-            message_ = type + " solve failed";
-            return false;
-          }
+        {
+          const auto lock = mumps_guard();
+          if (solver->Solve() != 0)
+            {
+              message_ = type + " solve failed";
+              return false;
+            }
+        }
         std::copy(&(*x)[0], &(*x)[0] + rhs.size(), rhs.begin());
         if (!all_finite(rhs))
           {
