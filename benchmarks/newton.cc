@@ -170,9 +170,11 @@ namespace
       return scene;
     }
 
-    /** Breadth-first over the grid from the rest state. */
+    /** Breadth-first over the grid from the rest state; with
+     * @p use_behind, each solve also gets the state behind its source on
+     * the same grid line, where it was computed (second-order start). */
     Statistics
-    build_scaffold(StateSolver &solver)
+    build_scaffold(StateSolver &solver, const bool use_behind = false)
     {
       Statistics statistics;
       const int  n =
@@ -195,7 +197,14 @@ namespace
                     norm(position(q)) > options.radius + 1e-12)
                   continue;
                 visited[q]  = true;
-                State state = solver.solve(grid[p], position(q));
+                auto behind = p;
+                behind[axis] -= sign;
+                const auto b = grid.find(behind);
+                State      state =
+                  solver.solve(grid[p],
+                               position(q),
+                               use_behind && b != grid.end() ? &b->second :
+                                                               nullptr);
                 statistics.add(state);
                 if (state.converged)
                   {
@@ -444,53 +453,67 @@ main(int argc, char **argv)
     std::cout << "The engine's path: the " << 1000 * e.radius
               << " mm cloud around rest, 5 mm grid, breadth-first from "
                  "neighbours, one solver\n"
-              << "  reuse  states  state (ms)  Newton its  factorisations  "
-                 "GMRES its   (per state, medians and averages)\n";
-    std::map<bool, std::map<std::array<int, 3>, State>> grids;
-    for (const bool reuse : {false, true})
-      {
-        Study       path(e);
-        StateSolver s(path.mesh, path.nodes, path.scene.parameters);
-        s.settings().reuse_factorization = reuse;
-        const Statistics st              = path.build_scaffold(s);
-        grids[reuse]                     = path.grid;
-        const double n                   = std::max(1u, st.states);
-        std::cout << "  " << std::left << std::setw(7) << (reuse ? "yes" : "no")
-                  << std::right << std::setw(6) << st.states << std::setw(12)
-                  << ms(median(st.state_time)) << std::setw(12)
-                  << std::setprecision(3) << st.average_iterations()
-                  << std::setw(16) << st.factorized / n << std::setw(11)
-                  << st.krylov / n << "\n";
-        std::ostringstream r;
-        r << std::setprecision(3) << "RESULT newton study=reuse material="
-          << (o.material == "mr" ? "mooney-rivlin element=" + o.element :
-                                   o.material)
-          << " mesh=" << mesh_name << " reuse=" << (reuse ? "yes" : "no")
-          << " state_ms=" << ms(median(st.state_time))
-          << " avg_iters=" << st.average_iterations()
-          << " factorizations_per_state=" << st.factorized / n
-          << " gmres_per_state=" << st.krylov / n
-          << " failure_pct=" << st.failure_percentage();
-        results.push_back(r.str());
-      }
-    double       largest  = 0;
-    unsigned int compared = 0, differ = 0;
-    for (const auto &[index, a] : grids[false])
-      if (const auto b = grids[true].find(index); b != grids[true].end())
+              << "  reuse  behind  states  state (ms)  Newton its  "
+                 "factorisations  GMRES its   (per state, medians and "
+                 "averages)\n";
+    std::map<std::pair<bool, bool>, std::map<std::array<int, 3>, State>> grids;
+    for (const bool behind : {false, true})
+      for (const bool reuse : {false, true})
         {
-          ++compared;
-          const double d = Utilities::distance(a.force, b->second.force) /
-                           std::max(Utilities::norm(a.force), 1e-3);
-          largest = std::max(largest, d);
-          differ += d > 1e-6;
+          Study       path(e);
+          StateSolver s(path.mesh, path.nodes, path.scene.parameters);
+          s.settings().reuse_factorization = reuse;
+          const Statistics st              = path.build_scaffold(s, behind);
+          grids[{reuse, behind}]           = path.grid;
+          const double n                   = std::max(1u, st.states);
+          std::cout << "  " << std::left << std::setw(7)
+                    << (reuse ? "yes" : "no") << std::setw(8)
+                    << (behind ? "yes" : "no") << std::right << std::setw(6)
+                    << st.states << std::setw(12) << ms(median(st.state_time))
+                    << std::setw(12) << std::setprecision(3)
+                    << st.average_iterations() << std::setw(16)
+                    << st.factorized / n << std::setw(11) << st.krylov / n
+                    << "\n";
+          std::ostringstream r;
+          r << std::setprecision(3) << "RESULT newton study=reuse material="
+            << (o.material == "mr" ? "mooney-rivlin element=" + o.element :
+                                     o.material)
+            << " mesh=" << mesh_name << " reuse=" << (reuse ? "yes" : "no")
+            << " behind=" << (behind ? "yes" : "no")
+            << " state_ms=" << ms(median(st.state_time))
+            << " avg_iters=" << st.average_iterations()
+            << " factorizations_per_state=" << st.factorized / n
+            << " gmres_per_state=" << st.krylov / n
+            << " failure_pct=" << st.failure_percentage();
+          results.push_back(r.str());
         }
-    std::cout << "  forces of the " << compared
-              << " states both computed: largest relative difference "
+    double       largest  = 0;
+    unsigned int compared = 0, differ = 0, only_one = 0;
+    const auto  &plain = grids[{false, false}];
+    for (const auto &[variant, g] : grids)
+      {
+        if (variant == std::make_pair(false, false))
+          continue;
+        for (const auto &[index, a] : plain)
+          if (const auto b = g.find(index); b != g.end())
+            {
+              ++compared;
+              const double d = Utilities::distance(a.force, b->second.force) /
+                               std::max(Utilities::norm(a.force), 1e-3);
+              largest = std::max(largest, d);
+              differ += d > 1e-6;
+            }
+          else
+            ++only_one;
+        for (const auto &[index, b] : g)
+          only_one += plain.count(index) == 0;
+      }
+    std::cout << "  forces of the variants against the plain solver, "
+              << compared << " states: largest relative difference "
               << std::setprecision(2) << largest << " ("
               << (differ == 0 ? "all within 1e-6" :
                                 std::to_string(differ) + " beyond 1e-6")
-              << "); states only one computed: "
-              << grids[false].size() + grids[true].size() - 2 * compared
+              << "); states only one of a pair computed: " << only_one
               << "\n\n";
     std::ostringstream r;
     r << "RESULT newton study=reuse-check compared=" << compared

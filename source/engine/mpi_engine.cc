@@ -458,13 +458,24 @@ namespace palpate
         // never waits while another gets a second task), one whose server
         // holds the source.
         const std::size_t depth = servers[free.front()].tasks.size();
-        const auto last   = std::find_if(free.begin(), free.end(), [&](int r) {
+        const auto last = std::find_if(free.begin(), free.end(), [&](int r) {
           return servers[r].tasks.size() > depth;
         });
-        auto       chosen = std::find_if(free.begin(), last, [&](int r) {
-          return (holders[task.source] & bit(r)) != 0;
+        // Best of all, one that also holds the state behind the source on
+        // the same grid line: its solve then starts from a second-order
+        // extrapolation (StateSolver::solve with behind).
+        unsigned int  b           = 0;
+        std::uint64_t with_behind = 0;
+        if (grid.behind(task.source, task.target, b))
+          with_behind = holders[b];
+        auto chosen = std::find_if(free.begin(), last, [&](int r) {
+          return (holders[task.source] & with_behind & bit(r)) != 0;
         });
-        const bool local  = chosen != last;
+        if (chosen == last)
+          chosen = std::find_if(free.begin(), last, [&](int r) {
+            return (holders[task.source] & bit(r)) != 0;
+          });
+        const bool local = chosen != last;
         if (!local)
           chosen = free.begin();
         const int rank   = *chosen;

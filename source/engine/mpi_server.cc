@@ -186,6 +186,19 @@ namespace palpate
               continue;
             }
 
+          // The state behind the source on the same grid line, if held
+          // here (it is not fetched), makes Newton's start second-order.
+          std::shared_ptr<const State> behind;
+          if (unsigned int b = 0;
+              task.source != origin && grid.behind(task.source, task.point, b))
+            {
+              if (b == origin)
+                behind = rest;
+              else if (const auto i = shared.store.find(b);
+                       i != shared.store.end())
+                behind = i->second;
+            }
+
           // Solve, with the lock released: the communicator answers
           // requests meanwhile.
           lock.unlock();
@@ -195,7 +208,7 @@ namespace palpate
           State      state;
           try
             {
-              state = solver->solve(*source, target);
+              state = solver->solve(*source, target, behind.get());
             }
           catch (const std::exception &e)
             {

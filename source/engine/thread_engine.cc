@@ -215,7 +215,16 @@ namespace palpate
           {
             if (const auto source = cache.state(task.source))
               {
-                result = solver.solve(*source, grid.position(task.target));
+                // The state behind the source on the same grid line, if
+                // held, makes Newton's start second-order accurate.
+                unsigned int                 b = 0;
+                std::shared_ptr<const State> behind;
+                if (grid.behind(task.source, task.target, b) &&
+                    cache.has_state(b))
+                  behind = cache.state(b);
+                result = solver.solve(*source,
+                                      grid.position(task.target),
+                                      behind.get());
                 solved = true;
                 if (result.converged)
                   {

@@ -542,6 +542,16 @@ namespace palpate
   State
   StateSolver::solve(const State &from, const Utilities::Point3 &target)
   {
+    return solve(from, target, nullptr);
+  }
+
+
+
+  State
+  StateSolver::solve(const State             &from,
+                     const Utilities::Point3 &target,
+                     const State             *behind)
+  {
     const auto start = Clock::now();
     State      state;
     state.active_displacement = target;
@@ -615,6 +625,37 @@ namespace palpate
     Impl::Outcome       failure;
     std::vector<double> previous; // converged unknowns one increment back
     double              previous_t = 0, current_t = 0;
+
+    // A state behind the source on the line to the target is the
+    // increment before the first one: the secant predictor below then
+    // extrapolates it to the first increment's end.
+    if (behind != nullptr && behind->converged &&
+        behind->solution.size() == from.solution.size() &&
+        behind->multipliers.size() == from.multipliers.size() && length > 0)
+      {
+        Utilities::Point3 back, ahead;
+        for (unsigned int d = 0; d < 3; ++d)
+          {
+            back[d]  = a[d] - behind->active_displacement[d];
+            ahead[d] = target[d] - a[d];
+          }
+        const double b      = Utilities::norm(back);
+        double       cosine = 0;
+        for (unsigned int d = 0; d < 3; ++d)
+          cosine += back[d] * ahead[d];
+        cosine /= std::max(b * length, 1e-300);
+        if (b > 0 && cosine > 1 - 1e-9)
+          {
+            bool finite = true;
+            for (const double v : behind->solution)
+              finite = finite && std::isfinite(v);
+            if (finite)
+              {
+                previous   = impl->system->from_state(*behind);
+                previous_t = -b / length;
+              }
+          }
+      }
     std::function<bool(double, double, unsigned int)> increment =
       [&](const double t0, const double t1, const unsigned int depth) {
         const std::vector<double> saved     = x;

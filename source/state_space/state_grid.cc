@@ -64,6 +64,23 @@ namespace palpate
 
 
 
+  bool
+  StateGrid::behind(const unsigned int source,
+                    const unsigned int target,
+                    unsigned int      &point) const noexcept
+  {
+    const GridIndex s = index(source), t = index(target);
+    GridIndex       b;
+    for (unsigned int d = 0; d < 3; ++d)
+      b[d] = 2 * s[d] - t[d];
+    if (!contains(b))
+      return false;
+    point = linear(b);
+    return true;
+  }
+
+
+
   GridIndex
   StateGrid::nearest(const Utilities::Point3 &x) const noexcept
   {

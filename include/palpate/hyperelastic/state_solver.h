@@ -59,6 +59,21 @@ namespace palpate
     State
     solve(const State &from, const Utilities::Point3 &target);
 
+    /**
+     * The same, with @p behind, a converged state whose active node lies
+     * on the line through @p from and @p target, on the other side of
+     * @p from (the grid point behind the source, on the same grid line):
+     * Newton then starts from the extrapolation of behind -> from to the
+     * target, which is already on the target and second-order accurate,
+     * instead of spending its first iteration on a tangent predictor. If
+     * @p behind is null, not on that line, or not an equilibrium of this
+     * body, this is solve(from, target).
+     */
+    State
+    solve(const State             &from,
+          const Utilities::Point3 &target,
+          const State             *behind);
+
     /** The discrete system. */
     const HyperelasticSystem &
     system() const;

@@ -69,6 +69,16 @@ namespace palpate
     Utilities::Point3
     position(const unsigned int p) const noexcept;
 
+    /**
+     * The point behind @p source as seen from @p target: source - (target
+     * - source), the next point beyond the source on the grid line from
+     * the target through it. False if it is outside the grid.
+     */
+    bool
+    behind(const unsigned int source,
+           const unsigned int target,
+           unsigned int      &point) const noexcept;
+
     /** The grid point nearest to @p x (clamped to the grid). */
     GridIndex
     nearest(const Utilities::Point3 &x) const noexcept;
