@@ -63,6 +63,8 @@ namespace
      * the size of the paper authors' second liver), same organ and
      * coordinates. */
     std::string mesh = "liver501";
+    /** Only the cost-growth study. */
+    bool growth = false;
   };
 
   double
@@ -151,13 +153,23 @@ namespace
     static Scene
     make_scene(const Options &o)
     {
-      Scene scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
-                                (o.material == "mr" ?
-                                   "/parameters/liver-mooney-rivlin.prm" :
-                                   "/parameters/liver-stvk.prm"));
+      const bool blob  = o.mesh.rfind("blob", 0) == 0;
+      Scene      scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
+                                (blob ? "/parameters/default.prm" :
+                                      o.material == "mr" ?
+                                             "/parameters/liver-mooney-rivlin.prm" :
+                                             "/parameters/liver-stvk.prm"));
       if (o.material == "nh")
         scene.parameters.material_model.model_name = "Neo-Hookean";
-      if (o.mesh != "liver501")
+      if (blob)
+        {
+          // The organ-like blob of the default scene at resolution r
+          // ("blobR"): (3 (r + 1) + 1)^3 nodes.
+          scene.parameters.mesh.blob_refinements = std::stoi(o.mesh.substr(4));
+          if (o.material == "mr")
+            scene.parameters.material_model.model_name = "Mooney-Rivlin";
+        }
+      else if (o.mesh != "liver501")
         {
           auto &file = scene.parameters.mesh.file_name;
           file.replace(file.rfind("liver501"), 8, o.mesh);
@@ -288,6 +300,97 @@ namespace
 
 
 
+namespace
+{
+  /**
+   * How the cost of a state grows with the mesh: the engine's path (the
+   * cloud of radius 10 mm around rest, 5 mm grid, breadth-first from
+   * neighbours, one solver) on the organ-like blob at four resolutions
+   * and on liver501 and liver2k, with the plain solver (a factorisation
+   * per Newton step, tangent predictor) and with palpate's levers
+   * (factorisation reuse and the second-order start). The exponent p of
+   * state time ~ unknowns^p is the least-squares slope on log-log axes.
+   * Writes newton-growth.csv for doc/images/newton_growth.py.
+   */
+  int
+  growth_study(const Options &o)
+  {
+    std::vector<std::string> meshes = {
+      "blob1", "blob2", "blob3", "blob4", "liver501", "liver2k"};
+    if (o.quick)
+      meshes = {"blob1", "blob2", "blob3", "liver501"};
+    std::cout << "Cost growth: state time against unknowns, "
+              << (o.material == "mr" ? "Mooney-Rivlin P1-P1" :
+                                       "St.Venant-Kirchhoff")
+              << ", the engine's path (cloud of " << (o.quick ? 5 : 10)
+              << " mm around rest, 5 mm grid, one solver)\n"
+              << "  mesh        nodes  unknowns  plain (ms)  levers (ms)  "
+                 "speed-up\n";
+    std::ofstream csv("newton-growth.csv");
+    csv << "mesh,nodes,unknowns,plain_ms,levers_ms\n";
+    std::vector<double>      logn, logp, logl;
+    std::vector<std::string> lines;
+    for (const auto &m : meshes)
+      {
+        Options e             = o;
+        e.mesh                = m;
+        e.spacing             = 0.005;
+        e.radius              = o.quick ? 0.005 : 0.01;
+        double       ms_of[2] = {0, 0};
+        unsigned int unknowns = 0, nodes = 0;
+        for (const bool levers : {false, true})
+          {
+            Study       path(e);
+            StateSolver s(path.mesh, path.nodes, path.scene.parameters);
+            s.settings().reuse_factorization = levers;
+            const Statistics st              = path.build_scaffold(s, levers);
+            ms_of[levers]                    = 1000 * median(st.state_time);
+            unknowns                         = s.system().n_equations();
+            nodes                            = path.mesh.n_vertices();
+          }
+        std::cout << "  " << std::left << std::setw(10) << m << std::right
+                  << std::setw(7) << nodes << std::setw(10) << unknowns
+                  << std::setw(12) << std::setprecision(3) << ms_of[0]
+                  << std::setw(13) << ms_of[1] << std::setw(10)
+                  << ms_of[0] / ms_of[1] << std::endl;
+        csv << m << "," << nodes << "," << unknowns << "," << ms_of[0] << ","
+            << ms_of[1] << "\n";
+        logn.push_back(std::log(unknowns));
+        logp.push_back(std::log(ms_of[0]));
+        logl.push_back(std::log(ms_of[1]));
+        std::ostringstream r;
+        r << std::setprecision(3) << "RESULT newton study=growth material="
+          << (o.material == "mr" ? "mooney-rivlin" : o.material)
+          << " mesh=" << m << " unknowns=" << unknowns
+          << " plain_state_ms=" << ms_of[0] << " levers_state_ms=" << ms_of[1];
+        lines.push_back(r.str());
+      }
+    const auto slope = [&](const std::vector<double> &y) {
+      double mx = 0, my = 0;
+      for (unsigned int i = 0; i < y.size(); ++i)
+        mx += logn[i] / y.size(), my += y[i] / y.size();
+      double sxy = 0, sxx = 0;
+      for (unsigned int i = 0; i < y.size(); ++i)
+        sxy += (logn[i] - mx) * (y[i] - my),
+          sxx += (logn[i] - mx) * (logn[i] - mx);
+      return sxy / sxx;
+    };
+    std::cout << "  exponent (state time ~ unknowns^p): plain p = "
+              << std::setprecision(3) << slope(logp)
+              << ", with the levers p = " << slope(logl)
+              << "\n  wrote newton-growth.csv (plot: "
+              << "/usr/bin/python3 doc/images/newton_growth.py "
+                 "newton-growth.csv doc/images/newton-growth.png)\n\n";
+    for (const auto &l : lines)
+      std::cout << l << "\n";
+    std::cout << "RESULT newton study=growth-exponent material="
+              << (o.material == "mr" ? "mooney-rivlin" : o.material)
+              << " plain_exponent=" << std::setprecision(3) << slope(logp)
+              << " levers_exponent=" << slope(logl) << "\n";
+    return 0;
+  }
+} // namespace
+
 int
 main(int argc, char **argv)
 {
@@ -310,6 +413,8 @@ main(int argc, char **argv)
         o.radius = std::stod(argv[++i]);
       else if (a == "--seed" && i + 1 < argc)
         o.seed = std::stoi(argv[++i]);
+      else if (a == "--growth")
+        o.growth = true;
       else if (a == "--mesh" && i + 1 < argc)
         o.mesh = argv[++i];
       else if (a == "--no-studies")
@@ -327,6 +432,8 @@ main(int argc, char **argv)
       std::cerr << "benchmarks/run newton: --mesh is liver501 or liver2k\n";
       return 2;
     }
+  if (o.growth)
+    return growth_study(o);
   if ((o.material != "stvk" && o.material != "nh" && o.material != "mr") ||
       (o.element != "p1p1" && o.element != "taylor-hood"))
     {

@@ -26,10 +26,13 @@ main(int argc, char **argv)
 
   for (const std::string material : {"St.Venant-Kirchhoff", "Neo-Hookean"})
     {
-      palpate::Scene scene                  = shipped_scene("liver-stvk.prm");
-      auto          &p                      = scene.parameters;
-      p.material_model.model_name           = material;
-      p.nonlinear_solver.residual_tolerance = 1e-13;
+      palpate::Scene scene = shipped_scene("liver-stvk.prm");
+      auto          &p     = scene.parameters;
+      // Quadratic convergence is a property of the exact Newton step: no
+      // GMRES with a kept factorisation here.
+      p.nonlinear_solver.reuse_factorization = false;
+      p.material_model.model_name            = material;
+      p.nonlinear_solver.residual_tolerance  = 1e-13;
       const Body           body(scene);
       palpate::StateSolver solver(body.mesh, body.nodes, p);
 

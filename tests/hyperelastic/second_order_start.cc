@@ -22,7 +22,11 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  const Body           body(shipped_scene("liver-stvk.prm"));
+  // Exact Newton steps (no kept factorisation), so that two solves of the
+  // same transition can be compared iteration for iteration.
+  palpate::Scene scene = shipped_scene("liver-stvk.prm");
+  scene.parameters.nonlinear_solver.reuse_factorization = false;
+  const Body           body(scene);
   palpate::StateSolver solver(body.mesh, body.nodes, body.scene.parameters);
 
   std::vector<palpate::State> plain{solver.rest_state()},
