@@ -3,7 +3,7 @@
 
 // benchmarks/run max-speed [--quick] [--material stvk|mr|all]
 //                          [--spacing 5,10] [--workers 1,2]
-//                          [--engine threads|mpi|all]
+//                          [--engine threads|mpi|all] [--mesh liver2k]
 //                          [--length CM] [--no-studies]
 //
 // The paper's headline experiment, measured: the largest speed at which the
@@ -73,8 +73,10 @@ namespace
     std::vector<double>       spacings  = {5, 10};
     std::vector<unsigned int> workers   = {1, 2};
     std::vector<std::string>  engines   = {"threads", "mpi"};
-    double                    length    = 0.08; // m
-    bool                      studies   = true;
+    /** liver501 (the paper's) or liver2k (2059 nodes, the same organ). */
+    std::string mesh    = "liver501";
+    double      length  = 0.08; // m
+    bool        studies = true;
   };
 
   /** One interaction at one speed. */
@@ -95,6 +97,7 @@ namespace
     unsigned int workers;
     double       tolerance;
     std::string  engine = "threads";
+    std::string  mesh   = "liver501";
   };
 
   const Point3 direction{{-1, 0, 0}};
@@ -105,7 +108,12 @@ namespace
     Scene scene = Scene::read(
       std::string(PALPATE_SOURCE_DIR) + "/parameters/" +
       (c.material == "stvk" ? "liver-stvk.prm" : "liver-mooney-rivlin.prm"));
-    auto &p                               = scene.parameters;
+    auto &p = scene.parameters;
+    if (c.mesh != "liver501")
+      {
+        auto &file = p.mesh.file_name;
+        file.replace(file.rfind("liver501"), 8, c.mesh);
+      }
     p.state_space.grid_spacing            = 1e-3 * c.spacing_mm;
     p.engine.workers                      = c.workers;
     p.engine.type                         = c.engine;
@@ -135,7 +143,10 @@ namespace
                                                                      "mr")
           << " " << 1000 * p.state_space.grid_spacing << " "
           << p.nonlinear_solver.residual_tolerance << " " << speed << " "
-          << length;
+          << length << " "
+          << (p.mesh.file_name.find("liver2k") != std::string::npos ?
+                "liver2k" :
+                "liver501");
         const auto v = mpi_child::run(mpi_child::command(3, a.str()));
         Trial      t;
         t.speed           = speed;
@@ -277,13 +288,14 @@ namespace
   /**
    * A trial of the MPI engine, under mpirun: rank 0 runs it and prints it
    * as a CHILD line; the other ranks serve.
-   * Arguments: material h_mm tolerance speed length.
+   * Arguments: material h_mm tolerance speed length mesh.
    */
   int
   child(const std::vector<std::string> &a)
   {
-    const Configuration c{a[0], std::stod(a[1]), 2, std::stod(a[2]), "mpi"};
-    const Scene         scene = scene_for(c);
+    const Configuration c{
+      a[0], std::stod(a[1]), 2, std::stod(a[2]), "mpi", a[5]};
+    const Scene scene = scene_for(c);
     if (mpi_rank() > 0)
       {
         const Mesh          mesh  = Mesh::create(scene);
@@ -308,7 +320,7 @@ int
 main(int argc, char **argv)
 {
   Environment env(argc, argv);
-  if (argc == 7 && std::string(argv[1]) == "--child")
+  if (argc == 8 && std::string(argv[1]) == "--child")
     return child(std::vector<std::string>(argv + 2, argv + argc));
   Options o;
   for (int i = 1; i < argc; ++i)
@@ -347,6 +359,12 @@ main(int argc, char **argv)
           if (e != "all" && e != "threads" && e != "mpi")
             throw std::invalid_argument("--engine must be threads, mpi or all");
         }
+      else if (a == "--mesh")
+        {
+          o.mesh = next();
+          if (o.mesh != "liver501" && o.mesh != "liver2k")
+            throw std::invalid_argument("--mesh must be liver501 or liver2k");
+        }
       else if (a == "--length")
         o.length = 0.01 * std::stod(next());
       else if (a == "--no-studies")
@@ -379,7 +397,7 @@ main(int argc, char **argv)
   std::cout
     << "Maximum HIP speed along a straight line (after the initial cloud)\n"
     << "  machine: " << machine() << "\n"
-    << "  liver501 (25 cm), cloud radius 25 mm, look-ahead "
+    << "  " << o.mesh << " (25 cm), cloud radius 25 mm, look-ahead "
     << scene_for({"stvk", 5, 1, 1e-8}).parameters.scheduler.look_ahead_time
     << " s, path " << 100 * o.length
     << " cm along -x from rest, 1 kHz haptic loop"
@@ -405,7 +423,7 @@ main(int argc, char **argv)
         for (const unsigned int w :
              e == "mpi" ? std::vector<unsigned int>{2} : o.workers)
           {
-            const Configuration c{m, h, w, 1e-8, e};
+            const Configuration c{m, h, w, 1e-8, e, o.mesh};
             std::cout << (m == "stvk" ? "St.Venant-Kirchhoff" :
                                         "Mooney-Rivlin (P1-P1)")
                       << ", h = " << h << " mm, " << w
@@ -419,7 +437,7 @@ main(int argc, char **argv)
   if (o.studies)
     for (const double tolerance : {1e-4, 1e-6})
       {
-        const Configuration c{"stvk", 5, 1, tolerance};
+        const Configuration c{"stvk", 5, 1, tolerance, "threads", o.mesh};
         std::cout
           << "St.Venant-Kirchhoff, h = 5 mm, 1 worker, residual tolerance "
           << tolerance << ":" << std::endl;
@@ -465,8 +483,9 @@ main(int argc, char **argv)
   for (const auto &x : rows)
     std::cout << "RESULT max-speed material="
               << (x.c.material == "stvk" ? "stvk" : "mooney-rivlin")
-              << " h_mm=" << std::setprecision(0) << x.c.spacing_mm
-              << " engine=" << x.c.engine << " workers=" << x.c.workers
+              << " mesh=" << x.c.mesh << " h_mm=" << std::setprecision(0)
+              << x.c.spacing_mm << " engine=" << x.c.engine
+              << " workers=" << x.c.workers
               << " speed_mm_s=" << std::setprecision(1) << 1000 * x.t.speed
               << " state_ms=" << x.t.state_ms
               << " deadline_misses=" << x.t.deadline_misses

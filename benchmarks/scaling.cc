@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run scaling [--quick] [--repeat N]
+// benchmarks/run scaling [--quick] [--repeat N] [--reuse yes|no]
 //
 // How the engine's throughput (states per second) grows with a second
 // solver: 1 and 2 solver threads (Engine / Type = threads) against 1 and 2
@@ -13,6 +13,8 @@
 // throughput = states finished (converged or failure points) in the
 // initial cloud / the time from attach until the cloud was complete.
 // The median of --repeat runs (3; 1 with --quick) is reported.
+// --reuse overrides the scene's Nonlinear solver / Reuse factorization
+// (liver-stvk.prm: false, measured best for it), to compare.
 //
 // Why: MUMPS keeps global state, so solver threads take turns behind one
 // mutex; processes do not share it. Target (issue 8): MPI
@@ -43,7 +45,8 @@ namespace
   Scene
   scene_for(const std::string &engine,
             const unsigned int workers,
-            const double       radius)
+            const double       radius,
+            const std::string &reuse)
   {
     Scene scene                = Scene::read(std::string(PALPATE_SOURCE_DIR) +
                               "/parameters/liver-stvk.prm");
@@ -58,6 +61,8 @@ namespace
     p.effects.shape_output        = false;
     p.effects.force_log           = false;
     p.output.summary_formats      = {};
+    if (reuse != "scene")
+      p.nonlinear_solver.reuse_factorization = reuse == "yes";
     scene.validate();
     return scene;
   }
@@ -66,9 +71,10 @@ namespace
   int
   child(const std::string &engine,
         const unsigned int workers,
-        const double       radius)
+        const double       radius,
+        const std::string &reuse)
   {
-    const Scene scene = scene_for(engine, workers, radius);
+    const Scene scene = scene_for(engine, workers, radius, reuse);
     if (engine == "mpi" && mpi_rank() > 0)
       {
         const Mesh          mesh  = Mesh::create(scene);
@@ -100,33 +106,41 @@ int
 main(int argc, char **argv)
 {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.size() == 4 && args[0] == "--child")
+  if (args.size() == 5 && args[0] == "--child")
     {
       Environment env(argc, argv);
-      return child(args[1], std::stoul(args[2]), std::stod(args[3]));
+      return child(args[1], std::stoul(args[2]), std::stod(args[3]), args[4]);
     }
 
   bool         quick  = false;
+  std::string  reuse  = "scene";
   unsigned int repeat = 3;
   for (unsigned int i = 0; i < args.size(); ++i)
     if (args[i] == "--quick")
       quick = true;
+    else if (args[i] == "--reuse" && i + 1 < args.size() &&
+             (args[i + 1] == "yes" || args[i + 1] == "no"))
+      reuse = args[++i];
     else if (args[i] == "--repeat" && i + 1 < args.size())
       repeat = std::stoul(args[++i]);
     else
       {
-        std::cerr << "usage: benchmarks/run scaling [--quick] [--repeat N]\n";
+        std::cerr << "usage: benchmarks/run scaling [--quick] [--repeat N] "
+                     "[--reuse yes|no]\n";
         return 2;
       }
   if (quick)
     repeat = 1;
-  const double radius = quick ? 0.015 : 0.025;
+  const double radius     = quick ? 0.015 : 0.025;
+  const bool   reuse_used = scene_for("threads", 1, radius, reuse)
+                            .parameters.nonlinear_solver.reuse_factorization;
 
   std::cout << "Engine throughput with one and two solvers\n"
             << "  machine: " << std::thread::hardware_concurrency()
             << " cores; liver501 StVK, h = 5 mm, initial cloud of radius "
             << 1000 * radius << " mm around rest; median of " << repeat
             << " run" << (repeat > 1 ? "s" : "") << (quick ? " [--quick]" : "")
+            << (reuse == "scene" ? std::string() : " [--reuse " + reuse + "]")
             << "\n\n";
 
   std::vector<Row> rows;
@@ -137,7 +151,8 @@ main(int argc, char **argv)
         for (unsigned int r = 0; r < repeat; ++r)
           {
             std::ostringstream a;
-            a << "--child " << engine << " " << n << " " << radius;
+            a << "--child " << engine << " " << n << " " << radius << " "
+              << reuse;
             const auto v = mpi_child::run(
               mpi_child::command(engine == "mpi" ? n + 1 : 0, a.str()));
             Row row;
@@ -188,6 +203,7 @@ main(int argc, char **argv)
               << rate(engine, 2) / rate(engine, 1)
               << " states_per_s_1=" << std::setprecision(1) << rate(engine, 1)
               << " states_per_s_2=" << rate(engine, 2)
-              << " radius_mm=" << std::setprecision(0) << 1000 * radius << "\n";
+              << " radius_mm=" << std::setprecision(0) << 1000 * radius
+              << " reuse=" << (reuse_used ? "yes" : "no") << "\n";
   return 0;
 }
