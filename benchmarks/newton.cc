@@ -186,7 +186,9 @@ namespace
      * @p use_behind, each solve also gets the state behind its source on
      * the same grid line, where it was computed (second-order start). */
     Statistics
-    build_scaffold(StateSolver &solver, const bool use_behind = false)
+    build_scaffold(StateSolver &solver,
+                   const bool   use_behind  = false,
+                   const bool   third_order = false)
     {
       Statistics statistics;
       const int  n =
@@ -209,14 +211,19 @@ namespace
                     norm(position(q)) > options.radius + 1e-12)
                   continue;
                 visited[q]  = true;
-                auto behind = p;
+                auto behind = p, behind2 = p;
                 behind[axis] -= sign;
-                const auto b = grid.find(behind);
+                behind2[axis] -= 2 * sign;
+                const auto b  = grid.find(behind);
+                const auto b2 = grid.find(behind2);
                 State      state =
                   solver.solve(grid[p],
                                position(q),
                                use_behind && b != grid.end() ? &b->second :
-                                                               nullptr);
+                                                               nullptr,
+                               use_behind && third_order && b2 != grid.end() ?
+                                 &b2->second :
+                                 nullptr);
                 statistics.add(state);
                 if (state.converged)
                   {
@@ -573,9 +580,9 @@ main(int argc, char **argv)
           Study       path(e);
           StateSolver s(path.mesh, path.nodes, path.scene.parameters);
           s.settings().reuse_factorization = reuse;
-          const Statistics st              = path.build_scaffold(s, behind);
-          grids[{reuse, behind}]           = path.grid;
-          const double n                   = std::max(1u, st.states);
+          const Statistics st    = path.build_scaffold(s, behind, behind);
+          grids[{reuse, behind}] = path.grid;
+          const double n         = std::max(1u, st.states);
           std::cout << "  " << std::left << std::setw(7)
                     << (reuse ? "yes" : "no") << std::setw(8)
                     << (behind ? "yes" : "no") << std::right << std::setw(6)

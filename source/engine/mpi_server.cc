@@ -186,17 +186,24 @@ namespace palpate
               continue;
             }
 
-          // The state behind the source on the same grid line, if held
-          // here (it is not fetched), makes Newton's start second-order.
-          std::shared_ptr<const State> behind;
+          // The states behind the source on the same grid line, if held
+          // here (they are not fetched), make Newton's start second- or
+          // third-order.
+          std::shared_ptr<const State> behind, behind2;
+          const auto                   held = [&](const unsigned int p) {
+            if (p == origin)
+              return rest;
+            const auto i = shared.store.find(p);
+            return i == shared.store.end() ? std::shared_ptr<const State>() :
+                                                               i->second;
+          };
           if (unsigned int b = 0;
               task.source != origin && grid.behind(task.source, task.point, b))
             {
-              if (b == origin)
-                behind = rest;
-              else if (const auto i = shared.store.find(b);
-                       i != shared.store.end())
-                behind = i->second;
+              behind = held(b);
+              if (unsigned int bb = 0;
+                  behind && b != origin && grid.behind(b, task.source, bb))
+                behind2 = held(bb);
             }
 
           // Solve, with the lock released: the communicator answers
@@ -208,7 +215,8 @@ namespace palpate
           State      state;
           try
             {
-              state = solver->solve(*source, target, behind.get());
+              state =
+                solver->solve(*source, target, behind.get(), behind2.get());
             }
           catch (const std::exception &e)
             {

@@ -217,14 +217,20 @@ namespace palpate
               {
                 // The state behind the source on the same grid line, if
                 // held, makes Newton's start second-order accurate.
-                unsigned int                 b = 0;
-                std::shared_ptr<const State> behind;
+                // And the one behind that, third-order.
+                unsigned int                 b = 0, bb = 0;
+                std::shared_ptr<const State> behind, behind2;
                 if (grid.behind(task.source, task.target, b) &&
                     cache.has_state(b))
-                  behind = cache.state(b);
+                  {
+                    behind = cache.state(b);
+                    if (grid.behind(b, task.source, bb) && cache.has_state(bb))
+                      behind2 = cache.state(bb);
+                  }
                 result = solver.solve(*source,
                                       grid.position(task.target),
-                                      behind.get());
+                                      behind.get(),
+                                      behind2.get());
                 solved = true;
                 if (result.converged)
                   {

@@ -535,7 +535,8 @@ namespace palpate
   State
   StateSolver::solve(const State             &from,
                      const Utilities::Point3 &target,
-                     const State             *behind)
+                     const State             *behind,
+                     const State             *behind2)
   {
     const auto start = Clock::now();
     State      state;
@@ -638,6 +639,32 @@ namespace palpate
               {
                 previous   = impl->system->from_state(*behind);
                 previous_t = -b / length;
+                // With a second state behind, at the same spacing on the
+                // same line, and one increment: the quadratic through the
+                // three, 3 x - 3 x_b + x_bb at the target (third order).
+                // The secant predictor below computes x + (x - previous),
+                // so previous becomes the point that makes it that.
+                if (behind2 != nullptr && behind2->converged && n == 1 &&
+                    std::abs(b - length) <= 1e-9 * length &&
+                    behind2->solution.size() == from.solution.size() &&
+                    behind2->multipliers.size() == from.multipliers.size())
+                  {
+                    double off = 0;
+                    for (unsigned int d = 0; d < 3; ++d)
+                      off = std::max(off,
+                                     std::abs(behind2->active_displacement[d] -
+                                              (a[d] - 2 * back[d])));
+                    bool finite2 = off <= 1e-9 * length;
+                    for (const double v : behind2->solution)
+                      finite2 = finite2 && std::isfinite(v);
+                    if (finite2)
+                      {
+                        const std::vector<double> bb =
+                          impl->system->from_state(*behind2);
+                        for (unsigned int i = 0; i < previous.size(); ++i)
+                          previous[i] = 3 * previous[i] - bb[i] - x[i];
+                      }
+                  }
               }
           }
       }

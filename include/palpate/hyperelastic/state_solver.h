@@ -67,12 +67,15 @@ namespace palpate
      * target, which is already on the target and second-order accurate,
      * instead of spending its first iteration on a tangent predictor. If
      * @p behind is null, not on that line, or not an equilibrium of this
-     * body, this is solve(from, target).
+     * body, this is solve(from, target). With @p behind2 too, the state
+     * one more step behind at the same spacing, the start is the quadratic
+     * through the three (third order), when the path is one increment.
      */
     State
     solve(const State             &from,
           const Utilities::Point3 &target,
-          const State             *behind);
+          const State             *behind,
+          const State             *behind2 = nullptr);
 
     /** The discrete system. */
     const HyperelasticSystem &
