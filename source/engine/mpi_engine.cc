@@ -319,7 +319,7 @@ namespace palpate
                 holders[h.source] &= ~(h.source == origin ? 0 : bit(h.holder));
                 break;
               }
-            if (h.fetch_seconds > 0 && (h.flags & Flags::fetched_source))
+            if (h.flags & Flags::fetched_source)
               {
                 ++stats.fetched_sources;
                 stats.transfer_seconds.push_back(h.fetch_seconds);

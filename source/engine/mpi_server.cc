@@ -30,6 +30,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <thread>
 
 namespace palpate
@@ -67,13 +68,16 @@ namespace palpate
       std::map<unsigned int, std::shared_ptr<const State>> store;
       std::size_t                                          bytes = 0;
 
-      // A remote source the solver waits for: asked (by the solver),
-      // requested (by the communicator), then arrived or failed.
-      bool                         fetch_asked = false, fetch_sent = false;
-      unsigned int                 fetch_point  = 0;
-      int                          fetch_holder = 0;
-      std::shared_ptr<const State> fetched;
-      bool                         fetch_failed = false;
+      // Remote sources. The communicator requests a task's source from
+      // its holder as soon as the task arrives (prefetch: it is usually
+      // here before the solver finishes the task ahead of it); the solver
+      // asks for one itself only if that failed or it was dropped since.
+      // requested: in flight, by point; to_request: asked by the solver,
+      // not sent yet; failed: the holder did not have it; transferred:
+      // arrived from another server, not yet reported to the client.
+      std::map<unsigned int, int>              requested;
+      std::deque<std::pair<unsigned int, int>> to_request;
+      std::set<unsigned int>                   failed, transferred;
 
       // Messages the solver thread wants sent (the communicator sends).
       std::deque<std::pair<Header, std::shared_ptr<const State>>> outbox;
@@ -154,31 +158,31 @@ namespace palpate
             source = s->second;
           else if (task.holder != messenger.rank())
             {
-              const auto asked    = Clock::now();
-              shared.fetch_asked  = true;
-              shared.fetch_sent   = false;
-              shared.fetch_point  = task.source;
-              shared.fetch_holder = task.holder;
-              shared.fetched.reset();
-              shared.fetch_failed = false;
+              const auto asked = Clock::now();
+              if (!shared.requested.count(task.source))
+                {
+                  shared.failed.erase(task.source);
+                  shared.requested[task.source] = task.holder;
+                  shared.to_request.emplace_back(task.source, task.holder);
+                }
               // The holder answers within a round trip; a holder that
               // died never does, and the task then ends as
               // source_missing for the client to plan again.
               shared.wake_solver.wait_for(lock, std::chrono::seconds(10), [&] {
-                return shared.stop || shared.fetched || shared.fetch_failed;
+                return shared.stop || shared.store.count(task.source) ||
+                       shared.failed.count(task.source);
               });
-              shared.fetch_asked = false;
               if (shared.stop)
                 return;
-              source               = shared.fetched;
+              shared.failed.erase(task.source);
+              shared.requested.erase(task.source);
+              if (const auto s = shared.store.find(task.source);
+                  s != shared.store.end())
+                source = s->second;
               result.fetch_seconds = seconds_since(asked);
-              if (source)
-                {
-                  result.flags |= Flags::fetched_source;
-                  shared.bytes += bytes_of(*source);
-                  shared.store[task.source] = source;
-                }
             }
+          if (source && shared.transferred.erase(task.source) > 0)
+            result.flags |= Flags::fetched_source;
           if (!source)
             {
               result.flags |= Flags::source_missing;
@@ -293,6 +297,15 @@ namespace palpate
                     std::lock_guard<std::mutex> lock(shared.mutex);
                     shared.tasks.push_back(h);
                     shared.wake_solver.notify_all();
+                    // Prefetch its source from the server that holds it.
+                    if (h.source != origin && h.holder != messenger.rank() &&
+                        !shared.store.count(h.source) &&
+                        !shared.requested.count(h.source))
+                      {
+                        shared.failed.erase(h.source);
+                        shared.requested[h.source] = h.holder;
+                        shared.to_request.emplace_back(h.source, h.holder);
+                      }
                     break;
                   }
                 case Kind::request_state:
@@ -318,15 +331,22 @@ namespace palpate
                 case Kind::state_missing:
                   {
                     std::lock_guard<std::mutex> lock(shared.mutex);
-                    if (shared.fetch_asked && h.point == shared.fetch_point)
+                    if (!shared.requested.erase(h.point))
+                      break; // not asked for (any more)
+                    if (h.kind == Kind::state)
                       {
-                        if (h.kind == Kind::state)
-                          shared.fetched =
-                            std::make_shared<const State>(state_of(message));
-                        else
-                          shared.fetch_failed = true;
-                        shared.wake_solver.notify_all();
+                        if (!shared.store.count(h.point))
+                          {
+                            auto s =
+                              std::make_shared<const State>(state_of(message));
+                            shared.bytes += bytes_of(*s);
+                            shared.store[h.point] = std::move(s);
+                          }
+                        shared.transferred.insert(h.point);
                       }
+                    else
+                      shared.failed.insert(h.point);
+                    shared.wake_solver.notify_all();
                     break;
                   }
                 case Kind::shutdown:
@@ -340,18 +360,19 @@ namespace palpate
         // What the solver thread asked for: a fetch, results, drops.
         {
           std::unique_lock<std::mutex> lock(shared.mutex);
-          if (shared.fetch_asked && !shared.fetch_sent)
+          for (const auto &[point, holder] : shared.to_request)
             {
               Header request;
               request.kind  = Kind::request_state;
-              request.point = shared.fetch_point;
-              if (!messenger.send(shared.fetch_holder, pack(request)))
+              request.point = point;
+              if (!messenger.send(holder, pack(request)))
                 {
-                  shared.fetch_failed = true;
+                  shared.requested.erase(point);
+                  shared.failed.insert(point);
                   shared.wake_solver.notify_all();
                 }
-              shared.fetch_sent = true;
             }
+          shared.to_request.clear();
           auto outbox = std::move(shared.outbox);
           shared.outbox.clear();
           lock.unlock();
