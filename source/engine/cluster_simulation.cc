@@ -177,8 +177,8 @@ namespace palpate
 
     // The bridge scans the whole grid; as ThreadEngine does, do not scan
     // again while nothing finished and the HIP stayed in the same cell.
-    std::uint64_t     finished = 0, bridge_failed_at = ~std::uint64_t(0);
-    GridIndex         bridge_failed_cell{{0, 0, 0}};
+    std::uint64_t     finished = 0;
+    BridgeMemory      bridge;
     const double      nan = std::numeric_limits<double>::quiet_NaN();
     Utilities::Point3 planned_at{{nan, nan, nan}}, planned_velocity{{0, 0, 0}};
     bool              changed = true;
@@ -257,8 +257,7 @@ namespace palpate
         GridIndex             cell;
         std::array<double, 3> local;
         grid.locate(x, cell, local);
-        const bool allow_bridge =
-          !(finished == bridge_failed_at && cell == bridge_failed_cell);
+        const bool allow_bridge = bridge.allowed(finished, cell);
         // As many tasks as ThreadEngine plans (twice the workers), or all
         // of them with unlimited servers.
         const auto plan = scheduler.plan(
@@ -267,11 +266,7 @@ namespace palpate
           [&known](const unsigned int p) { return known[p]; },
           unlimited ? grid.size() : 2 * settings.servers,
           allow_bridge);
-        if (plan.empty() && allow_bridge)
-          {
-            bridge_failed_at   = finished;
-            bridge_failed_cell = cell;
-          }
+        bridge.planned(plan.empty(), allow_bridge, finished, cell);
 
         // Give out the tasks, most urgent first.
         unsigned int waiting = 0;

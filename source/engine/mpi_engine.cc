@@ -181,8 +181,7 @@ namespace palpate
     unsigned int            busy            = 0;
     bool                    nothing_to_plan = false, replan = false;
     std::uint64_t           finished = 0, finished_at_plan = 0;
-    std::uint64_t           bridge_failed_at = ~std::uint64_t(0);
-    GridIndex               bridge_failed_cell{{0, 0, 0}};
+    BridgeMemory            bridge;
     Clock::time_point       next_tick;
     std::thread             thread;
     Clock::time_point       t0;
@@ -428,19 +427,14 @@ namespace palpate
         return !s.lost;
       });
 
-    const bool allow_bridge =
-      !(finished == bridge_failed_at && cell == bridge_failed_cell);
-    const auto plan = scheduler.plan(
+    const bool allow_bridge = bridge.allowed(finished, cell);
+    const auto plan         = scheduler.plan(
       position,
       velocity,
       [this](const unsigned int p) { return knowledge(p); },
       2 * std::max(1u, alive),
       allow_bridge);
-    if (plan.empty() && allow_bridge)
-      {
-        bridge_failed_at   = finished;
-        bridge_failed_cell = cell;
-      }
+    bridge.planned(plan.empty(), allow_bridge, finished, cell);
     nothing_to_plan  = plan.empty();
     finished_at_plan = finished;
     replan           = false;
@@ -622,10 +616,10 @@ namespace palpate
     if (s.cache.status(s.origin) != PointStatus::available)
       s.cache.publish_force(s.origin, {{0, 0, 0}}, s.cache.generation());
     std::lock_guard<std::mutex> lock(s.mutex);
-    s.nothing_to_plan  = false;
-    s.replan           = true;
-    s.bridge_failed_at = ~std::uint64_t(0);
-    s.attached         = true;
+    s.nothing_to_plan = false;
+    s.replan          = true;
+    s.bridge.reset();
+    s.attached = true;
   }
 
 

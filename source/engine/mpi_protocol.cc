@@ -176,8 +176,6 @@ namespace palpate
                    MPI_STATUS_IGNORE) != MPI_SUCCESS)
         return false;
       rank = status.MPI_SOURCE;
-      ++messages_received;
-      bytes_received += count;
       return true;
     }
 

@@ -106,8 +106,7 @@ namespace palpate
       ready.kind = Kind::ready;
       try
         {
-          solver       = std::make_unique<StateSolver>(mesh, nodes, p);
-          ready.n_dofs = solver->rest_state().solution.size();
+          solver = std::make_unique<StateSolver>(mesh, nodes, p);
           ready.set_text(solver->linear_solver_name());
         }
       catch (const std::exception &e)
@@ -125,6 +124,24 @@ namespace palpate
     const auto rest = std::make_shared<const State>(solver->rest_state());
 
     Shared shared;
+    // The whole state of point p if this server holds it (the rest state
+    // always), else null. Call with shared.mutex held.
+    const auto held = [&](const unsigned int p) {
+      if (p == origin)
+        return rest;
+      const auto i = shared.store.find(p);
+      return i == shared.store.end() ? std::shared_ptr<const State>() :
+                                       i->second;
+    };
+    // Ask the communicator to request point p from @p holder, unless it
+    // is on its way already. Call with shared.mutex held.
+    const auto request = [&](const unsigned int p, const int holder) {
+      if (shared.requested.count(p))
+        return;
+      shared.failed.erase(p);
+      shared.requested[p] = holder;
+      shared.to_request.emplace_back(p, holder);
+    };
 
     // The solver thread: one task at a time.
     std::thread solver_thread([&] {
@@ -150,21 +167,11 @@ namespace palpate
 
           // The source: the rest state, one held here, or one fetched
           // from its holder through the communicator.
-          std::shared_ptr<const State> source;
-          if (task.source == origin)
-            source = rest;
-          else if (const auto s = shared.store.find(task.source);
-                   s != shared.store.end())
-            source = s->second;
-          else if (task.holder != messenger.rank())
+          std::shared_ptr<const State> source = held(task.source);
+          if (!source && task.holder != messenger.rank())
             {
               const auto asked = Clock::now();
-              if (!shared.requested.count(task.source))
-                {
-                  shared.failed.erase(task.source);
-                  shared.requested[task.source] = task.holder;
-                  shared.to_request.emplace_back(task.source, task.holder);
-                }
+              request(task.source, task.holder);
               // The holder answers within a round trip; a holder that
               // died never does, and the task then ends as
               // source_missing for the client to plan again.
@@ -176,9 +183,7 @@ namespace palpate
                 return;
               shared.failed.erase(task.source);
               shared.requested.erase(task.source);
-              if (const auto s = shared.store.find(task.source);
-                  s != shared.store.end())
-                source = s->second;
+              source               = held(task.source);
               result.fetch_seconds = seconds_since(asked);
             }
           if (source && shared.transferred.erase(task.source) > 0)
@@ -194,13 +199,6 @@ namespace palpate
           // here (they are not fetched), make Newton's start second- or
           // third-order.
           std::shared_ptr<const State> behind, behind2;
-          const auto                   held = [&](const unsigned int p) {
-            if (p == origin)
-              return rest;
-            const auto i = shared.store.find(p);
-            return i == shared.store.end() ? std::shared_ptr<const State>() :
-                                                               i->second;
-          };
           if (unsigned int b = 0;
               task.source != origin && grid.behind(task.source, task.point, b))
             {
@@ -275,7 +273,6 @@ namespace palpate
     // The communicator.
     auto              last_heartbeat = Clock::now() - std::chrono::seconds(1);
     unsigned int      tasks_received = 0;
-    std::uint64_t     states_sent    = 0;
     bool              running        = true;
     std::vector<char> message;
     while (running)
@@ -298,14 +295,8 @@ namespace palpate
                     shared.tasks.push_back(h);
                     shared.wake_solver.notify_all();
                     // Prefetch its source from the server that holds it.
-                    if (h.source != origin && h.holder != messenger.rank() &&
-                        !shared.store.count(h.source) &&
-                        !shared.requested.count(h.source))
-                      {
-                        shared.failed.erase(h.source);
-                        shared.requested[h.source] = h.holder;
-                        shared.to_request.emplace_back(h.source, h.holder);
-                      }
+                    if (h.holder != messenger.rank() && !held(h.source))
+                      request(h.source, h.holder);
                     break;
                   }
                 case Kind::request_state:
@@ -313,17 +304,11 @@ namespace palpate
                     std::shared_ptr<const State> s;
                     {
                       std::lock_guard<std::mutex> lock(shared.mutex);
-                      if (h.point == origin)
-                        s = rest;
-                      else if (const auto i = shared.store.find(h.point);
-                               i != shared.store.end())
-                        s = i->second;
+                      s = held(h.point);
                     }
                     Header reply = h;
                     reply.kind   = s ? Kind::state : Kind::state_missing;
                     reply.holder = messenger.rank();
-                    if (s)
-                      ++states_sent;
                     messenger.send(from, s ? pack(reply, *s) : pack(reply));
                     break;
                   }
@@ -382,7 +367,6 @@ namespace palpate
               // traffic of all ranks.
               h.messages_sent = messenger.messages_sent + 1;
               h.bytes_sent    = messenger.bytes_sent + sizeof(Header);
-              h.states_sent   = states_sent;
               messenger.send(client_rank, pack(h));
               activity = true;
             }
@@ -393,7 +377,6 @@ namespace palpate
             beat.kind          = Kind::heartbeat;
             beat.messages_sent = messenger.messages_sent + 1;
             beat.bytes_sent    = messenger.bytes_sent + sizeof(Header);
-            beat.states_sent   = states_sent;
             messenger.send(client_rank, pack(beat));
             last_heartbeat = Clock::now();
           }

@@ -105,8 +105,7 @@ namespace palpate
     bool replan = false;
     // The bridge found nothing with this many tasks finished and the HIP
     // in this cell: do not scan the grid again until one changes.
-    std::uint64_t            bridge_failed_at = ~std::uint64_t(0);
-    GridIndex                bridge_failed_cell{{0, 0, 0}};
+    BridgeMemory             bridge;
     std::atomic<bool>        is_running{false};
     bool                     started_once = false;
     std::vector<std::thread> workers;
@@ -135,19 +134,14 @@ namespace palpate
         grid.locate(position, cell, local);
         lock.lock();
 
-        const bool allow_bridge =
-          !(finished == bridge_failed_at && cell == bridge_failed_cell);
-        const auto plan = scheduler.plan(
+        const bool allow_bridge = bridge.allowed(finished, cell);
+        const auto plan         = scheduler.plan(
           position,
           velocity,
           [this](const unsigned int p) { return knowledge(p); },
           2 * solvers.size(),
           allow_bridge);
-        if (plan.empty() && allow_bridge)
-          {
-            bridge_failed_at   = finished;
-            bridge_failed_cell = cell;
-          }
+        bridge.planned(plan.empty(), allow_bridge, finished, cell);
         // Queued tasks that are neither in the new plan nor in the cloud
         // any more are dropped.
         for (const Task &old : queue)
@@ -332,11 +326,11 @@ namespace palpate
       std::lock_guard<std::mutex> lock(s.mutex);
       if (!s.started_once)
         s.t0 = Clock::now(); // task times count from the first attach
-      s.started_once     = true;
-      s.is_running       = true;
-      s.nothing_to_plan  = false;
-      s.replan           = false;
-      s.bridge_failed_at = ~std::uint64_t(0);
+      s.started_once    = true;
+      s.is_running      = true;
+      s.nothing_to_plan = false;
+      s.replan          = false;
+      s.bridge.reset();
     }
     for (unsigned int w = 0; w < s.solvers.size(); ++w)
       s.workers.emplace_back([&s, w] { s.worker_loop(w); });

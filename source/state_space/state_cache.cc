@@ -39,6 +39,44 @@ namespace palpate
       return sizeof(State) + s.solution.size() * sizeof(double) +
              s.multipliers.size() * sizeof(double);
     }
+    /**
+     * What the real-time side reads of a point, written behind its
+     * sequence lock (the caller holds the cache's mutex, so there is one
+     * writer): odd sequence, the fields, even sequence.
+     */
+    template <typename Entry>
+    void
+    write_entry(Entry                   &e,
+                const Utilities::Point3 &force,
+                const PointStatus        status,
+                const std::uint64_t      generation)
+    {
+      const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
+      e.sequence.store(s + 1, std::memory_order_relaxed);
+      std::atomic_thread_fence(std::memory_order_release);
+      for (unsigned int d = 0; d < 3; ++d)
+        e.force[d].store(force[d], std::memory_order_relaxed);
+      e.status.store(static_cast<std::uint8_t>(status),
+                     std::memory_order_relaxed);
+      e.generation.store(generation, std::memory_order_relaxed);
+      e.sequence.store(s + 2, std::memory_order_release);
+    }
+
+    /** Make a point available with @p force unless it already is in this
+     * generation: rewriting the same value would only make a concurrent
+     * real-time read miss it. */
+    template <typename Entry>
+    void
+    make_available(Entry                   &e,
+                   const Utilities::Point3 &force,
+                   const std::uint64_t      generation)
+    {
+      if (e.generation.load(std::memory_order_relaxed) == generation &&
+          e.status.load(std::memory_order_relaxed) ==
+            static_cast<std::uint8_t>(PointStatus::available))
+        return;
+      write_entry(e, force, PointStatus::available, generation);
+    }
   } // namespace
 
 
@@ -93,20 +131,7 @@ namespace palpate
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
-    Entry &e = entries[point];
-    if (e.generation.load(std::memory_order_relaxed) == generation &&
-        e.status.load(std::memory_order_relaxed) ==
-          static_cast<std::uint8_t>(PointStatus::available))
-      return; // already available: keep the force the haptic side reads
-    const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
-    e.sequence.store(s + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
-    for (unsigned int d = 0; d < 3; ++d)
-      e.force[d].store(force[d], std::memory_order_relaxed);
-    e.status.store(static_cast<std::uint8_t>(PointStatus::available),
-                   std::memory_order_relaxed);
-    e.generation.store(generation, std::memory_order_relaxed);
-    e.sequence.store(s + 2, std::memory_order_release);
+    make_available(entries[point], force, generation);
   }
 
 
@@ -134,24 +159,9 @@ namespace palpate
       return; // computed for parameters that no longer hold
     Entry &e = entries[point];
     // A point that is already available (a state recomputed because its
-    // whole state had been dropped) keeps its force: rewriting the same
-    // value would only make a concurrent real-time read miss it.
-    const bool available =
-      e.generation.load(std::memory_order_relaxed) == generation &&
-      e.status.load(std::memory_order_relaxed) ==
-        static_cast<std::uint8_t>(PointStatus::available);
-    if (!available)
-      {
-        const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
-        e.sequence.store(s + 1, std::memory_order_relaxed);
-        std::atomic_thread_fence(std::memory_order_release);
-        for (unsigned int d = 0; d < 3; ++d)
-          e.force[d].store(state->force[d], std::memory_order_relaxed);
-        e.status.store(static_cast<std::uint8_t>(PointStatus::available),
-                       std::memory_order_relaxed);
-        e.generation.store(generation, std::memory_order_relaxed);
-        e.sequence.store(s + 2, std::memory_order_release);
-      }
+    // whole state had been dropped, or fetched from an MPI server whose
+    // force arrived first) keeps its force.
+    make_available(e, state->force, generation);
 
     if (!states[point])
       ++held;
@@ -196,16 +206,7 @@ namespace palpate
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
-    Entry              &e = entries[point];
-    const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
-    e.sequence.store(s + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
-    for (unsigned int d = 0; d < 3; ++d)
-      e.force[d].store(0.0, std::memory_order_relaxed);
-    e.status.store(static_cast<std::uint8_t>(PointStatus::failed),
-                   std::memory_order_relaxed);
-    e.generation.store(generation, std::memory_order_relaxed);
-    e.sequence.store(s + 2, std::memory_order_release);
+    write_entry(entries[point], {{0, 0, 0}}, PointStatus::failed, generation);
   }
 
 

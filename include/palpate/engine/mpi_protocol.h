@@ -90,10 +90,8 @@ namespace palpate
       /** task: the active node's displacement at the target (m). */
       double position[3] = {0, 0, 0};
       /** The sender's counters so far (servers, in results and
-       * heartbeats): messages and bytes sent, whole states sent. */
-      std::uint64_t messages_sent = 0, bytes_sent = 0, states_sent = 0;
-      /** ready: the number of unknowns of a state. */
-      std::uint64_t n_dofs = 0;
+       * heartbeats): messages and bytes sent. */
+      std::uint64_t messages_sent = 0, bytes_sent = 0;
       /** ready: linear solver; result and ready: an error message. */
       char text[200] = {};
 
@@ -163,9 +161,8 @@ namespace palpate
         return n_ranks;
       }
 
-      /** Messages and bytes sent and received so far. */
-      std::uint64_t messages_sent = 0, bytes_sent = 0, messages_received = 0,
-                    bytes_received = 0;
+      /** Messages and bytes sent so far. */
+      std::uint64_t messages_sent = 0, bytes_sent = 0;
 
     private:
       struct Pending

@@ -78,6 +78,48 @@ namespace palpate
   }
 
   /**
+   * What an engine remembers between plans about Scheduler::plan's bridge:
+   * when the bridge found nothing, the grid is not scanned again until a
+   * task has finished or the HIP is in another cell (nothing it could find
+   * has changed).
+   */
+  class BridgeMemory
+  {
+  public:
+    /** Whether the next plan may build a bridge. */
+    bool
+    allowed(const std::uint64_t tasks_finished, const GridIndex &cell) const
+    {
+      return !(tasks_finished == failed_at && cell == failed_cell);
+    }
+
+    /** After a plan made with @p allowed_bridge: remember a fruitless one. */
+    void
+    planned(const bool          plan_empty,
+            const bool          allowed_bridge,
+            const std::uint64_t tasks_finished,
+            const GridIndex    &cell)
+    {
+      if (plan_empty && allowed_bridge)
+        {
+          failed_at   = tasks_finished;
+          failed_cell = cell;
+        }
+    }
+
+    /** Forget (a new attach). */
+    void
+    reset()
+    {
+      failed_at = ~std::uint64_t(0);
+    }
+
+  private:
+    std::uint64_t failed_at   = ~std::uint64_t(0);
+    GridIndex     failed_cell = {{0, 0, 0}};
+  };
+
+  /**
    * The scheduling policy: which states to compute next.
    *
    * The *cloud* is the set of grid points within the cloud radius R of the
