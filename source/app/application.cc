@@ -249,6 +249,12 @@ namespace palpate
         err << "\npalpate: the input has a problem, " << e.what() << "\n";
         return ExitStatus::input_error;
       }
+    catch (const OutputError &e)
+      {
+        out.flush();
+        err << "\npalpate: output failed: " << e.what() << "\n";
+        return ExitStatus::output_failed;
+      }
     catch (const NotAvailableError &e)
       {
         out.flush();

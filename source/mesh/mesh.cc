@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
@@ -333,6 +334,26 @@ namespace palpate
   Mesh
   Mesh::create(const Scene &scene)
   {
+    // A body palpate can touch is between a few millimetres (a small
+    // sample) and about a metre (the largest organs) across: anything else
+    // is a mesh read in the wrong unit, and would run with nonsense
+    // forces and a state space of the wrong size.
+    const auto check_size = [](const Scene &scene, const Mesh &mesh) {
+      const double size = mesh.diameter();
+      if (size >= 0.002 && size <= 2)
+        return;
+      const double factor = scene.parameters.mesh.scale_factor;
+      throw scene.error(
+        "Mesh/Scale factor",
+        "with this scale factor the body is " + Utilities::to_string(size, 3) +
+          " m across (the diagonal of its bounding box); a body to palpate "
+          "is between 0.002 and 2 m: the mesh file's unit is not the one "
+          "the scale factor assumes",
+        "set Scale factor to the metres per mesh-file unit: 0.001 for "
+        "millimetres, 0.01 for centimetres; for this mesh to be 0.25 m "
+        "across (a liver), " +
+          Utilities::to_string(factor * 0.25 / size, 4) + ".");
+    };
     const auto &p = scene.parameters.mesh;
     if (p.source == "beam")
       return Mesh(generate_beam(p), 1.0, "the beam generator");
@@ -348,12 +369,14 @@ namespace palpate
         "The shared liver meshes are in ../shared/meshes next to the "
         "project (see its README); or use Source = blob, which needs no "
         "file.");
+    std::unique_ptr<Mesh> mesh;
     try
       {
         // Errors about the file's content name the file as the scene
         // writes it (and the report shows it that way too).
-        Mesh mesh(read_mesh_file(path), p.scale_factor, p.file_name);
-        return mesh;
+        mesh = std::make_unique<Mesh>(read_mesh_file(path),
+                                      p.scale_factor,
+                                      p.file_name);
       }
     catch (const InputError &e)
       {
@@ -366,6 +389,8 @@ namespace palpate
                          e.fix() + " (The scene '" + scene.file() +
                            "' reads this file through Mesh / File name.)");
       }
+    check_size(scene, *mesh);
+    return std::move(*mesh);
   }
 
 

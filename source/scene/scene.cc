@@ -9,12 +9,15 @@
 #include <boost/property_tree/ptree.hpp>
 #include <boost/property_tree/xml_parser.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 namespace palpate
 {
@@ -197,64 +200,37 @@ namespace palpate
       if (std::regex_search(description,
                             std::regex(R"(^\[List of <\[Integer)")))
         return "whole numbers separated by commas";
-      return description;
-    }
-
-    /** Whether @p value matches the declared pattern @p description. */
-    bool
-    matches(const std::string &description, const std::string &value)
-    {
+      // A pattern this function does not know: deal.II's own words.
       const auto pattern = dealii::Patterns::pattern_factory(description);
-      return pattern != nullptr && pattern->match(value);
+      return pattern != nullptr ?
+               pattern->description(dealii::Patterns::PatternBase::Text) :
+               description;
     }
 
-    /**
-     * One logical line of a .prm file: comments removed, continuation lines
-     * joined, with the number of the line it starts on.
-     */
-    struct LogicalLine
+    /** The physical lines of a scene file, without line ends. */
+    std::vector<std::string>
+    split_lines(const std::string &content)
     {
-      unsigned int number;
-      std::string  text;
-    };
-
-    std::vector<LogicalLine>
-    read_logical_lines(std::istream &in)
-    {
-      std::vector<LogicalLine> lines;
-      std::string              raw;
-      unsigned int             number = 0;
-      std::string              pending;
-      unsigned int             pending_start = 0;
-      while (std::getline(in, raw))
+      std::vector<std::string> lines;
+      std::istringstream       in(content);
+      std::string              line;
+      while (std::getline(in, line))
         {
-          ++number;
-          if (!raw.empty() && raw.back() == '\r')
-            raw.pop_back();
-          // Strip a comment: '#' not preceded by a backslash.
-          std::string stripped;
-          for (unsigned int i = 0; i < raw.size(); ++i)
-            {
-              if (raw[i] == '#' && (i == 0 || raw[i - 1] != '\\'))
-                break;
-              stripped += raw[i];
-            }
-          if (pending.empty())
-            pending_start = number;
-          const std::string t = Utilities::trim(stripped);
-          if (!t.empty() && t.back() == '\\')
-            {
-              pending += t.substr(0, t.size() - 1) + " ";
-              continue;
-            }
-          pending += stripped;
-          if (!Utilities::trim(pending).empty())
-            lines.push_back({pending_start, Utilities::trim(pending)});
-          pending.clear();
+          if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+          lines.push_back(line);
         }
-      if (!Utilities::trim(pending).empty())
-        lines.push_back({pending_start, Utilities::trim(pending)});
       return lines;
+    }
+
+    /** @p line without its comment ('#' not after a backslash), trimmed. */
+    std::string
+    without_comment(const std::string &line)
+    {
+      for (std::size_t i = 0; i < line.size(); ++i)
+        if (line[i] == '#' && (i == 0 || line[i - 1] != '\\'))
+          return Utilities::trim(line.substr(0, i));
+      return Utilities::trim(line);
     }
 
     bool
@@ -278,6 +254,78 @@ namespace palpate
       return true;
     }
 
+    /**
+     * The statement that ends on line @p last (1-based): its first line
+     * and its text, continuation lines ('\' at the end) joined.
+     */
+    std::pair<unsigned int, std::string>
+    statement_at(const std::vector<std::string> &lines, const unsigned int last)
+    {
+      if (last == 0 || last > lines.size())
+        return {last, ""};
+      unsigned int first = last;
+      while (first > 1)
+        {
+          const std::string previous = without_comment(lines[first - 2]);
+          if (previous.empty() || previous.back() != '\\')
+            break;
+          --first;
+        }
+      std::string text;
+      for (unsigned int l = first; l <= last; ++l)
+        {
+          std::string piece = without_comment(lines[l - 1]);
+          if (l < last && !piece.empty() && piece.back() == '\\')
+            piece.pop_back();
+          text += (text.empty() ? "" : " ") + piece;
+        }
+      return {first, Utilities::trim(text)};
+    }
+
+    /**
+     * The subsection path in force before line @p line (1-based), and
+     * where each of its subsections was opened. deal.II's ParameterHandler
+     * has accepted these lines: this only finds where a message points.
+     */
+    std::vector<std::string>
+    path_before(const std::vector<std::string> &lines,
+                const unsigned int              line,
+                std::vector<unsigned int>      *opened_at = nullptr)
+    {
+      std::vector<std::string>  path;
+      std::vector<unsigned int> opened;
+      for (unsigned int l = 1; l < line && l <= lines.size(); ++l)
+        {
+          std::string       rest;
+          const std::string t = without_comment(lines[l - 1]);
+          if (starts_with_keyword(t, "subsection", rest))
+            {
+              path.push_back(rest);
+              opened.push_back(l);
+            }
+          else if (starts_with_keyword(t, "end", rest) && rest.empty() &&
+                   !path.empty())
+            {
+              path.pop_back();
+              opened.pop_back();
+            }
+        }
+      if (opened_at != nullptr)
+        *opened_at = opened;
+      return path;
+    }
+
+    /** The declared subsection at @p path, nullptr if there is none. */
+    const DeclaredSection *
+    section_at(const std::vector<std::string> &path)
+    {
+      const DeclaredSection *s = &declared_tree();
+      for (const auto &name : path)
+        if (s != nullptr)
+          s = s->find_subsection(name);
+      return s;
+    }
+
     std::string
     entry_key(const std::vector<std::string> &path, const std::string &name)
     {
@@ -285,6 +333,167 @@ namespace palpate
       for (const auto &p : path)
         key += p + "/";
       return key + name;
+    }
+
+    /**
+     * Attach to every declared entry below @p section an action that
+     * passes the entry's key ("Section/Entry") and value to @p record.
+     */
+    void
+    record_every_entry(dealii::ParameterHandler                       &prm,
+                       const DeclaredSection                          &section,
+                       std::vector<std::string>                       &path,
+                       const std::function<void(const std::string &,
+                                                const std::string &)> &record)
+    {
+      for (const auto &named_entry : section.entries)
+        {
+          const std::string key = entry_key(path, named_entry.first);
+          prm.add_action(named_entry.first,
+                         [key, &record](const std::string &value) {
+                           record(key, value);
+                         });
+        }
+      for (const auto &[name, sub] : section.subsections)
+        {
+          prm.enter_subsection(name);
+          path.push_back(name);
+          record_every_entry(prm, sub, path, record);
+          path.pop_back();
+          prm.leave_subsection();
+        }
+    }
+
+    /** deal.II's own words for an exception, without the stack trace. */
+    std::string
+    dealii_message(const std::exception &e)
+    {
+      if (const auto *d = dynamic_cast<const dealii::ExceptionBase *>(&e))
+        {
+          std::ostringstream s;
+          d->print_info(s);
+          std::string text = Utilities::trim(s.str());
+          for (char &c : text)
+            if (c == '\n')
+              c = ' ';
+          return text;
+        }
+      return e.what();
+    }
+
+    /** "A/B/C" as "A / B / C". */
+    std::string
+    shown_key(const std::string &key)
+    {
+      std::string s;
+      for (const char c : key)
+        s += c == '/' ? std::string(" / ") : std::string(1, c);
+      return s;
+    }
+
+    /**
+     * The error for the statement deal.II's ParameterHandler stopped at:
+     * which line, which entry, why, and a likely fix. @p kind says which
+     * of deal.II's exceptions it threw.
+     */
+    enum class Rejection
+    {
+      no_subsection,
+      cannot_parse,
+      invalid_value,
+      other
+    };
+
+    InputError
+    explain_rejection(const std::string              &filename,
+                      const std::vector<std::string> &lines,
+                      const unsigned int              last_line,
+                      const Rejection                 kind,
+                      const std::string              &dealii_words)
+    {
+      const auto [line, text]             = statement_at(lines, last_line);
+      const std::vector<std::string> path = path_before(lines, line);
+      const DeclaredSection         *here = section_at(path);
+      std::string                    rest;
+      if (here != nullptr && kind == Rejection::no_subsection &&
+          starts_with_keyword(text, "subsection", rest))
+        return InputError(filename,
+                          line,
+                          "subsection " + rest + " (in " +
+                            path_to_string(path) + ")",
+                          "there is no subsection '" + rest + "' here",
+                          suggestion(rest, here->subsection_names()) +
+                            "The subsections here are: " +
+                            join(here->subsection_names(), ", ") +
+                            ". 'palpate --print-parameters' lists everything.");
+      if (here != nullptr && starts_with_keyword(text, "set", rest))
+        {
+          const auto equal = rest.find('=');
+          if (equal == std::string::npos)
+            return InputError(filename,
+                              line,
+                              text,
+                              "a 'set' line needs the form 'set Name = value'",
+                              "add ' = value' after the entry name.");
+          const std::string    name  = Utilities::trim(rest.substr(0, equal));
+          const std::string    value = Utilities::trim(rest.substr(equal + 1));
+          const DeclaredEntry *entry = here->find_entry(name);
+          if (entry == nullptr)
+            return InputError(filename,
+                              line,
+                              path_to_string(path) + " / " + name,
+                              "there is no entry '" + name + "' in " +
+                                path_to_string(path),
+                              suggestion(name, here->entry_names()) +
+                                "The entries here are: " +
+                                join(here->entry_names(), ", ") + ".");
+          if (kind == Rejection::invalid_value)
+            {
+              std::string       hint;
+              const std::string selection = "[Selection ";
+              const auto       &d         = entry->pattern_description;
+              if (d.compare(0, selection.size(), selection) == 0 &&
+                  d.size() > selection.size() + 2)
+                hint =
+                  suggestion(value,
+                             Utilities::split(d.substr(selection.size(),
+                                                       d.size() -
+                                                         selection.size() - 2),
+                                              '|'));
+              return InputError(
+                filename,
+                line,
+                path_to_string(path) + " / " + name + " = " + value,
+                "'" + value + "' is not allowed here: the entry takes " +
+                  describe_pattern(d),
+                hint + "Set " + name + " to such a value (its default is '" +
+                  entry->default_value + "').");
+            }
+        }
+      if (starts_with_keyword(text, "end", rest) && rest.empty() &&
+          path.empty())
+        return InputError(filename,
+                          line,
+                          "end",
+                          "'end' without a matching 'subsection'",
+                          "remove this line, or add the 'subsection' it is "
+                          "meant to close.");
+      if (kind == Rejection::cannot_parse &&
+          !starts_with_keyword(text, "set", rest) &&
+          !starts_with_keyword(text, "subsection", rest) &&
+          !starts_with_keyword(text, "end", rest))
+        return InputError(filename,
+                          line,
+                          text,
+                          "this line is not 'subsection Name', 'end' or "
+                          "'set Name = value'",
+                          "fix the line or comment it out with '#'.");
+      return InputError(filename,
+                        line,
+                        text.empty() ? std::string("(whole file)") : text,
+                        "deal.II's ParameterHandler rejected the file: " +
+                          dealii_words,
+                        "fix the line the message names.");
     }
   } // namespace
 
@@ -302,143 +511,198 @@ namespace palpate
   Scene
   Scene::read(const std::string &filename)
   {
+    namespace fs = std::filesystem;
     Scene scene;
     scene.file_      = filename;
-    scene.directory_ = std::filesystem::path(filename).parent_path().string();
+    scene.directory_ = fs::path(filename).parent_path().string();
 
-    std::ifstream in(filename);
+    std::error_code ec;
+    if (fs::is_directory(filename, ec))
+      {
+        std::vector<std::string> scenes;
+        for (const auto &e : fs::directory_iterator(filename, ec))
+          if (e.path().extension() == ".prm")
+            scenes.push_back(e.path().string());
+        std::sort(scenes.begin(), scenes.end());
+        throw InputError(
+          filename,
+          0,
+          "(the scene file itself)",
+          "this is a directory, not a scene file",
+          scenes.empty() ?
+            std::string("give a .prm scene file; shipped scenes are in "
+                        "parameters/, e.g. 'palpate parameters/default.prm'.") :
+            "give one of the " + std::to_string(scenes.size()) +
+              " .prm files in it, e.g. 'palpate " + scenes.front() + "'.");
+      }
+    std::ifstream in(filename, std::ios::binary);
     if (!in)
       throw InputError(filename,
                        0,
                        "(the scene file itself)",
                        "the file cannot be opened: " +
-                         std::string(std::filesystem::exists(filename) ?
+                         std::string(fs::exists(filename, ec) ?
                                        "it is not readable" :
                                        "it does not exist"),
                        "check the path; shipped scenes are in parameters/, "
                        "e.g. 'palpate parameters/default.prm'.");
-
-    // First pass: check every line against the declared parameters, so
-    // that errors can name the line, the entry and a likely fix.
-    const DeclaredSection               &root = declared_tree();
-    std::vector<const DeclaredSection *> stack{&root};
-    std::vector<std::string>             path;
-    std::vector<unsigned int>            opened_at;
-    for (const LogicalLine &line : read_logical_lines(in))
+    // A scene is a few kB of text: refuse to read gigabytes by mistake.
+    constexpr std::size_t max_bytes = std::size_t(4) << 20;
+    std::string           content(max_bytes + 1, '\0');
+    in.read(content.data(), content.size());
+    if (in.bad())
+      throw InputError(filename,
+                       0,
+                       "(the scene file itself)",
+                       "the file cannot be read (an input/output error)",
+                       "check the disk and the path.");
+    content.resize(in.gcount());
+    if (content.size() > max_bytes)
+      throw InputError(filename,
+                       0,
+                       "(the scene file itself)",
+                       "the file is larger than 4 MiB; a scene file is a few "
+                       "kB of text",
+                       "check that this is the scene (.prm) and not a mesh or "
+                       "an output file.");
+    {
+      unsigned int line = 1, column = 1;
+      for (const char c : content)
+        {
+          const auto byte = static_cast<unsigned char>(c);
+          if (c == '\n')
+            {
+              ++line;
+              column = 1;
+              continue;
+            }
+          if (byte < 0x20 && c != '\t' && c != '\r')
+            throw InputError(
+              filename,
+              line,
+              "column " + std::to_string(column) + " of line " +
+                std::to_string(line),
+              "the line holds " +
+                std::string(byte == 0 ? "a NUL byte" :
+                                        "a control character (byte " +
+                                          std::to_string(byte) + ")") +
+                ", which a scene file (plain text) cannot contain",
+              "delete the character, or check that this is the scene file "
+              "and not a binary file.");
+          ++column;
+        }
+    }
+    const std::vector<std::string> lines = split_lines(content);
+    for (unsigned int l = 1; l <= lines.size(); ++l)
       {
         std::string rest;
-        if (starts_with_keyword(line.text, "subsection", rest))
-          {
-            const DeclaredSection *sub = stack.back()->find_subsection(rest);
-            if (sub == nullptr)
-              throw InputError(
-                filename,
-                line.number,
-                "subsection " + rest + " (in " + path_to_string(path) + ")",
-                "there is no subsection '" + rest + "' here",
-                suggestion(rest, stack.back()->subsection_names()) +
-                  "The subsections here are: " +
-                  join(stack.back()->subsection_names(), ", ") +
-                  ". 'palpate --print-parameters' lists everything.");
-            stack.push_back(sub);
-            path.push_back(rest);
-            opened_at.push_back(line.number);
-          }
-        else if (starts_with_keyword(line.text, "end", rest) && rest.empty())
-          {
-            if (path.empty())
-              throw InputError(filename,
-                               line.number,
-                               "end",
-                               "'end' without a matching 'subsection'",
-                               "remove this line, or add the 'subsection' it "
-                               "is meant to close.");
-            stack.pop_back();
-            path.pop_back();
-            opened_at.pop_back();
-          }
-        else if (starts_with_keyword(line.text, "set", rest))
-          {
-            const auto equal = rest.find('=');
-            if (equal == std::string::npos)
-              throw InputError(filename,
-                               line.number,
-                               line.text,
-                               "a 'set' line needs the form 'set Name = value'",
-                               "add ' = value' after the entry name.");
-            const std::string name  = Utilities::trim(rest.substr(0, equal));
-            const std::string value = Utilities::trim(rest.substr(equal + 1));
-            const DeclaredEntry *entry = stack.back()->find_entry(name);
-            if (entry == nullptr)
-              throw InputError(filename,
-                               line.number,
-                               path_to_string(path) + " / " + name,
-                               "there is no entry '" + name + "' in " +
-                                 path_to_string(path),
-                               suggestion(name, stack.back()->entry_names()) +
-                                 "The entries here are: " +
-                                 join(stack.back()->entry_names(), ", ") + ".");
-            if (!matches(entry->pattern_description, value))
-              {
-                std::string hint;
-                std::smatch m;
-                if (std::regex_match(entry->pattern_description,
-                                     m,
-                                     std::regex(R"(\[Selection (.*) \])")))
-                  hint = suggestion(value, Utilities::split(m[1].str(), '|'));
-                throw InputError(filename,
-                                 line.number,
-                                 path_to_string(path) + " / " + name + " = " +
-                                   value,
-                                 "'" + value +
-                                   "' is not allowed here: the "
-                                   "entry takes " +
-                                   describe_pattern(entry->pattern_description),
-                                 hint + "Set " + name +
-                                   " to such a value (its default is '" +
-                                   entry->default_value + "').");
-              }
-            scene.entry_lines_[entry_key(path, name)]  = line.number;
-            scene.entry_values_[entry_key(path, name)] = value;
-          }
-        else if (starts_with_keyword(line.text, "include", rest))
+        if (starts_with_keyword(without_comment(lines[l - 1]), "include", rest))
           throw InputError(filename,
-                           line.number,
-                           line.text,
+                           l,
+                           without_comment(lines[l - 1]),
                            "scene files cannot include other files",
                            "copy the entries you need into this file.");
-        else
-          throw InputError(filename,
-                           line.number,
-                           line.text,
-                           "this line is not 'subsection Name', 'end' or "
-                           "'set Name = value'",
-                           "fix the line or comment it out with '#'.");
       }
-    if (!path.empty())
-      throw InputError(filename,
-                       opened_at.back(),
-                       "subsection " + path.back(),
-                       "the subsection opened here is never closed",
-                       "add a line 'end' after its last entry.");
 
-    // Second pass: the file is well-formed, let deal.II read the values.
+    // deal.II's ParameterHandler reads the file. An action on every entry
+    // records what the file sets and on which line (the stream position
+    // tells), so messages can point at the line and an entry set twice is
+    // caught instead of the last one silently winning.
+    if (content.empty() || content.back() != '\n')
+      content += '\n';
+    std::istringstream stream(content);
+    const auto         line_now = [&]() -> unsigned int {
+      const std::streamoff position = stream.tellg();
+      if (position < 0)
+        return lines.size();
+      return std::count(content.begin(), content.begin() + position, '\n');
+    };
+    struct Setting
+    {
+      std::string  key;
+      std::string  value;
+      unsigned int line;
+    };
+    std::vector<Setting> settings;
+    const std::function<void(const std::string &, const std::string &)> record =
+      [&](const std::string &key, const std::string &value) {
+        settings.push_back({key, value, line_now()});
+      };
     dealii::ParameterHandler prm;
     Parameters::AllParameters::declare_parameters(prm);
+    {
+      std::vector<std::string> path;
+      record_every_entry(prm, declared_tree(), path, record);
+    }
+    settings.clear(); // add_action() ran each action once for the default
     try
       {
-        std::ifstream values(filename);
-        prm.parse_input(values, filename, "", false);
+        prm.parse_input(stream, filename, "", false);
+      }
+    catch (const dealii::ParameterHandler::ExcNoSubsection &e)
+      {
+        throw explain_rejection(filename,
+                                lines,
+                                line_now(),
+                                Rejection::no_subsection,
+                                dealii_message(e));
+      }
+    catch (const dealii::ParameterHandler::ExcCannotParseLine &e)
+      {
+        throw explain_rejection(filename,
+                                lines,
+                                line_now(),
+                                Rejection::cannot_parse,
+                                dealii_message(e));
+      }
+    catch (const dealii::ParameterHandler::ExcInvalidEntryForPattern &e)
+      {
+        throw explain_rejection(filename,
+                                lines,
+                                line_now(),
+                                Rejection::invalid_value,
+                                dealii_message(e));
+      }
+    catch (const dealii::ParameterHandler::ExcUnbalancedSubsections &)
+      {
+        std::vector<unsigned int>      opened;
+        const std::vector<std::string> path =
+          path_before(lines, lines.size() + 1, &opened);
+        if (path.empty())
+          throw InputError(filename,
+                           0,
+                           "(whole file)",
+                           "the numbers of 'subsection' and 'end' lines "
+                           "differ",
+                           "close every subsection with one 'end'.");
+        throw InputError(filename,
+                         opened.back(),
+                         "subsection " + path.back(),
+                         "the subsection opened here is never closed",
+                         "add a line 'end' after its last entry.");
       }
     catch (const std::exception &e)
       {
-        throw InputError(filename,
-                         0,
-                         "(whole file)",
-                         std::string("deal.II's ParameterHandler rejected "
-                                     "the file: ") +
-                           e.what(),
-                         "fix the entry the message names.");
+        throw explain_rejection(
+          filename, lines, line_now(), Rejection::other, dealii_message(e));
+      }
+
+    std::map<std::string, const Setting *> first_setting;
+    for (const Setting &s : settings)
+      {
+        const auto [it, first] = first_setting.emplace(s.key, &s);
+        if (!first)
+          throw InputError(filename,
+                           s.line,
+                           shown_key(s.key) + " = " + s.value,
+                           "the entry is set twice: on line " +
+                             std::to_string(it->second->line) + " (" +
+                             it->second->value + ") and on line " +
+                             std::to_string(s.line) + " (" + s.value +
+                             "); palpate does not guess which one you meant",
+                           "delete one of the two lines.");
+        scene.entry_lines_[s.key]  = s.line;
+        scene.entry_values_[s.key] = s.value;
       }
     scene.parameters.parse_parameters(prm);
     scene.validate();
@@ -492,6 +756,7 @@ namespace palpate
   void
   Scene::validate() const
   {
+    using namespace Limits;
     const auto &p = parameters;
 
     // Material: the moduli of the model in use must describe a solid.
@@ -558,6 +823,41 @@ namespace palpate
                   "the scale factor must be positive",
                   "set it to the number of metres per mesh-file unit, e.g. "
                   "0.001 for a mesh in millimetres.");
+
+    if (p.mesh.source == "beam")
+      {
+        const double dims[3]  = {p.mesh.beam_length,
+                                 p.mesh.beam_width,
+                                 p.mesh.beam_height};
+        const char  *names[3] = {"Length", "Width", "Height"};
+        const char  *words[3] = {"length", "width", "height"};
+        for (unsigned int d = 0; d < 3; ++d)
+          if (!(dims[d] > 0))
+            throw error(std::string("Mesh/Beam/") + names[d],
+                        std::string("the beam's ") + words[d] +
+                          " must be positive: a beam of zero or negative " +
+                          words[d] + " has no volume",
+                        std::string("set it in metres, e.g. ") +
+                          (d == 0 ? "0.1." : "0.02."));
+        const double nodes = (p.mesh.beam_subdivisions_length + 1.) *
+                             (p.mesh.beam_subdivisions_width + 1.) *
+                             (p.mesh.beam_subdivisions_height + 1.);
+        if (nodes > max_generated_nodes)
+          throw error("Mesh/Beam/Subdivisions",
+                      "the beam would have " + Utilities::to_string(nodes, 3) +
+                        " nodes; at most " +
+                        Utilities::to_string(max_generated_nodes, 3) +
+                        " are allowed (a state of 1e5 nodes takes minutes, "
+                        "far from haptic rates)",
+                      "use fewer subdivisions, e.g. 10, 2, 2.");
+      }
+    if (p.mesh.source == "blob")
+      for (unsigned int d = 0; d < 3; ++d)
+        if (!(p.mesh.blob_semi_axes[d] > 0))
+          throw error("Mesh/Blob/Semi-axes",
+                      "every semi-axis must be positive: a blob with a zero "
+                      "or negative semi-axis has no volume",
+                      "give three lengths in metres, e.g. 0.125, 0.09, 0.07.");
 
     // Fixed nodes: the region must be well-defined.
     const auto &f = p.boundary_conditions.fixed_nodes;
@@ -627,6 +927,42 @@ namespace palpate
         "spacing.");
     if (p.scheduler.rate <= 0)
       throw error("Scheduler/Rate", "the rate must be positive", "use 100 Hz.");
+    if (p.scheduler.cloud_radius > p.state_space.extent)
+      throw error("Scheduler/Cloud radius",
+                  "the cloud reaches beyond the state space (State space / "
+                  "Extent = " +
+                    Utilities::to_string(p.state_space.extent, 4) +
+                    " m): the initial cloud alone would be most of the "
+                    "grid's points, and the motion would wait for them",
+                  "keep the cloud local: a radius of 4-6 grid spacings (the "
+                  "default 0.025 m with 0.005 m spacing); at most Extent.");
+    if (p.scheduler.rate > max_scheduler_rate)
+      throw error("Scheduler/Rate",
+                  "at most " + Utilities::to_string(max_scheduler_rate, 4) +
+                    " Hz: the scheduler re-plans the cloud on each cycle, and "
+                    "faster cycles only take time from the solvers",
+                  "use 100 Hz (the paper's rate).");
+    {
+      const unsigned int cores =
+        std::max(2u, std::thread::hardware_concurrency());
+      if (p.engine.type == "threads" && p.engine.workers > cores)
+        throw error("Engine/Workers",
+                    "at most " + std::to_string(cores) +
+                      " on this machine, its number of cores: each worker is "
+                      "a solver thread that needs a core, and more workers "
+                      "than cores only take time from the haptic loop",
+                    "set Workers to " + std::to_string(cores) +
+                      " or less (for more solvers, use several machines: "
+                      "Engine / Type = mpi).");
+      if (p.nonlinear_solver.assembly_threads > cores)
+        throw error("Nonlinear solver/Assembly threads",
+                    "at most " + std::to_string(cores) +
+                      " on this machine, its number of cores: more threads "
+                      "than cores do not assemble faster",
+                    "set Assembly threads to 1 (the workers already use the "
+                    "cores) or at most " +
+                      std::to_string(cores) + ".");
+    }
 
     // Haptics.
     const auto &h = p.haptics;
@@ -642,12 +978,33 @@ namespace palpate
       throw error("Haptics/Maximum force change",
                   "the force change per tick must be positive",
                   "use e.g. 0.05 N.");
+    if (h.loop_rate > max_loop_rate)
+      throw error("Haptics/Loop rate",
+                  "at most " + Utilities::to_string(max_loop_rate, 5) +
+                    " Hz: haptic devices run at 1 kHz, the fastest at 10 kHz, "
+                    "and the loop preallocates its statistics for every tick",
+                  "use 1000 Hz.");
     const auto &t = h.trajectory;
     if ((t.type == "straight line" || t.type == "circle") &&
         Utilities::norm(t.direction) == 0)
       throw error("Haptics/Trajectory/Direction",
                   "the direction is the zero vector",
                   "give a direction, e.g. 0, 0, -1.");
+    if (t.type != "replay" && t.duration > max_motion_duration)
+      throw error("Haptics/Trajectory/Duration",
+                  "at most " + Utilities::to_string(max_motion_duration, 4) +
+                    " s (one hour): the haptic loop preallocates its "
+                    "statistics and force log for every tick of the run, so "
+                    "the real-time thread never allocates",
+                  "split a longer session into several runs.");
+    if (t.type != "replay" && t.speed > max_hip_speed)
+      throw error("Haptics/Trajectory/Speed",
+                  "at most " + Utilities::to_string(max_hip_speed, 3) +
+                    " m/s: a hand on a haptic device moves at most about "
+                    "2 m/s, and states for a faster probe can never be "
+                    "computed in time",
+                  "give the speed in m/s: 0.01 is 1 cm/s, a careful "
+                  "palpation; 0.03 m/s is fast.");
     if (t.type == "replay" && t.file_name.empty())
       throw error("Haptics/Trajectory/File name",
                   "Type = replay, but no CSV file is named",
@@ -655,6 +1012,13 @@ namespace palpate
     if (p.effects.shape_output && p.effects.shape_output_rate <= 0)
       throw error("Effects/Shape output rate",
                   "the rate must be positive",
+                  "use 30 Hz.");
+    if (p.effects.shape_output &&
+        p.effects.shape_output_rate > max_shape_output_rate)
+      throw error("Effects/Shape output rate",
+                  "at most " + Utilities::to_string(max_shape_output_rate, 3) +
+                    " Hz: each frame is a VTU file of the whole mesh, and a "
+                    "screen shows at most 240 frames a second",
                   "use 30 Hz.");
   }
 

@@ -5,6 +5,7 @@
 // and must exit with status 2 (input error) and a message that names the
 // file, the line if there is one, the entry, and what to do.
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -12,17 +13,20 @@
 
 namespace
 {
-  const std::string beam = "subsection Run\n  set Mode = set-up only\nend\n"
-                           "subsection Mesh\n  set Source = beam\nend\n"
-                           "subsection Boundary conditions\n"
-                           "  subsection Fixed nodes\n"
-                           "    set Selection = boundary id\n"
-                           "    set Boundary ids = 0\n"
-                           "  end\n"
-                           "  subsection Active node\n"
-                           "    set Point = 0.1, 0, 0.01\n"
-                           "  end\n"
-                           "end\n";
+  const std::string setup = "subsection Run\n  set Mode = set-up only\nend\n";
+  const std::string interaction =
+    "subsection Run\n  set Mode = interaction\nend\n";
+  const std::string beam_body = "subsection Mesh\n  set Source = beam\nend\n"
+                                "subsection Boundary conditions\n"
+                                "  subsection Fixed nodes\n"
+                                "    set Selection = boundary id\n"
+                                "    set Boundary ids = 0\n"
+                                "  end\n"
+                                "  subsection Active node\n"
+                                "    set Point = 0.1, 0, 0.01\n"
+                                "  end\n"
+                                "end\n";
+  const std::string beam      = setup + beam_body;
 
   void
   run(const std::string &what, const std::string &arguments)
@@ -142,15 +146,187 @@ main(int argc, char **argv)
 
   scene("the MPI engine without mpirun (exit status 2)",
         "mpi.prm",
-        beam + "subsection Engine\n  set Type = mpi\nend\n"
-               "subsection Run\n  set Mode = interaction\nend\n");
+        interaction + beam_body + "subsection Engine\n  set Type = mpi\nend\n");
   write_file("path.csv", "t, x, y, z\n0, 0, 0, 0\n0.1, 0.001, 0\n");
   scene("a replay trajectory file with a bad line",
         "replay.prm",
-        beam +
+        interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
-          "    set Type = replay\n    set File name = path.csv\n  end\nend\n"
-          "subsection Run\n  set Mode = interaction\nend\n");
+          "    set Type = replay\n    set File name = path.csv\n  end\nend\n");
   run("a scene file that does not exist", "no-such-scene.prm");
   run("an unknown option", "--frobnicate");
+
+  // Issue 11: each of these once crashed, hung, or ran with nonsense.
+  std::filesystem::create_directories("scenes/sub");
+  write_file("scenes/a.prm", beam);
+  run("a directory given as the scene", "scenes");
+  scene("Haptics / Loop rate = 1e9 (once: std::bad_alloc)",
+        "loop-rate.prm",
+        beam + "subsection Haptics\n  set Loop rate = 1e9\nend\n");
+  scene("a trajectory Duration = 1e12 s (once: std::bad_alloc)",
+        "duration.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Duration = 1e12\n  end\nend\n");
+  write_file("ms.csv", "t, x, y, z\n0, 0, 0, 0\n5000000, 0, 0, -0.001\n");
+  scene("a replay recording of 5e6 s (its times in ms?)",
+        "replay-long.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = ms.csv\n  end\nend\n");
+  scene("Engine / Workers = 1000 (once: accepted, 1,400 deadline misses)",
+        "workers.prm",
+        beam + "subsection Engine\n  set Workers = 1000\nend\n");
+  scene("Nonlinear solver / Assembly threads = 1000",
+        "assembly.prm",
+        beam + "subsection Nonlinear solver\n  set Assembly threads = 1000\n"
+               "end\n");
+  scene("Cloud radius beyond the grid (once: a silent 120 s stall)",
+        "cloud.prm",
+        beam + "subsection Scheduler\n  set Cloud radius = 0.2\nend\n");
+  scene("a memory budget that cannot hold the cloud (once: thrashing)",
+        "budget.prm",
+        interaction + beam_body +
+          "subsection Engine\n  set Memory budget = 1\nend\n"
+          "subsection Scheduler\n  set Cloud radius = 0.1\nend\n");
+  scene("an entry set twice (once: the last silently won)",
+        "twice.prm",
+        beam + "subsection Run\n  set Mode = interaction\nend\n");
+  scene("a NUL byte in a line (once: the message was cut off)",
+        "nul.prm",
+        beam +
+          std::string("subsection Mesh\n  set Scale fac\0tor = 1\nend\n", 42));
+  scene("Beam / Length = 0 (once: blamed on the beam generator)",
+        "beam-length.prm",
+        beam + "subsection Mesh\n  subsection Beam\n    set Length = 0\n"
+               "  end\nend\n");
+  scene("a trajectory Speed = 1e6 m/s (once: accepted)",
+        "speed.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Speed = 1e6\n  end\nend\n");
+  scene("an output directory that is a file",
+        "outdir.prm",
+        interaction + beam_body +
+          "subsection Output\n  set Directory = good.prm/out\nend\n"
+          "subsection Effects\n  set Force log = true\nend\n");
+
+  // The parser is deal.II's: continuation lines and Windows line ends are
+  // read as deal.II reads them (both scenes are fine).
+  scene("a value continued on the next line (fine)",
+        "continued.prm",
+        beam + "subsection Material model\n"
+               "  subsection St.Venant-Kirchhoff\n"
+               "    set Young's modulus = \\\n      20000\n  end\nend\n");
+  scene("Windows line ends (fine)",
+        "crlf.prm",
+        "subsection Run\r\n  set Mode = set-up only\r\nend\r\n");
+
+  // The grammar of a scene file.
+  scene("'end' without a subsection", "end.prm", beam + "end\n");
+  scene("a set line without '='",
+        "set.prm",
+        beam + "subsection Mesh\n  set Scale factor 2\nend\n");
+  scene("an include line", "include.prm", "include other.prm\n" + beam);
+  scene("a line that is no statement", "junk.prm", beam + "hello world\n");
+  run("a binary file given as the scene", palpate_executable);
+
+  // Values that are numbers but not physical.
+  scene("a negative Young's modulus",
+        "young.prm",
+        beam + "subsection Material model\n"
+               "  subsection St.Venant-Kirchhoff\n"
+               "    set Young's modulus = -5\n  end\nend\n");
+  scene("Young's modulus = nan",
+        "young-nan.prm",
+        beam + "subsection Material model\n"
+               "  subsection St.Venant-Kirchhoff\n"
+               "    set Young's modulus = nan\n  end\nend\n");
+  scene("Mooney-Rivlin with C10 + C01 = 0",
+        "mr.prm",
+        beam + "subsection Material model\n"
+               "  set Model name = Mooney-Rivlin\n"
+               "  subsection Mooney-Rivlin\n    set C10 = 0\n    set C01 = 0\n"
+               "  end\nend\n");
+  scene("Mooney-Rivlin P1-P1 with quadratic displacements",
+        "mr-degree.prm",
+        beam + "subsection Material model\n"
+               "  set Model name = Mooney-Rivlin\nend\n"
+               "subsection Discretization\n  set Polynomial degree = 2\nend\n");
+  scene("Mesh / Scale factor = 0",
+        "scale.prm",
+        beam + "subsection Mesh\n  set Scale factor = 0\nend\n");
+  scene("a beam of 1e9 nodes",
+        "subdivisions.prm",
+        beam + "subsection Mesh\n  subsection Beam\n"
+               "    set Subdivisions = 1000, 1000, 1000\n  end\nend\n");
+  scene("a blob with a zero semi-axis",
+        "blob.prm",
+        setup + "subsection Mesh\n  subsection Blob\n"
+                "    set Semi-axes = 0.1, 0, 0.05\n  end\nend\n");
+  scene("an empty fixed-node box",
+        "box.prm",
+        setup + "subsection Boundary conditions\n  subsection Fixed nodes\n"
+                "    set Selection = box\n    set Box lower corner = 0, 0, 0\n"
+                "    set Box upper corner = 1, 0, 1\n  end\nend\n");
+  scene("a zero half-space normal",
+        "normal.prm",
+        setup + "subsection Boundary conditions\n  subsection Fixed nodes\n"
+                "    set Half-space normal = 0, 0, 0\n  end\nend\n");
+  scene("an empty fixed-node list",
+        "node-list.prm",
+        setup + "subsection Boundary conditions\n  subsection Fixed nodes\n"
+                "    set Selection = node list\n  end\nend\n");
+  scene("a grid spacing larger than the extent",
+        "grid.prm",
+        beam + "subsection State space\n  set Grid spacing = 0.2\nend\n");
+  scene("a state space of 1e9 grid points",
+        "extent.prm",
+        beam + "subsection State space\n  set Extent = 5\nend\n");
+  scene("a cloud too small for one cell",
+        "cloud-small.prm",
+        beam + "subsection Scheduler\n  set Cloud radius = 0.001\nend\n");
+  scene("Scheduler / Rate = 1e9",
+        "scheduler-rate.prm",
+        beam + "subsection Scheduler\n  set Rate = 1e9\nend\n");
+  scene("Haptics / Force limit = 0",
+        "force-limit.prm",
+        beam + "subsection Haptics\n  set Force limit = 0\nend\n");
+  scene("a zero trajectory direction",
+        "direction.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Direction = 0, 0, 0\n  end\nend\n");
+  scene("a replay trajectory without a file",
+        "replay-none.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Type = replay\n  end\nend\n");
+  scene("Shape output at 1e6 Hz",
+        "shape-rate.prm",
+        beam + "subsection Effects\n  set Shape output = true\n"
+               "  set Shape output rate = 1e6\nend\n");
+  write_file("empty.msh", "");
+  scene("an empty mesh file",
+        "empty-mesh.prm",
+        setup + "subsection Mesh\n  set Source = file\n"
+                "  set File name = empty.msh\nend\n");
+  scene("a mesh file that is a directory",
+        "dir-mesh.prm",
+        setup + "subsection Mesh\n  set Source = file\n"
+                "  set File name = scenes\nend\n");
+  scene("a mesh file of an unknown format",
+        "format-mesh.prm",
+        setup + "subsection Mesh\n  set Source = file\n"
+                "  set File name = good.prm\nend\n");
+  scene(
+    "the liver mesh read in the wrong unit (scale factor 1)",
+    "liver-mm.prm",
+    setup +
+      "subsection Mesh\n  set Source = file\n"
+      "  set File name = " +
+      palpate_shared_dir +
+      "/meshes/liver-tetgen/liver501.msh\nend\n"
+      "subsection Boundary conditions\n  subsection Fixed nodes\n"
+      "    set Selection = box\n    set Box lower corner = -1e9, -1e9, -1e9\n"
+      "    set Box upper corner = 1e9, 1e9, -1\n  end\nend\n");
+  run("'solve' without a scene", "solve");
+  run("'solve --to' with two numbers", "solve good.prm --to 0,0");
+  run("an unexpected second argument", "good.prm other.prm");
 }

@@ -24,6 +24,8 @@ namespace palpate
     /** An MPI solver server was lost during the run (the summary says
      * which and why); what the others computed was used. */
     constexpr int server_lost = 5;
+    /** The run finished, but an output file could not be written. */
+    constexpr int output_failed = 6;
   } // namespace ExitStatus
 
   /**

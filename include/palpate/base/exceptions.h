@@ -15,6 +15,19 @@ namespace palpate
    * is wrong with it, and what to do about it. `main()` prints it as a banner
    * and exits with status 2; tests print it verbatim.
    */
+  /**
+   * palpate could not write an output file (the directory removed, the disk
+   * full) after the work itself was done: the message names the file and
+   * the reason; what was computed is reported before it.
+   */
+  class OutputError : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
+
+
   class InputError : public std::runtime_error
   {
   public:

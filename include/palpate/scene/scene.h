@@ -14,6 +14,26 @@
 namespace palpate
 {
   /**
+   * Where a number in a scene could exhaust the machine, the largest value
+   * Scene::validate() accepts. Each error message says why.
+   */
+  namespace Limits
+  {
+    /** Haptics / Loop rate (Hz): devices run at 1 kHz, the fastest at 10. */
+    constexpr double max_loop_rate = 10000;
+    /** Motion duration (s): the loop preallocates per-tick statistics. */
+    constexpr double max_motion_duration = 3600;
+    /** Trajectory speed (m/s): a hand moves at most about 2 m/s. */
+    constexpr double max_hip_speed = 10;
+    /** Scheduler / Rate (Hz). */
+    constexpr double max_scheduler_rate = 1000;
+    /** Effects / Shape output rate (Hz): one VTU file per frame. */
+    constexpr double max_shape_output_rate = 240;
+    /** Nodes of a generated mesh (beam). */
+    constexpr double max_generated_nodes = 1e5;
+  } // namespace Limits
+
+  /**
    * A scene as read from a `.prm` file: its parameters, plus where each one
    * came from, so that any later check (a missing mesh file, a region that
    * selects no node) can point at the file, the line and the entry.
