@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/app/interaction_run.h>
+#include <palpate/base/exceptions.h>
 #include <palpate/haptics/haptic_loop.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
@@ -12,12 +13,58 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <iomanip>
 #include <ostream>
 #include <thread>
 
 namespace palpate
 {
+  namespace
+  {
+    /**
+     * That Output / Directory exists or can be created, and takes files:
+     * an InputError naming the entry if not.
+     */
+    void
+    check_output_directory(const Scene &scene)
+    {
+      const std::string &directory = scene.parameters.output.directory;
+      std::string        problem;
+      try
+        {
+          std::filesystem::create_directories(directory);
+          const std::string probe = directory + "/.palpate-write-test";
+          {
+            std::ofstream test(probe);
+            test << "test\n";
+            test.flush();
+            if (!test)
+              problem = "files cannot be written in it";
+          }
+          std::filesystem::remove(probe);
+        }
+      catch (const std::filesystem::filesystem_error &e)
+        {
+          problem = std::string("it cannot be created: ") + e.code().message() +
+                    (std::filesystem::exists(directory) &&
+                         !std::filesystem::is_directory(directory) ?
+                       " (a file of that name is in the way)" :
+                       "");
+        }
+      if (!problem.empty())
+        throw scene.error("Output/Directory",
+                          "the scene writes files (shape output, force log "
+                          "or summaries) into '" +
+                            directory + "', but " + problem,
+                          "name a directory you can write, e.g. 'output', or "
+                          "turn those outputs off.");
+    }
+  } // namespace
+
+
+
   RunSummary
   run_interaction(std::ostream &out, const Scene &scene)
   {
@@ -27,10 +74,30 @@ namespace palpate
     // How long the initial cloud may take before the motion starts anyway.
     const double wait_limit = 120;
 
+    // The output directory is checked before anything runs, so that no
+    // work is lost to an unwritable directory at the end.
+    const bool files = p.effects.force_log ||
+                       !p.output.summary_formats.empty() ||
+                       p.effects.shape_output;
+    if (files)
+      check_output_directory(scene);
+
+    auto         trajectory = Trajectory::create(scene);
+    const double duration   = trajectory->duration();
+    if (duration > Limits::max_motion_duration)
+      throw InputError(
+        scene.resolve_path(p.haptics.trajectory.file_name),
+        0,
+        "trajectory replay (Haptics / Trajectory / File name)",
+        "the recording lasts " + Utilities::to_string(duration, 4) +
+          " s; at most " +
+          Utilities::to_string(Limits::max_motion_duration, 4) +
+          " s (one hour) are allowed: the haptic loop preallocates its "
+          "statistics and force log for every tick of the run",
+        "check the time column (seconds, not milliseconds), or split the "
+        "recording.");
     Interaction     interaction(scene);
     const auto     &grid        = interaction.grid();
-    auto            trajectory  = Trajectory::create(scene);
-    const double    duration    = trajectory->duration();
     const double    max_seconds = wait_limit + duration + 1;
     SimulatedDevice device(std::move(trajectory),
                            p.effects.force_log ?
@@ -72,6 +139,13 @@ namespace palpate
     bool         cloud_complete = false;
     if (moving)
       loop.start_motion();
+    else
+      out << "  initial cloud: " << interaction.initial_cloud_size()
+          << " grid points around the rest position; the motion starts when "
+             "they are computed (at most "
+          << wait_limit << " s)\n"
+          << std::flush;
+    double next_progress = 10; // s: a word every 10 s while waiting
 
     // Watch: report events as they happen, start the motion once the
     // initial cloud is there.
@@ -81,6 +155,17 @@ namespace palpate
         interaction.poll_events(out);
         const double t =
           std::chrono::duration<double>(Clock::now() - t0).count();
+        if (!moving && t > next_progress &&
+            !interaction.initial_cloud_complete())
+          {
+            const auto counts = interaction.cache().counts();
+            out << "  initial cloud: " << counts.first << " of "
+                << interaction.initial_cloud_size() << " states computed ("
+                << counts.second << " failure points) after "
+                << std::setprecision(3) << t << " s\n"
+                << std::flush;
+            next_progress += 10;
+          }
         if (!moving && (interaction.initial_cloud_complete() || t > wait_limit))
           {
             const auto counts = interaction.cache().counts();
@@ -97,8 +182,17 @@ namespace palpate
           }
       }
     loop.join();
+    // What could not be written is collected and reported after everything
+    // else was written: one lost file does not lose the others.
+    std::vector<std::string> output_failures;
     if (shape)
-      shape->stop();
+      {
+        shape->stop();
+        if (!shape->failure().empty())
+          output_failures.push_back("the shape output stopped after " +
+                                    std::to_string(shape->frames().first) +
+                                    " frames: " + shape->failure());
+      }
     interaction.detach();
     interaction.poll_events(out);
 
@@ -113,31 +207,52 @@ namespace palpate
     summary.print(out);
 
     // Machine-readable copies and logs, only when asked for.
-    const bool files =
-      p.effects.force_log || !p.output.summary_formats.empty() || shape;
-    if (files)
-      std::filesystem::create_directories(p.output.directory);
+    const auto write = [&](const std::string           &file,
+                           const std::function<void()> &how) {
+      try
+        {
+          std::filesystem::create_directories(p.output.directory);
+          how();
+          out << "  wrote " << file << "\n";
+        }
+      catch (const std::exception &e)
+        {
+          output_failures.push_back(file + ": " + e.what());
+        }
+    };
     for (const auto &format : p.output.summary_formats)
       {
         const std::string file =
           p.output.directory + "/" + stem + "-summary." + format;
-        if (format == "csv")
-          summary.write_csv(file);
-        else
-          summary.write_json(file);
-        out << "  wrote " << file << "\n";
+        write(file, [&] {
+          if (format == "csv")
+            summary.write_csv(file);
+          else
+            summary.write_json(file);
+        });
       }
     if (p.effects.force_log)
       {
         const std::string file =
           p.output.directory + "/" + stem + "-forces.csv";
-        device.write_force_log(file);
-        out << "  wrote " << file << "\n";
+        write(file, [&] { device.write_force_log(file); });
       }
     if (shape)
       out << "  wrote " << p.output.directory << "/" << stem << "-shape.pvd ("
           << shape->frames().first << " frames, " << shape->frames().second
           << " skipped for missing states)\n";
+    if (!output_failures.empty())
+      {
+        std::string what;
+        for (const auto &f : output_failures)
+          what += "\n  " + f;
+        throw OutputError(
+          "the interaction finished (its summary is above), but " +
+          std::to_string(output_failures.size()) +
+          " output(s) could not be written:" + what +
+          "\n  Check the disk and Output / Directory (" + p.output.directory +
+          ").");
+      }
     return summary;
   }
 } // namespace palpate

@@ -142,8 +142,16 @@ namespace palpate
     void
     wait_for_servers();
 
+    /** The communicator thread: communicate(), and whatever it throws
+     * ends the engine through shut_down_after_error(). */
     void
     loop();
+
+    void
+    communicate();
+
+    void
+    shut_down_after_error(const std::string &what);
 
     void
     handle(const int from, const std::vector<char> &message);
@@ -512,6 +520,43 @@ namespace palpate
 
   void
   MpiEngine::Impl::loop()
+  {
+    // The communicator must not take the process down while a device
+    // renders forces: whatever it throws ends the distributed engine
+    // cleanly (every server counted lost, with the reason, and released
+    // at the end); the interaction goes on with what is cached.
+    try
+      {
+        communicate();
+      }
+    catch (const std::exception &e)
+      {
+        shut_down_after_error(e.what());
+      }
+    catch (...)
+      {
+        shut_down_after_error("an exception of unknown type");
+      }
+  }
+
+
+
+  void
+  MpiEngine::Impl::shut_down_after_error(const std::string &what)
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++stats.errors;
+    stats.last_error = "MPI communicator thread: " + what;
+    for (unsigned int r = 1; r < servers.size(); ++r)
+      lose(r, "the client's communicator thread failed (" + what + ")");
+    quit = true;
+    stopped.notify_all();
+  }
+
+
+
+  void
+  MpiEngine::Impl::communicate()
   {
     const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / parameters.scheduler.rate));

@@ -71,8 +71,16 @@ namespace palpate
                              cache.has_state(p));
     }
 
+    /** The scheduler thread: schedule(), and whatever it throws stops
+     * the engine through shut_down_after_error(). */
     void
     scheduler_loop();
+
+    void
+    schedule();
+
+    void
+    shut_down_after_error(const std::string &what);
 
     void
     worker_loop(const unsigned int worker);
@@ -112,12 +120,56 @@ namespace palpate
     std::thread              scheduler_thread;
     Clock::time_point        t0;
     EngineStatistics         stats;
+    EngineFaults             faults;
+    unsigned int             plans  = 0;
+    bool                     failed = false; // the scheduler threw
   };
 
 
 
   void
   ThreadEngine::Impl::scheduler_loop()
+  {
+    // The scheduler must not take the process down while a device renders
+    // forces: whatever it throws is counted and reported, the workers stop
+    // (is_running = false) and the interaction goes on with what is
+    // cached, its force fading where states are missing.
+    try
+      {
+        schedule();
+      }
+    catch (const std::exception &e)
+      {
+        shut_down_after_error(e.what());
+      }
+    catch (...)
+      {
+        shut_down_after_error("an exception of unknown type");
+      }
+  }
+
+
+
+  void
+  ThreadEngine::Impl::shut_down_after_error(const std::string &what)
+  {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      ++stats.errors;
+      stats.last_error = "scheduler thread: " + what;
+      is_running       = false;
+      failed           = true;
+      queue.clear();
+      nothing_to_plan = true;
+    }
+    work_available.notify_all();
+    work_done.notify_all();
+  }
+
+
+
+  void
+  ThreadEngine::Impl::schedule()
   {
     const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / parameters.scheduler.rate));
@@ -134,6 +186,10 @@ namespace palpate
         grid.locate(position, cell, local);
         lock.lock();
 
+        if (faults.scheduler_throws_at_plan > 0 &&
+            ++plans == faults.scheduler_throws_at_plan)
+          throw std::runtime_error("fault injected for a test (plan " +
+                                   std::to_string(plans) + ")");
         const bool allow_bridge = bridge.allowed(finished, cell);
         const auto plan         = scheduler.plan(
           position,
@@ -296,9 +352,12 @@ namespace palpate
                              const Parameters::AllParameters &parameters,
                              const StateGrid                 &grid,
                              StateCache                      &cache,
-                             const HipChannel                &hip)
+                             const HipChannel                &hip,
+                             const EngineFaults              &faults)
     : impl(std::make_unique<Impl>(mesh, nodes, parameters, grid, cache, hip))
-  {}
+  {
+    impl->faults = faults;
+  }
 
 
 
@@ -327,6 +386,7 @@ namespace palpate
       if (!s.started_once)
         s.t0 = Clock::now(); // task times count from the first attach
       s.started_once    = true;
+      s.failed          = false;
       s.is_running      = true;
       s.nothing_to_plan = false;
       s.replan          = false;
@@ -346,8 +406,10 @@ namespace palpate
     {
       // Under the mutex, so that no thread can test the flag, miss the
       // notification and then wait for ever.
+      // (The scheduler may have stopped the engine itself after an error:
+      // its threads are joined all the same.)
       std::lock_guard<std::mutex> lock(s.mutex);
-      if (!s.is_running)
+      if (!s.is_running && !s.scheduler_thread.joinable())
         return;
       s.is_running = false;
     }
@@ -394,6 +456,8 @@ namespace palpate
   ThreadEngine::idle() const
   {
     std::lock_guard<std::mutex> lock(impl->mutex);
+    if (impl->failed)
+      return impl->busy == 0; // nothing more will be planned
     return impl->busy == 0 && impl->queue.empty() && impl->nothing_to_plan &&
            impl->finished_at_plan == impl->finished;
   }

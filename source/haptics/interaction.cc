@@ -5,6 +5,7 @@
 #include <palpate/engine/hip_channel.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/hyperelastic/state.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
@@ -39,10 +40,48 @@ namespace palpate
     {
       for (unsigned int p = 0; p < grid.size(); ++p)
         used[p].store(0, std::memory_order_relaxed);
+      const double radius = scene.parameters.scheduler.cloud_radius;
+      const int    reach =
+        std::min<int>(grid.half_width(), std::floor(radius / grid.spacing()));
+      for (int i = -reach; i <= reach; ++i)
+        for (int j = -reach; j <= reach; ++j)
+          for (int k = -reach; k <= reach; ++k)
+            cloud_size +=
+              Utilities::norm(grid.position(GridIndex{{i, j, k}})) <= radius;
+      check_memory_budget();
       engine =
         PrecomputationEngine::create(scene, mesh, nodes, grid, cache, hip);
     }
 
+    /**
+     * That the memory budget holds the initial cloud's whole states: if it
+     * cannot, the cache drops states it needs as sources and computes them
+     * again, without end.
+     */
+    void
+    check_memory_budget() const
+    {
+      // At least the displacement of every node and the state's own size
+      // (Mooney-Rivlin's pressures and quadratic elements add more).
+      const double state_bytes = sizeof(State) + 3. * mesh.n_vertices() * 8;
+      const double budget = scene.parameters.engine.memory_budget * 1048576.0;
+      const double needed = 1.25 * cloud_size * state_bytes;
+      if (needed > budget)
+        throw scene.error(
+          "Engine/Memory budget",
+          "the initial cloud's " + std::to_string(cloud_size) +
+            " states of this mesh (" + std::to_string(mesh.n_vertices()) +
+            " nodes, at least " + Utilities::to_string(state_bytes / 1024, 3) +
+            " KiB each) need at least " +
+            Utilities::to_string(needed / 1048576, 3) +
+            " MiB with room to move; beyond the budget the cache drops "
+            "states it needs again and recomputes them without end",
+          "raise Memory budget to " +
+            Utilities::to_string(std::ceil(2 * needed / 1048576), 4) +
+            " (MiB) or more, or make Scheduler / Cloud radius smaller.");
+    }
+
+    unsigned int                                 cloud_size = 0;
     Scene                                        scene;
     Mesh                                         mesh;
     NodeSelection                                nodes;
@@ -225,6 +264,14 @@ namespace palpate
     if (!s.initial_done.load() && s.is_attached.load() && s.engine->idle())
       s.initial_done.store(true);
     return s.initial_done.load();
+  }
+
+
+
+  unsigned int
+  Interaction::initial_cloud_size() const noexcept
+  {
+    return impl->cloud_size;
   }
 
 

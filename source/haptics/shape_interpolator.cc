@@ -37,12 +37,16 @@ namespace palpate
     void
     run();
 
+    void
+    write_frames();
+
     const Interaction        &interaction;
     const double              rate;
     const std::string         directory, stem;
     HyperelasticSystem        system; // for the FE space and VTU output
     std::atomic<bool>         running{false};
     std::atomic<unsigned int> written{0}, skipped{0};
+    std::string               failure; // written by the thread before it ends
     std::vector<std::pair<double, std::string>> records;
     std::thread                                 thread;
   };
@@ -51,6 +55,28 @@ namespace palpate
 
   void
   ShapeInterpolator::Impl::run()
+  {
+    // A frame that cannot be written (the directory removed, the disk
+    // full) stops the shape output, not the interaction: the error is kept
+    // for stop() and failure(), and the frames written so far stay listed.
+    try
+      {
+        write_frames();
+      }
+    catch (const std::exception &e)
+      {
+        failure = e.what();
+      }
+    catch (...)
+      {
+        failure = "an exception of unknown type";
+      }
+  }
+
+
+
+  void
+  ShapeInterpolator::Impl::write_frames()
   {
     using Clock        = std::chrono::steady_clock;
     const auto  t0     = Clock::now();
@@ -146,8 +172,21 @@ namespace palpate
     if (!impl->running.exchange(false))
       return;
     impl->thread.join();
-    std::ofstream pvd(impl->directory + "/" + impl->stem + "-shape.pvd");
-    dealii::DataOutBase::write_pvd_record(pvd, impl->records);
+    const std::string file = impl->directory + "/" + impl->stem + "-shape.pvd";
+    std::ofstream     pvd(file);
+    if (pvd)
+      dealii::DataOutBase::write_pvd_record(pvd, impl->records);
+    pvd.flush();
+    if (!pvd && impl->failure.empty())
+      impl->failure = "cannot write the file '" + file + "'";
+  }
+
+
+
+  const std::string &
+  ShapeInterpolator::failure() const
+  {
+    return impl->failure;
   }
 
 

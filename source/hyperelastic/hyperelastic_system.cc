@@ -1120,5 +1120,9 @@ namespace palpate
     if (!out)
       throw std::runtime_error("cannot write the file '" + filename + "'");
     data_out.write_vtu(out);
+    out.flush();
+    if (!out)
+      throw std::runtime_error("writing the file '" + filename +
+                               "' failed (is the disk full?)");
   }
 } // namespace palpate

@@ -12,6 +12,17 @@
 namespace palpate
 {
   /**
+   * Faults a test can inject into a ThreadEngine, to check that each thread
+   * reports what goes wrong and shuts down cleanly instead of taking the
+   * process down. The default injects nothing.
+   */
+  struct EngineFaults
+  {
+    /** The scheduler throws at this plan (counting from 1); 0: never. */
+    unsigned int scheduler_throws_at_plan = 0;
+  };
+
+  /**
    * The precomputation engine on one machine: a scheduler thread (at
    * Scheduler / Rate) plans tasks with the Scheduler policy into a small
    * queue, rebuilt at every tick (tasks that left the cloud are dropped);
@@ -28,7 +39,8 @@ namespace palpate
                  const Parameters::AllParameters &parameters,
                  const StateGrid                 &grid,
                  StateCache                      &cache,
-                 const HipChannel                &hip);
+                 const HipChannel                &hip,
+                 const EngineFaults              &faults = EngineFaults());
 
     ~ThreadEngine() override;
 

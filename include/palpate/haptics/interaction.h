@@ -87,6 +87,11 @@ namespace palpate
     bool
     initial_cloud_complete() const;
 
+    /** The number of grid points in the cloud around the rest position:
+     * the states computed before the motion starts. */
+    unsigned int
+    initial_cloud_size() const noexcept;
+
     /**
      * Change the material, the fixed nodes, the active node, the effects or
      * the solver settings: only while detached (std::logic_error

@@ -42,6 +42,13 @@ namespace palpate
     std::pair<unsigned int, unsigned int>
     frames() const;
 
+    /**
+     * After stop(): why the shape output stopped early (a frame or the PVD
+     * file could not be written), or empty if it did not.
+     */
+    const std::string &
+    failure() const;
+
   private:
     struct Impl;
     std::unique_ptr<Impl> impl;

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// A thread that fails reports and shuts down cleanly; it never takes the
+// process down (std::terminate) while a device renders forces:
+// - the thread engine's scheduler throws at its 3rd plan (an injected
+//   fault): the error is counted and named in the statistics, the engine
+//   stops and reports idle, stop() returns, and attaching again computes
+//   the cloud;
+// - the shape output's directory is replaced by a file in mid-run: the
+//   shape thread stops with the error, the frames written before it stay
+//   listed in the PVD file, and the interaction goes on.
+
+#include <palpate/engine/hip_channel.h>
+#include <palpate/engine/thread_engine.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/haptics/shape_interpolator.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "../tests.h"
+
+namespace
+{
+  /** Wait at most @p seconds for @p done(); whether it came. */
+  template <typename Predicate>
+  bool
+  wait_for(const Predicate &done, const double seconds)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    while (!done())
+      {
+        if (std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                          start)
+              .count() > seconds)
+          return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    return true;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  palpate::Scene scene       = shipped_scene("beam.prm");
+  auto          &p           = scene.parameters;
+  p.state_space.grid_spacing = 0.002;
+  p.state_space.extent       = 0.006;
+  p.scheduler.cloud_radius   = 0.0045;
+  p.engine.workers           = 2;
+
+  {
+    deallog << "--- the scheduler throws at its 3rd plan" << std::endl;
+    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
+    const palpate::NodeSelection nodes =
+      palpate::NodeSelection::create(scene, mesh);
+    const palpate::StateGrid grid(p.state_space.grid_spacing,
+                                  p.state_space.extent);
+    palpate::StateCache      cache(grid, 1 << 28);
+    palpate::HipChannel      hip;
+    palpate::EngineFaults    faults;
+    faults.scheduler_throws_at_plan = 3;
+    palpate::ThreadEngine engine(mesh, nodes, p, grid, cache, hip, faults);
+    engine.start();
+    const bool idle  = wait_for([&] { return engine.idle(); }, 60);
+    const auto stats = engine.statistics();
+    deallog << "engine idle after the fault: " << (idle ? "yes" : "NO")
+            << ", running: " << (engine.running() ? "YES" : "no")
+            << ", errors: " << stats.errors << " (" << stats.last_error << ")"
+            << std::endl;
+    engine.stop();
+    deallog << "stop() returned" << std::endl;
+
+    unsigned int cloud = 0; // grid points within the radius of the origin
+    for (unsigned int q = 0; q < grid.size(); ++q)
+      cloud +=
+        palpate::Utilities::norm(grid.position(q)) <= p.scheduler.cloud_radius;
+    engine.start();
+    const bool computed = wait_for(
+      [&] {
+        return engine.idle() &&
+               cache.counts().first + cache.counts().second >= cloud;
+      },
+      300);
+    engine.stop();
+    deallog << "attached again: the cloud of " << cloud << " points is "
+            << (computed ? "computed" : "NOT computed")
+            << ", errors still: " << engine.statistics().errors << std::endl;
+  }
+
+  {
+    deallog << "--- the shape output's directory disappears in mid-run"
+            << std::endl;
+    std::filesystem::remove_all("shapes");
+    palpate::Interaction interaction(scene);
+    interaction.attach();
+    const bool cloud =
+      wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
+    palpate::ShapeInterpolator shape(interaction, 50, "shapes", "beam");
+    shape.start();
+    const bool some = wait_for([&] { return shape.frames().first >= 3; }, 60);
+    std::filesystem::remove_all("shapes");
+    write_file("shapes", "a file where the directory was\n");
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const unsigned int before = shape.frames().first;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const bool stopped_writing = shape.frames().first == before;
+    shape.stop();
+    const palpate::Utilities::Point3 f = interaction.force({{0, 0, 0}});
+    interaction.detach();
+    deallog << "initial cloud: " << (cloud ? "yes" : "NO")
+            << ", frames written before: " << (some ? ">= 3" : "FEWER")
+            << ", no more frames after: " << (stopped_writing ? "yes" : "NO")
+            << std::endl;
+    const std::string &failure = shape.failure();
+    deallog << "failure reported: "
+            << (failure.find("cannot write the file 'shapes/beam-shape-") !=
+                    std::string::npos ?
+                  "yes, naming the frame's file" :
+                  "NO: '" + failure + "'")
+            << std::endl;
+    deallog << "the interaction still answers: force at rest "
+            << (std::isfinite(f[0]) && std::isfinite(f[1]) &&
+                    std::isfinite(f[2]) ?
+                  "finite" :
+                  "NOT FINITE")
+            << std::endl;
+    std::filesystem::remove("shapes");
+  }
+}
