@@ -10,7 +10,9 @@
 #include <boost/property_tree/xml_parser.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -512,7 +514,7 @@ namespace palpate
   Scene::read(const std::string &filename)
   {
     namespace fs = std::filesystem;
-    Scene scene;
+    Scene scene{Unparsed()};
     scene.file_      = filename;
     scene.directory_ = fs::path(filename).parent_path().string();
 
@@ -704,7 +706,43 @@ namespace palpate
         scene.entry_lines_[s.key]  = s.line;
         scene.entry_values_[s.key] = s.value;
       }
-    scene.parameters.parse_parameters(prm);
+    try
+      {
+        scene.parameters.parse_parameters(prm);
+      }
+    catch (const std::exception &e)
+      {
+        // deal.II's patterns accept numbers that its conversions then
+        // refuse: values out of double range, like 1e-320.
+        for (const Setting &s : settings)
+          for (const std::string &piece : Utilities::split(s.value, ','))
+            {
+              if (piece.empty())
+                continue;
+              errno            = 0;
+              char        *end = nullptr;
+              const double x   = std::strtod(piece.c_str(), &end);
+              if (end != piece.c_str() && errno == ERANGE)
+                throw InputError(
+                  filename,
+                  s.line,
+                  shown_key(s.key) + " = " + s.value,
+                  "'" + piece + "' is out of the range of numbers palpate " +
+                    "computes with (" +
+                    (std::abs(x) < 1 ? "too close to zero: below 1e-307" :
+                                       "too large: beyond 1e308") +
+                    ")",
+                  "give a value within the entry's physical range; "
+                  "'palpate --print-parameters' shows the default.");
+            }
+        throw InputError(filename,
+                         0,
+                         "(whole file)",
+                         "deal.II's ParameterHandler could not convert a "
+                         "value: " +
+                           dealii_message(e),
+                         "fix the entry the message names.");
+      }
     scene.validate();
     return scene;
   }

@@ -28,10 +28,17 @@ namespace
                                 "end\n";
   const std::string beam      = setup + beam_body;
 
+  unsigned int n_cases = 0, n_internal = 0, n_crashes = 0;
+
   void
   run(const std::string &what, const std::string &arguments)
   {
     const ProgramRun r = run_palpate(arguments);
+    ++n_cases;
+    n_internal += r.output.find("internal error") != std::string::npos;
+    // 0 success, 2 input error, 3 not available; anything else (a signal,
+    // an internal error) is a crash here.
+    n_crashes += r.exit_status != 0 && r.exit_status != 2 && r.exit_status != 3;
     deallog << "=== " << what << ": exit status " << r.exit_status << std::endl;
     // Only the message: the report lines before it are tested elsewhere.
     const auto  start = r.output.find("palpate:");
@@ -326,7 +333,16 @@ main(int argc, char **argv)
       "subsection Boundary conditions\n  subsection Fixed nodes\n"
       "    set Selection = box\n    set Box lower corner = -1e9, -1e9, -1e9\n"
       "    set Box upper corner = 1e9, 1e9, -1\n  end\nend\n");
+  scene("a number below the double range (1e-320)",
+        "denormal.prm",
+        beam + "subsection Mesh\n  set Scale factor = 1e-320\nend\n");
+  scene("an entry name with a different case",
+        "case.prm",
+        beam + "subsection Mesh\n  set scale factor = 1\nend\n");
   run("'solve' without a scene", "solve");
   run("'solve --to' with two numbers", "solve good.prm --to 0,0");
   run("an unexpected second argument", "good.prm other.prm");
+
+  deallog << n_cases << " cases: " << n_internal << " with an internal error, "
+          << n_crashes << " crashed (both must be 0)" << std::endl;
 }

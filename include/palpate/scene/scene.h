@@ -94,6 +94,12 @@ namespace palpate
     validate() const;
 
   private:
+    /** A scene whose parameters are not parsed yet (for read()). */
+    struct Unparsed
+    {};
+    explicit Scene(Unparsed)
+    {}
+
     std::string                         file_;
     std::string                         directory_;
     std::map<std::string, unsigned int> entry_lines_;
