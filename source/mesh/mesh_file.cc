@@ -7,6 +7,8 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -53,6 +55,25 @@ namespace palpate
       return types;
     }
 
+    /**
+     * The error for a file that exists but cannot be read: not "empty" and
+     * not "not a mesh file", which would send the user looking for the
+     * wrong problem. @p reason is the system's, e.g. "Permission denied".
+     */
+    InputError
+    unreadable(const std::string &filename, const std::string &reason)
+    {
+      return InputError(filename,
+                        0,
+                        "mesh file",
+                        "the file cannot be read" + (reason.empty() ?
+                                                       std::string() :
+                                                       " (" + reason + ")"),
+                        "check that the path names the mesh file itself and "
+                        "that you may read it (permissions, the disk, a "
+                        "network mount).");
+    }
+
     /** Reads a text file line by line, keeping line numbers for messages. */
     class LineReader
     {
@@ -74,6 +95,10 @@ namespace palpate
             if (!line.empty())
               return true;
           }
+        // A read error ends getline() as the end of the file does; only
+        // the stream state tells them apart.
+        if (!in.is_open() || in.bad())
+          throw unreadable(filename, errno != 0 ? std::strerror(errno) : "");
         return false;
       }
 
@@ -505,6 +530,22 @@ namespace palpate
                            "write the tetrahedral mesh as an unstructured "
                            "grid.");
 
+      // A count read from the file is checked before it is trusted: each
+      // item it counts takes at least two bytes of the file.
+      std::error_code ec;
+      const auto      bytes = std::filesystem::file_size(filename, ec);
+      const long      most  = ec ? 0 : static_cast<long>(bytes / 2);
+      const auto      count = [&](const char *what) {
+        const long n = tokens.number<long>(what);
+        if (n < 0 || n > most)
+          throw reader.error(std::string("the ") + what + " " +
+                               std::to_string(n) +
+                               " cannot be right: it is negative or more "
+                                    "than the file could hold",
+                             "the file is damaged; write it again.");
+        return n;
+      };
+
       std::vector<std::vector<long>> cells;
       std::vector<int>               types;
       std::vector<unsigned int>      cell_lines;
@@ -513,7 +554,7 @@ namespace palpate
           const std::string keyword = tokens.next("a section keyword");
           if (keyword == "POINTS")
             {
-              const long n = tokens.number<long>("point count");
+              const long n = count("point count");
               tokens.next("the point data type");
               for (long i = 0; i < n; ++i)
                 {
@@ -526,8 +567,8 @@ namespace palpate
             }
           else if (keyword == "CELLS")
             {
-              const long n    = tokens.number<long>("cell count");
-              const long size = tokens.number<long>("cell list size");
+              const long n    = count("cell count");
+              const long size = count("cell list size");
               if (tokens.at_end())
                 throw reader.error("the CELLS section is empty",
                                    "the file is truncated.");
@@ -536,16 +577,27 @@ namespace palpate
                   // VTK 5.1: CELLS n_offsets n_connectivity, then arrays.
                   tokens.next("OFFSETS");
                   tokens.next("the offset type");
-                  std::vector<long> offsets(n);
-                  for (auto &o : offsets)
-                    o = tokens.number<long>("offset");
+                  std::vector<long> offsets;
+                  for (long i = 0; i < n; ++i)
+                    {
+                      offsets.push_back(tokens.number<long>("offset"));
+                      if (offsets.back() < (i == 0 ? 0 : offsets[i - 1]) ||
+                          offsets.back() > size)
+                        throw reader.error(
+                          "offset " + std::to_string(i) + " (" +
+                            std::to_string(offsets.back()) +
+                            ") is not between the previous offset and the "
+                            "connectivity size " +
+                            std::to_string(size),
+                          "the file is damaged; write it again.");
+                    }
                   if (tokens.next("CONNECTIVITY") != "CONNECTIVITY")
                     throw reader.error("expected CONNECTIVITY after OFFSETS",
                                        "the file is damaged.");
                   tokens.next("the connectivity type");
-                  std::vector<long> connectivity(size);
-                  for (auto &c : connectivity)
-                    c = tokens.number<long>("point index");
+                  std::vector<long> connectivity;
+                  for (long i = 0; i < size; ++i)
+                    connectivity.push_back(tokens.number<long>("point index"));
                   for (long c = 0; c + 1 < n; ++c)
                     {
                       cells.emplace_back(connectivity.begin() + offsets[c],
@@ -556,7 +608,13 @@ namespace palpate
               else
                 for (long c = 0; c < n; ++c)
                   {
-                    const long        k = tokens.number<long>("cell size");
+                    const long k = tokens.number<long>("cell size");
+                    if (k < 0 || k > 64)
+                      throw reader.error("cell " + std::to_string(c) + " has " +
+                                           std::to_string(k) +
+                                           " points; a cell has at most 64",
+                                         "the file is damaged; write it "
+                                         "again.");
                     std::vector<long> cell(k);
                     for (auto &p : cell)
                       p = tokens.number<long>("point index");
@@ -566,7 +624,7 @@ namespace palpate
             }
           else if (keyword == "CELL_TYPES")
             {
-              const long n = tokens.number<long>("cell type count");
+              const long n = count("cell type count");
               for (long c = 0; c < n; ++c)
                 types.push_back(tokens.number<int>("cell type"));
             }
@@ -644,6 +702,84 @@ namespace palpate
       return s;
     }
 
+    /** The system's reason for the last failed call, "" if it gave none. */
+    std::string
+    system_reason()
+    {
+      return errno != 0 ? std::strerror(errno) : "";
+    }
+
+    /**
+     * The whole file, for the XML reader. A read error is "cannot be
+     * read", a file without a byte "empty", and neither "not a VTK XML
+     * file".
+     */
+    std::string
+    file_contents(const std::string &filename)
+    {
+      errno = 0;
+      std::ifstream in(filename, std::ios::binary);
+      if (!in)
+        throw unreadable(filename, system_reason());
+      std::string       text;
+      std::vector<char> buffer(1 << 16);
+      while (in.read(buffer.data(), buffer.size()) || in.gcount() > 0)
+        text.append(buffer.data(), in.gcount());
+      if (in.bad())
+        throw unreadable(filename, system_reason());
+      if (text.empty())
+        throw InputError(filename,
+                         0,
+                         "mesh file",
+                         "the file is empty",
+                         "write the mesh again from the mesh generator.");
+      return text;
+    }
+
+    /** The line (from 1) on which position @p at of @p text lies. */
+    unsigned int
+    line_at(const std::string &text, const std::size_t at)
+    {
+      return 1 + std::count(text.begin(),
+                            text.begin() + std::min(at, text.size()),
+                            '\n');
+    }
+
+    /**
+     * A count given as an XML attribute (NumberOfPoints, NumberOfCells, an
+     * appended array's offset): a whole number, 0 or more. It is checked
+     * digit by digit: std::stol would read "-5" as -5 and "12abc" as 12,
+     * and a missing or garbled count must not become an empty mesh.
+     */
+    std::uint64_t
+    count_attribute(const std::string &filename,
+                    const unsigned int line,
+                    const std::string &element,
+                    const std::string &tag,
+                    const std::string &name)
+    {
+      const std::string value = Utilities::trim(attribute(tag, name));
+      if (value.empty())
+        throw InputError(filename,
+                         line,
+                         element + " " + name,
+                         "the " + element + " element does not give its " +
+                           name,
+                         "the file is damaged or was not written by VTK; "
+                         "write it again (ParaView, meshio, deal.II).");
+      // 18 digits: far beyond any mesh, and 3 x count stays in 64 bits.
+      if (value.size() > 18 ||
+          value.find_first_not_of("0123456789") != std::string::npos)
+        throw InputError(filename,
+                         line,
+                         element + " " + name,
+                         name + "=\"" + value +
+                           "\" is not a count: it must be a whole number, 0 "
+                           "or more",
+                         "the file is damaged; write it again.");
+      return std::stoull(value);
+    }
+
     struct VtuContext
     {
       std::string filename;
@@ -651,26 +787,58 @@ namespace palpate
       bool        compressed = false;
       std::string appended; // raw bytes, or base64 text
       bool        appended_base64 = false;
+      /** The line of the <DataArray> being read, for messages. */
+      unsigned int line = 0;
+
+      /** Bytes per header value: UInt32 or UInt64. */
+      std::size_t
+      header_size() const
+      {
+        return header_64 ? 8 : 4;
+      }
+
+      /** The error for a binary array that does not hold what it says. */
+      InputError
+      damaged(const std::string &name, const std::string &problem) const
+      {
+        return InputError(filename,
+                          line,
+                          "DataArray " + name,
+                          problem,
+                          "the file is damaged or truncated; write it again.");
+      }
     };
 
+    /**
+     * Value @p k of a binary array's header. Every number in a header
+     * comes from the file, so each read is checked against the bytes that
+     * are there.
+     */
     std::uint64_t
-    read_header_value(const unsigned char *p, const bool header_64)
+    header_value(const VtuContext                 &ctx,
+                 const std::vector<unsigned char> &header,
+                 const std::uint64_t               k,
+                 const std::string                &name)
     {
-      if (header_64)
+      const std::size_t hs = ctx.header_size();
+      if (k >= header.size() / hs)
+        throw ctx.damaged(name, "the array's header is cut short");
+      if (ctx.header_64)
         {
           std::uint64_t v;
-          std::memcpy(&v, p, 8);
+          std::memcpy(&v, header.data() + k * hs, 8);
           return v;
         }
       std::uint32_t v;
-      std::memcpy(&v, p, 4);
+      std::memcpy(&v, header.data() + k * hs, 4);
       return v;
     }
 
     /**
      * The data bytes of one binary array, given its decoded VTK header
      * (byte count, or block table if zlib-compressed) and the decoded bytes
-     * that follow it.
+     * that follow it. Every size in the header is checked against the
+     * bytes that follow before anything is read or allocated.
      */
     std::vector<unsigned char>
     decode_block_data(const VtuContext                 &ctx,
@@ -678,60 +846,86 @@ namespace palpate
                       const std::vector<unsigned char> &payload,
                       const std::string                &name)
     {
-      const std::size_t hs = ctx.header_64 ? 8 : 4;
       if (!ctx.compressed)
         {
-          const std::uint64_t n =
-            read_header_value(header.data(), ctx.header_64);
-          if (payload.size() < n)
-            throw InputError(ctx.filename,
-                             0,
-                             "DataArray " + name,
-                             "the array is shorter than its header says",
-                             "the file is damaged; write it again.");
+          const std::uint64_t n = header_value(ctx, header, 0, name);
+          if (n > payload.size())
+            throw ctx.damaged(name,
+                              "the array's header says it holds " +
+                                std::to_string(n) + " bytes, but only " +
+                                std::to_string(payload.size()) + " follow it");
           return std::vector<unsigned char>(payload.begin(),
                                             payload.begin() + n);
         }
-      const std::uint64_t n_blocks =
-        read_header_value(header.data(), ctx.header_64);
-      const std::uint64_t block =
-        read_header_value(header.data() + hs, ctx.header_64);
-      const std::uint64_t last =
-        read_header_value(header.data() + 2 * hs, ctx.header_64);
+      // zlib's deflate packs at most 1032 bytes into one (zlib's technical
+      // details): a block that claims more is damaged, and this bounds what
+      // a damaged header can make us allocate.
+      constexpr std::uint64_t    max_deflate_ratio = 1032;
+      const std::uint64_t        n_blocks = header_value(ctx, header, 0, name);
+      const std::uint64_t        block    = header_value(ctx, header, 1, name);
+      const std::uint64_t        last     = header_value(ctx, header, 2, name);
       std::vector<unsigned char> out;
       std::size_t                offset = 0;
       for (std::uint64_t b = 0; b < n_blocks; ++b)
         {
-          const std::uint64_t csize =
-            read_header_value(header.data() + (3 + b) * hs, ctx.header_64);
-          uLongf size = (b + 1 == n_blocks && last != 0) ? last : block;
+          const std::uint64_t csize = header_value(ctx, header, 3 + b, name);
+          const std::uint64_t size =
+            (b + 1 == n_blocks && last != 0) ? last : block;
+          if (csize > payload.size() - offset)
+            throw ctx.damaged(name,
+                              "compressed block " + std::to_string(b) +
+                                " has " + std::to_string(csize) +
+                                " bytes by the array's header, but only " +
+                                std::to_string(payload.size() - offset) +
+                                " are left");
+          if (size > max_deflate_ratio * csize)
+            throw ctx.damaged(name,
+                              "compressed block " + std::to_string(b) +
+                                " is said to unpack to " +
+                                std::to_string(size) +
+                                " bytes, more than zlib can pack into " +
+                                std::to_string(csize) + " bytes");
           const std::size_t start = out.size();
           out.resize(start + size);
-          if (offset + csize > payload.size() ||
-              uncompress(out.data() + start,
-                         &size,
+          uLongf unpacked = size;
+          if (uncompress(out.data() + start,
+                         &unpacked,
                          payload.data() + offset,
                          csize) != Z_OK)
-            throw InputError(ctx.filename,
-                             0,
-                             "DataArray " + name,
-                             "a zlib-compressed block cannot be decompressed",
-                             "the file is damaged; write it again.");
-          out.resize(start + size);
+            throw ctx.damaged(name,
+                              "a zlib-compressed block cannot be "
+                              "decompressed");
+          out.resize(start + unpacked);
           offset += csize;
         }
       return out;
     }
 
-    /** Header length in bytes, given the first header value(s). */
+    /**
+     * Header length in bytes, given the first header value(s) and the
+     * number of bytes @p available from the header's start to the end of
+     * the data. A compressed array's header lists its blocks; a damaged
+     * block count (up to 2^64 - 1) is refused before it is multiplied.
+     */
     std::size_t
     header_length(const VtuContext                 &ctx,
-                  const std::vector<unsigned char> &first)
+                  const std::vector<unsigned char> &first,
+                  const std::size_t                 available,
+                  const std::string                &name)
     {
-      const std::size_t hs = ctx.header_64 ? 8 : 4;
+      const std::size_t hs = ctx.header_size();
       if (!ctx.compressed)
         return hs;
-      return (3 + read_header_value(first.data(), ctx.header_64)) * hs;
+      const std::uint64_t n_blocks = header_value(ctx, first, 0, name);
+      if (available / hs < 3 || n_blocks > available / hs - 3)
+        throw ctx.damaged(name,
+                          "the array's header lists " +
+                            std::to_string(n_blocks) +
+                            " compressed blocks, but the file holds only " +
+                            std::to_string(available) +
+                            " bytes from there on, too few for even their "
+                            "sizes");
+      return (3 + n_blocks) * hs;
     }
 
     /** The raw bytes of a binary (inline base64) or appended data array. */
@@ -742,11 +936,19 @@ namespace palpate
                        const std::size_t  appended_offset,
                        const std::string &name)
     {
-      const std::size_t hs = ctx.header_64 ? 8 : 4;
+      const std::size_t hs = ctx.header_size();
       if (is_inline || ctx.appended_base64)
         {
           const std::string &text  = is_inline ? encoded : ctx.appended;
           const std::size_t  start = is_inline ? 0 : appended_offset;
+          if (!is_inline && start >= text.size())
+            throw ctx.damaged(name,
+                              "the array's offset " + std::to_string(start) +
+                                " points past the end of the appended data (" +
+                                std::to_string(text.size()) + " characters)");
+          // At most 3 bytes per 4 base64 characters from here on.
+          const std::size_t available =
+            start < text.size() ? (text.size() - start + 3) / 4 * 3 : 0;
           // VTK encodes header and data separately when compressing, and
           // writers differ otherwise: try "separately" first, then
           // "together".
@@ -756,12 +958,8 @@ namespace palpate
                           start,
                           std::min(text.size(), start + first_chars));
           if (first.size() < hs)
-            throw InputError(ctx.filename,
-                             0,
-                             "DataArray " + name,
-                             "the binary array is empty",
-                             "the file is damaged; write it again.");
-          const std::size_t hl           = header_length(ctx, first);
+            throw ctx.damaged(name, "the binary array is empty");
+          const std::size_t hl = header_length(ctx, first, available, name);
           const std::size_t header_chars = 4 * ((hl + 2) / 3);
           // Appended base64 arrays follow each other; decoding stops at
           // the padding of this array's data, and the header says how many
@@ -787,34 +985,39 @@ namespace palpate
             }
           const auto all = base64_decode(text, start, end);
           if (all.size() < hl)
-            throw InputError(ctx.filename,
-                             0,
-                             "DataArray " + name,
-                             "the binary array is shorter than its header",
-                             "the file is damaged; write it again.");
+            throw ctx.damaged(name,
+                              "the binary array is shorter than its header");
           return decode_block_data(
             ctx,
             std::vector<unsigned char>(all.begin(), all.begin() + hl),
             std::vector<unsigned char>(all.begin() + hl, all.end()),
             name);
         }
-      // raw appended data
-      const auto *p =
-        reinterpret_cast<const unsigned char *>(ctx.appended.data());
-      if (appended_offset + hs > ctx.appended.size())
-        throw InputError(ctx.filename,
-                         0,
-                         "DataArray " + name,
-                         "the offset points past the appended data",
-                         "the file is damaged; write it again.");
-      const std::vector<unsigned char> first(p + appended_offset,
-                                             p + appended_offset + hs);
-      const std::size_t                hl = header_length(ctx, first);
-      const std::vector<unsigned char> header(p + appended_offset,
-                                              p + appended_offset + hl);
-      const std::vector<unsigned char> payload(p + appended_offset + hl,
-                                               p + ctx.appended.size());
-      return decode_block_data(ctx, header, payload, name);
+      // Raw appended data: the offset and every length come from the file
+      // and are checked against the bytes after the '_' marker.
+      const std::size_t size = ctx.appended.size();
+      if (appended_offset >= size)
+        throw ctx.damaged(name,
+                          "the array's offset " +
+                            std::to_string(appended_offset) +
+                            " points past the end of the appended data (" +
+                            std::to_string(size) + " bytes)");
+      const std::size_t left = size - appended_offset;
+      const auto       *p =
+        reinterpret_cast<const unsigned char *>(ctx.appended.data()) +
+        appended_offset;
+      if (left < hs)
+        throw ctx.damaged(name,
+                          "the appended data end inside the array's header");
+      const std::vector<unsigned char> first(p, p + hs);
+      const std::size_t hl = header_length(ctx, first, left, name);
+      if (hl > left)
+        throw ctx.damaged(name,
+                          "the appended data end inside the array's header");
+      return decode_block_data(ctx,
+                               std::vector<unsigned char>(p, p + hl),
+                               std::vector<unsigned char>(p + hl, p + left),
+                               name);
     }
 
     template <typename T>
@@ -839,7 +1042,9 @@ namespace palpate
     {
       const std::string type   = attribute(tag, "type");
       const std::string format = attribute(tag, "format");
-      const std::string name   = attribute(tag, "Name");
+      const std::string name   = attribute(tag, "Name").empty() ?
+                                   std::string("Points") :
+                                   attribute(tag, "Name");
       if (format == "ascii")
         {
           std::istringstream  s(content);
@@ -849,7 +1054,7 @@ namespace palpate
             v.push_back(x);
           if (!s.eof())
             throw InputError(ctx.filename,
-                             0,
+                             ctx.line,
                              "DataArray " + name,
                              "the ascii array holds something that is not a "
                              "number",
@@ -860,11 +1065,18 @@ namespace palpate
       if (format == "binary")
         bytes = binary_array_bytes(ctx, strip_space(content), true, 0, name);
       else if (format == "appended")
-        bytes = binary_array_bytes(
-          ctx, "", false, std::stoul(attribute(tag, "offset")), name);
+        bytes = binary_array_bytes(ctx,
+                                   "",
+                                   false,
+                                   count_attribute(ctx.filename,
+                                                   ctx.line,
+                                                   "DataArray " + name,
+                                                   tag,
+                                                   "offset"),
+                                   name);
       else
         throw InputError(ctx.filename,
-                         0,
+                         ctx.line,
                          "DataArray " + name,
                          "unknown format '" + format + "'",
                          "write the file again as ascii or binary.");
@@ -889,23 +1101,42 @@ namespace palpate
       if (type == "UInt8")
         return bytes_to_doubles<std::uint8_t>(bytes);
       throw InputError(ctx.filename,
-                       0,
+                       ctx.line,
                        "DataArray " + name,
                        "unknown data type '" + type + "'",
                        "write the file again with standard VTK types.");
     }
 
+    /** @p x as an index (a whole number in [0, 2^53]), or -1 if it is
+     * none: the arrays hold doubles, and a damaged one may hold anything. */
+    long
+    as_index(const double x)
+    {
+      return (x >= 0 && x <= 9007199254740992. && x == std::floor(x)) ?
+               static_cast<long>(x) :
+               -1;
+    }
+
     MeshData
     read_vtu(const std::string &filename)
     {
-      std::ifstream     in(filename, std::ios::binary);
-      std::stringstream buffer;
-      buffer << in.rdbuf();
-      std::string text = buffer.str();
+      std::string text = file_contents(filename);
 
       MeshData   data;
       VtuContext ctx;
       ctx.filename = filename;
+
+      // The text of the XML tag that starts at @p begin, up to its '>'.
+      const auto tag_at = [&](const std::size_t begin) {
+        const auto end = text.find('>', begin);
+        if (end == std::string::npos)
+          throw InputError(filename,
+                           line_at(text, begin),
+                           "mesh file",
+                           "the file ends inside an XML tag",
+                           "the file is truncated; write it again.");
+        return text.substr(begin, end - begin);
+      };
 
       const auto file_tag_begin = text.find("<VTKFile");
       if (file_tag_begin == std::string::npos)
@@ -916,9 +1147,7 @@ namespace palpate
                          "element",
                          "check the file name and extension (.msh, .vtk, "
                          ".vtu).");
-      const std::string file_tag =
-        text.substr(file_tag_begin,
-                    text.find('>', file_tag_begin) - file_tag_begin);
+      const std::string file_tag = tag_at(file_tag_begin);
       if (attribute(file_tag, "type") != "UnstructuredGrid")
         throw InputError(filename,
                          1,
@@ -947,17 +1176,30 @@ namespace palpate
                     (ctx.compressed ? "zlib-compressed" : "uncompressed");
 
       // Appended data: everything after the '_' marker up to the closing
-      // tag (raw bytes may contain anything, so search from the end).
+      // tag (raw bytes may contain anything, so search from the end). A
+      // file without the closing tag was cut short.
       const auto appended_tag = text.find("<AppendedData");
       if (appended_tag != std::string::npos)
         {
-          const std::string tag =
-            text.substr(appended_tag,
-                        text.find('>', appended_tag) - appended_tag);
-          ctx.appended_base64 = attribute(tag, "encoding") == "base64";
-          const auto start    = text.find('_', appended_tag) + 1;
-          const auto end      = text.rfind("</AppendedData>");
-          ctx.appended        = text.substr(start, end - start);
+          const std::string tag = tag_at(appended_tag);
+          ctx.appended_base64   = attribute(tag, "encoding") == "base64";
+          const auto marker     = text.find('_', appended_tag + tag.size());
+          const auto end        = text.rfind("</AppendedData>");
+          if (marker == std::string::npos)
+            throw InputError(filename,
+                             line_at(text, appended_tag),
+                             "mesh file",
+                             "the <AppendedData> section has no '_' before "
+                             "its data",
+                             "the file is damaged; write it again.");
+          if (end == std::string::npos || end < marker)
+            throw InputError(filename,
+                             line_at(text, appended_tag),
+                             "mesh file",
+                             "the file ends inside the <AppendedData> "
+                             "section (there is no </AppendedData>)",
+                             "the file is truncated; write it again.");
+          ctx.appended = text.substr(marker + 1, end - marker - 1);
           if (ctx.appended_base64)
             ctx.appended = strip_space(ctx.appended);
           text = text.substr(0, appended_tag); // keep the XML part
@@ -970,12 +1212,12 @@ namespace palpate
                          "mesh file",
                          "the file has no <Piece>",
                          "write the mesh again.");
-      const std::string piece_tag =
-        text.substr(piece, text.find('>', piece) - piece);
-      const long n_points =
-        std::stol("0" + attribute(piece_tag, "NumberOfPoints"));
-      const long n_cells =
-        std::stol("0" + attribute(piece_tag, "NumberOfCells"));
+      const std::string   piece_tag  = tag_at(piece);
+      const unsigned int  piece_line = line_at(text, piece);
+      const std::uint64_t n_points   = count_attribute(
+        filename, piece_line, "Piece", piece_tag, "NumberOfPoints");
+      const std::uint64_t n_cells = count_attribute(
+        filename, piece_line, "Piece", piece_tag, "NumberOfCells");
 
       // Collect the data arrays of the <Points> and <Cells> sections.
       std::map<std::string, std::vector<double>> arrays;
@@ -995,18 +1237,26 @@ namespace palpate
               const auto a = text.find("<DataArray", pos);
               if (a == std::string::npos || a > end)
                 break;
-              const auto        tag_end = text.find('>', a);
-              const std::string tag     = text.substr(a, tag_end - a);
+              const std::string tag     = tag_at(a);
+              const std::size_t tag_end = a + tag.size();
               std::string       content;
               std::size_t       next = tag_end + 1;
               if (text[tag_end - 1] != '/')
                 {
                   const auto close = text.find("</DataArray>", tag_end);
+                  if (close == std::string::npos)
+                    throw InputError(filename,
+                                     line_at(text, a),
+                                     "DataArray " + attribute(tag, "Name"),
+                                     "the <DataArray> is not closed by "
+                                     "</DataArray>",
+                                     "the file is truncated; write it again.");
                   content = text.substr(tag_end + 1, close - tag_end - 1);
                   next    = close;
                 }
               const std::string key =
                 section == "Points" ? "points" : attribute(tag, "Name");
+              ctx.line    = line_at(text, a);
               arrays[key] = data_array_values(ctx, tag, content);
               pos         = next;
             }
@@ -1020,7 +1270,7 @@ namespace palpate
                            "the file has no '" + key + "' data array",
                            "write the mesh again as an unstructured grid.");
       const auto &points = arrays["points"];
-      if (static_cast<long>(points.size()) != 3 * n_points)
+      if (points.size() != 3 * n_points)
         throw InputError(filename,
                          1,
                          "mesh file",
@@ -1028,7 +1278,7 @@ namespace palpate
                            std::to_string(points.size()) + " numbers for " +
                            std::to_string(n_points) + " points",
                          "write the mesh again with 3-D points.");
-      for (long i = 0; i < n_points; ++i)
+      for (std::size_t i = 0; i < n_points; ++i)
         {
           data.nodes.push_back(
             {{points[3 * i], points[3 * i + 1], points[3 * i + 2]}});
@@ -1037,8 +1287,7 @@ namespace palpate
       const auto &connectivity = arrays["connectivity"];
       const auto &offsets      = arrays["offsets"];
       const auto &types_d      = arrays["types"];
-      if (static_cast<long>(offsets.size()) != n_cells ||
-          static_cast<long>(types_d.size()) != n_cells)
+      if (offsets.size() != n_cells || types_d.size() != n_cells)
         throw InputError(filename,
                          1,
                          "mesh file",
@@ -1048,19 +1297,32 @@ namespace palpate
       std::vector<std::vector<long>> cells;
       std::vector<int>               types;
       std::size_t                    begin = 0;
-      for (long c = 0; c < n_cells; ++c)
+      for (std::size_t c = 0; c < n_cells; ++c)
         {
-          const std::size_t end = static_cast<std::size_t>(offsets[c]);
-          if (end > connectivity.size() || end < begin)
+          const long end = as_index(offsets[c]);
+          if (end < 0 || static_cast<std::size_t>(end) > connectivity.size() ||
+              static_cast<std::size_t>(end) < begin)
             throw InputError(filename,
                              1,
                              "mesh file, cell " + std::to_string(c),
                              "the offsets array is inconsistent",
                              "the file is damaged; write it again.");
           cells.emplace_back();
-          for (std::size_t k = begin; k < end; ++k)
-            cells.back().push_back(static_cast<long>(connectivity[k]));
-          types.push_back(static_cast<int>(types_d[c]));
+          for (std::size_t k = begin; k < static_cast<std::size_t>(end); ++k)
+            {
+              const long point = as_index(connectivity[k]);
+              if (point < 0)
+                throw InputError(filename,
+                                 1,
+                                 "mesh file, cell " + std::to_string(c),
+                                 "the connectivity array holds " +
+                                   std::to_string(connectivity[k]) +
+                                   ", which is not a point index",
+                                 "the file is damaged; write it again.");
+              cells.back().push_back(point);
+            }
+          const long type = as_index(types_d[c]);
+          types.push_back(type <= 255 ? static_cast<int>(type) : -1);
           begin = end;
         }
       LineReader reader(filename);
@@ -1075,23 +1337,45 @@ namespace palpate
   MeshData
   read_mesh_file(const std::string &filename)
   {
-    if (!std::filesystem::exists(filename))
+    namespace fs = std::filesystem;
+    // std::filesystem's throwing forms would report a path that cannot be
+    // examined (a symbolic link loop, a directory on the way that may not
+    // be searched) as a std::filesystem_error, not as bad input.
+    std::error_code       ec;
+    const fs::file_status status = fs::status(filename, ec);
+    if (status.type() == fs::file_type::not_found)
       throw InputError(
         filename, 0, "mesh file", "the file does not exist", "check the path.");
-    if (std::filesystem::is_directory(filename))
-      throw InputError(filename,
-                       0,
-                       "mesh file",
-                       "this is a directory, not a mesh file",
-                       "name the mesh file itself.");
-    {
-      std::ifstream probe(filename);
-      if (!probe)
+    if (ec)
+      throw unreadable(filename, ec.message());
+    if (fs::is_directory(status))
+      {
+        std::vector<std::string> meshes;
+        for (const auto &e : fs::directory_iterator(filename, ec))
+          {
+            const std::string extension = e.path().extension().string();
+            if (extension == ".msh" || extension == ".vtk" ||
+                extension == ".vtu")
+              meshes.push_back(e.path().string());
+          }
+        std::sort(meshes.begin(), meshes.end());
         throw InputError(filename,
                          0,
                          "mesh file",
-                         "the file cannot be read (permissions?)",
-                         "make it readable.");
+                         "this is a directory, not a mesh file: it cannot be "
+                         "read as a mesh",
+                         meshes.empty() ?
+                           std::string("name the mesh file itself (.msh, "
+                                       ".vtk or .vtu).") :
+                           "name one of the " + std::to_string(meshes.size()) +
+                             " mesh files in it, e.g. '" + meshes.front() +
+                             "'.");
+      }
+    {
+      errno = 0;
+      std::ifstream probe(filename);
+      if (!probe)
+        throw unreadable(filename, system_reason());
     }
     const std::string extension =
       std::filesystem::path(filename).extension().string();

@@ -1,0 +1,194 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// Fuzzing the mesh readers: a small beam written in every format palpate
+// reads (Gmsh 2.2 and 1, legacy VTK classic and 5.1, VTU ascii, base64,
+// base64+zlib and appended raw) and the shared liver501 (.msh, .vtk),
+// mutated 600 times each (seeded: the counts below are the same on every
+// run): bytes flipped, ranges deleted or repeated, lines dropped or
+// duplicated, numbers replaced by nasty ones (nan, inf, 1e308, -1, huge
+// counts), files truncated. Every mutant must either give a valid mesh
+// (positive, finite volume) or an InputError: any other exception, a crash
+// or a read slower than 2 s fails the test.
+
+#include <palpate/mesh/generators.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/scene/scene.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "../tests.h"
+
+#include "../mesh_writers.h"
+
+namespace
+{
+  const std::vector<std::string> numbers = {"nan",
+                                            "inf",
+                                            "-inf",
+                                            "1e308",
+                                            "-1",
+                                            "0",
+                                            "4294967295",
+                                            "4294967296",
+                                            "99999999999999999999",
+                                            "-2147483648",
+                                            "1e-320",
+                                            "3.5",
+                                            "abc",
+                                            ""};
+
+  std::size_t
+  pick(std::mt19937 &rng, const std::size_t n)
+  {
+    return n == 0 ? 0 : rng() % n;
+  }
+
+  std::string
+  mutate(std::string s, std::mt19937 &rng)
+  {
+    const unsigned int n = 1 + pick(rng, 3);
+    for (unsigned int m = 0; m < n && !s.empty(); ++m)
+      switch (pick(rng, 7))
+        {
+          case 0: // flip a byte
+            s[pick(rng, s.size())] = static_cast<char>(pick(rng, 256));
+            break;
+          case 1: // delete a range
+            s.erase(pick(rng, s.size()), 1 + pick(rng, 64));
+            break;
+          case 2: // repeat a range
+            {
+              const auto at = pick(rng, s.size());
+              s.insert(at, s.substr(at, 1 + pick(rng, 64)));
+              break;
+            }
+          case 3: // drop a line
+            {
+              const auto at  = s.find('\n', pick(rng, s.size()));
+              const auto end = at == std::string::npos ? std::string::npos :
+                                                         s.find('\n', at + 1);
+              if (at != std::string::npos)
+                s.erase(at, end == std::string::npos ? end : end - at);
+              break;
+            }
+          case 4: // duplicate a line
+            {
+              const auto at  = s.find('\n', pick(rng, s.size()));
+              const auto end = at == std::string::npos ? std::string::npos :
+                                                         s.find('\n', at + 1);
+              if (end != std::string::npos)
+                s.insert(at, s.substr(at, end - at));
+              break;
+            }
+          case 5: // a nasty number in place of one
+            {
+              auto at = pick(rng, s.size());
+              while (at < s.size() &&
+                     !std::isdigit(static_cast<unsigned char>(s[at])))
+                ++at;
+              auto end = at;
+              while (end < s.size() &&
+                     (std::isdigit(static_cast<unsigned char>(s[end])) ||
+                      s[end] == '.' || s[end] == 'e' || s[end] == '-'))
+                ++end;
+              if (at < s.size())
+                s.replace(at, end - at, numbers[pick(rng, numbers.size())]);
+              break;
+            }
+          default: // truncate
+            s.resize(pick(rng, s.size()));
+        }
+    return s;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  palpate::Scene scene;
+  auto          &p           = scene.parameters.mesh;
+  p.beam_subdivisions_length = 4, p.beam_subdivisions_width = 2,
+  p.beam_subdivisions_height   = 2;
+  const palpate::MeshData beam = palpate::generate_beam(p);
+  write_gmsh(beam, "beam22.msh", false);
+  write_gmsh(beam, "beam1.msh", true);
+  write_vtk(beam, "beam30.vtk", false);
+  write_vtk(beam, "beam51.vtk", true);
+  write_vtu(beam, "beam-ascii.vtu", Vtu::ascii);
+  write_vtu(beam, "beam-base64.vtu", Vtu::base64);
+  write_vtu(beam, "beam-zlib.vtu", Vtu::zlib);
+  write_vtu(beam, "beam-appended.vtu", Vtu::appended);
+  const std::vector<std::string> seeds = {
+    "beam22.msh",
+    "beam1.msh",
+    "beam30.vtk",
+    "beam51.vtk",
+    "beam-ascii.vtu",
+    "beam-base64.vtu",
+    "beam-zlib.vtu",
+    "beam-appended.vtu",
+    palpate_shared_dir + "/meshes/liver-tetgen/liver501.msh",
+    palpate_shared_dir + "/meshes/liver-tetgen/liver501.vtk"};
+
+  std::mt19937       rng(20261123);
+  const unsigned int per_seed    = 600;
+  unsigned int       total_valid = 0, total_rejected = 0, total_other = 0,
+               total_slow = 0;
+  for (const std::string &seed : seeds)
+    {
+      const std::string text      = read_file(seed);
+      const std::string extension = seed.substr(seed.rfind('.'));
+      const std::string file      = "mutant" + extension;
+      unsigned int      valid = 0, rejected = 0, other = 0, slow = 0;
+      for (unsigned int i = 0; i < per_seed; ++i)
+        {
+          write_file(file, mutate(text, rng));
+          const auto start = std::chrono::steady_clock::now();
+          try
+            {
+              const palpate::Mesh mesh(palpate::read_mesh_file(file),
+                                       1.0,
+                                       file);
+              if (std::isfinite(mesh.volume()) && mesh.volume() > 0 &&
+                  mesh.n_cells() > 0)
+                ++valid;
+              else
+                {
+                  ++other;
+                  deallog << "mutant " << i << " of " << seed
+                          << ": a mesh of volume " << mesh.volume() << " and "
+                          << mesh.n_cells() << " cells" << std::endl;
+                }
+            }
+          catch (const palpate::InputError &)
+            {
+              ++rejected;
+            }
+          catch (const std::exception &e)
+            {
+              if (++other <= 3)
+                deallog << "mutant " << i << " of " << seed
+                        << ": NOT an input error: " << e.what() << std::endl;
+            }
+          if (std::chrono::steady_clock::now() - start >
+              std::chrono::seconds(2))
+            ++slow;
+        }
+      deallog << std::filesystem::path(seed).filename().string() << ": "
+              << valid << " valid meshes, " << rejected << " input errors, "
+              << other << " other outcomes (must be 0)" << std::endl;
+      total_valid += valid, total_rejected += rejected, total_other += other,
+        total_slow += slow;
+    }
+  deallog << "all " << seeds.size() * per_seed << " mutants: " << total_valid
+          << " valid, " << total_rejected << " input errors, " << total_other
+          << " other outcomes (must be 0), " << total_slow
+          << " slower than 2 s (must be 0)" << std::endl;
+}
