@@ -4,6 +4,9 @@
 #include <palpate/haptics/run_summary.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <iomanip>
 #include <ostream>
@@ -16,63 +19,236 @@ namespace palpate
 {
   namespace
   {
-    std::string
-    number(const double x)
+    /**
+     * One summary entry. Tools read the summaries, so each value keeps its
+     * kind: counts are exact integers (a double printed with six digits
+     * turned 1440000 ticks into 1.44e+06), measurements are doubles that
+     * may be NaN or infinite, and text may hold anything a path or a
+     * trajectory name can.
+     */
+    struct Field
     {
-      std::ostringstream s;
-      s << std::setprecision(6) << x;
-      return s.str();
+      enum class Kind
+      {
+        text,
+        count,
+        real,
+        boolean
+      };
+
+      std::string key;
+      Kind        kind;
+      std::string text;     // text: the string; count, boolean: the value
+      double      real = 0; // real: the value
+    };
+
+    Field
+    text(const std::string &key, const std::string &value)
+    {
+      return {key, Field::Kind::text, value};
     }
 
-    /** Every field as (key, value), in order, for CSV and JSON. */
-    std::vector<std::pair<std::string, std::string>>
+    Field
+    count(const std::string &key, const std::uint64_t value)
+    {
+      return {key, Field::Kind::count, std::to_string(value)};
+    }
+
+    Field
+    real(const std::string &key, const double value)
+    {
+      return {key, Field::Kind::real, "", value};
+    }
+
+    Field
+    boolean(const std::string &key, const bool value)
+    {
+      return {key, Field::Kind::boolean, value ? "true" : "false"};
+    }
+
+    /**
+     * A finite double in the shortest form that reads back as the same
+     * double: 0.5 stays "0.5", 0.1 stays "0.1", 1/3 gets its 16-17 digits.
+     * std::to_chars does exactly this; a fixed precision either loses
+     * digits (6) or shows round-off noise (max_digits10 prints 0.1 as
+     * 0.10000000000000001).
+     */
+    std::string
+    shortest(const double x)
+    {
+      char       buffer[64];
+      const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+      return std::string(buffer, result.ptr);
+    }
+
+    /**
+     * @p text as a JSON string (RFC 8259, section 7): quotes, backslashes
+     * and every control character below 0x20 escaped (the short forms
+     * where JSON has them, \u00XX otherwise). JSON text must be UTF-8
+     * (section 8.1), and a scene path may hold any bytes: a byte that does
+     * not belong to a valid UTF-8 sequence becomes U+FFFD.
+     */
+    std::string
+    json_string(const std::string &text)
+    {
+      std::string out = "\"";
+      for (std::size_t i = 0; i < text.size(); ++i)
+        {
+          const auto c = static_cast<unsigned char>(text[i]);
+          switch (c)
+            {
+              case '"':
+                out += "\\\"";
+                continue;
+              case '\\':
+                out += "\\\\";
+                continue;
+              case '\b':
+                out += "\\b";
+                continue;
+              case '\f':
+                out += "\\f";
+                continue;
+              case '\n':
+                out += "\\n";
+                continue;
+              case '\r':
+                out += "\\r";
+                continue;
+              case '\t':
+                out += "\\t";
+                continue;
+              default:
+                break;
+            }
+          if (c < 0x20)
+            {
+              static const char hex[] = "0123456789abcdef";
+              out += "\\u00";
+              out += hex[c >> 4];
+              out += hex[c & 0xf];
+              continue;
+            }
+          if (c < 0x80)
+            {
+              out += static_cast<char>(c);
+              continue;
+            }
+          // A multi-byte UTF-8 sequence: a lead byte 110xxxxx, 1110xxxx or
+          // 11110xxx and that many continuation bytes 10xxxxxx, not an
+          // overlong form, a surrogate or beyond U+10FFFF.
+          const unsigned int length = c >= 0xc2 && c <= 0xdf ? 2 :
+                                      c >= 0xe0 && c <= 0xef ? 3 :
+                                      c >= 0xf0 && c <= 0xf4 ? 4 :
+                                                               0;
+          bool               valid  = length > 0 && i + length <= text.size();
+          for (unsigned int k = 1; valid && k < length; ++k)
+            valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+          if (valid && length > 2)
+            {
+              const auto second = static_cast<unsigned char>(text[i + 1]);
+              valid             = !(c == 0xe0 && second < 0xa0) && // overlong
+                      !(c == 0xed && second > 0x9f) &&             // surrogate
+                      !(c == 0xf0 && second < 0x90) &&             // overlong
+                      !(c == 0xf4 && second > 0x8f);               // > U+10FFFF
+            }
+          if (valid)
+            {
+              out.append(text, i, length);
+              i += length - 1;
+            }
+          else
+            out += "\\ufffd";
+        }
+      return out + "\"";
+    }
+
+    /** A JSON value: numbers bare, NaN and infinities null (JSON has no
+     * such numbers), text escaped. */
+    std::string
+    json_value(const Field &f)
+    {
+      switch (f.kind)
+        {
+          case Field::Kind::text:
+            return json_string(f.text);
+          case Field::Kind::real:
+            return std::isfinite(f.real) ? shortest(f.real) : "null";
+          default:
+            return f.text;
+        }
+    }
+
+    /**
+     * A CSV field (RFC 4180): in double quotes, with quotes inside doubled;
+     * line breaks may stay inside the quotes. Non-finite numbers are
+     * written nan, inf and -inf: pandas.read_csv, numpy and Python's
+     * float() read these as NaN and +-infinity (pandas counts "nan" among
+     * its default missing values), and unlike an empty field they keep
+     * "no value" and "infinite" apart.
+     */
+    std::string
+    csv_value(const Field &f)
+    {
+      std::string value = f.text;
+      if (f.kind == Field::Kind::real)
+        value = std::isnan(f.real) ? "nan" :
+                std::isinf(f.real) ? (f.real > 0 ? "inf" : "-inf") :
+                                     shortest(f.real);
+      std::string out = "\"";
+      for (const char c : value)
+        out += c == '"' ? std::string("\"\"") : std::string(1, c);
+      return out + "\"";
+    }
+
+    /** Every field, in order, for CSV and JSON. */
+    std::vector<Field>
     fields(const RunSummary &s)
     {
-      return {{"scene", s.scene},
-              {"engine", s.engine},
-              {"trajectory", s.trajectory},
-              {"states_computed", number(s.states_computed)},
-              {"states_failed", number(s.states_failed)},
-              {"tasks_dropped", number(s.tasks_dropped)},
-              {"results_discarded", number(s.results_discarded)},
-              {"solver_errors", number(s.solver_errors)},
-              {"median_state_ms", number(s.median_state_ms)},
-              {"worker_busy_fraction", number(s.worker_busy_fraction)},
-              {"messages", number(s.messages)},
-              {"bytes", number(s.bytes)},
-              {"local_sources", number(s.local_sources)},
-              {"fetched_sources", number(s.fetched_sources)},
-              {"states_to_client", number(s.states_to_client)},
-              {"transfer_p50_ms", number(s.transfer_p50_ms)},
-              {"transfer_max_ms", number(s.transfer_max_ms)},
-              {"lost_servers", number(s.lost_servers.size())},
-              {"states_used", number(s.states_used)},
-              {"corner_reads", number(s.corner_reads)},
-              {"corner_hits", number(s.corner_hits)},
-              {"missing_data_events", number(s.missing_events)},
-              {"missing_data_seconds", number(s.missing_seconds)},
-              {"non_finite_forces", number(s.non_finite_forces)},
-              {"largest_force_N", number(s.largest_force)},
-              {"largest_force_change_N", number(s.largest_force_change)},
-              {"loop_ran", s.loop_ran ? "true" : "false"},
-              {"realtime_priority", s.realtime_priority ? "true" : "false"},
-              {"memory_locked", s.memory_locked ? "true" : "false"},
-              {"loop_truncated", s.loop_truncated ? "true" : "false"},
-              {"loop_rate_Hz", number(s.loop_rate)},
-              {"motion_start_s", number(s.motion_start)},
-              {"motion_duration_s", number(s.motion_duration)},
-              {"ticks", number(s.ticks)},
-              {"deadline_misses", number(s.deadline_misses)},
-              {"period_p50_ms", number(s.period_p50_ms)},
-              {"period_p99_ms", number(s.period_p99_ms)},
-              {"period_p999_ms", number(s.period_p999_ms)},
-              {"period_max_ms", number(s.period_max_ms)},
-              {"interpolation_p50_us", number(s.interpolation_p50_us)},
-              {"interpolation_p999_us", number(s.interpolation_p999_us)},
-              {"initial_cloud_states", number(s.initial_cloud_states)},
-              {"initial_cloud_complete",
-               s.initial_cloud_complete ? "true" : "false"},
-              {"shape_frames", number(s.shape_frames)}};
+      return {text("scene", s.scene),
+              text("engine", s.engine),
+              text("trajectory", s.trajectory),
+              count("states_computed", s.states_computed),
+              count("states_failed", s.states_failed),
+              count("tasks_dropped", s.tasks_dropped),
+              count("results_discarded", s.results_discarded),
+              count("solver_errors", s.solver_errors),
+              real("median_state_ms", s.median_state_ms),
+              real("worker_busy_fraction", s.worker_busy_fraction),
+              count("messages", s.messages),
+              count("bytes", s.bytes),
+              count("local_sources", s.local_sources),
+              count("fetched_sources", s.fetched_sources),
+              count("states_to_client", s.states_to_client),
+              real("transfer_p50_ms", s.transfer_p50_ms),
+              real("transfer_max_ms", s.transfer_max_ms),
+              count("lost_servers", s.lost_servers.size()),
+              count("states_used", s.states_used),
+              count("corner_reads", s.corner_reads),
+              count("corner_hits", s.corner_hits),
+              count("missing_data_events", s.missing_events),
+              real("missing_data_seconds", s.missing_seconds),
+              count("non_finite_forces", s.non_finite_forces),
+              real("largest_force_N", s.largest_force),
+              real("largest_force_change_N", s.largest_force_change),
+              boolean("loop_ran", s.loop_ran),
+              boolean("realtime_priority", s.realtime_priority),
+              boolean("memory_locked", s.memory_locked),
+              boolean("loop_truncated", s.loop_truncated),
+              real("loop_rate_Hz", s.loop_rate),
+              real("motion_start_s", s.motion_start),
+              real("motion_duration_s", s.motion_duration),
+              count("ticks", s.ticks),
+              count("deadline_misses", s.deadline_misses),
+              real("period_p50_ms", s.period_p50_ms),
+              real("period_p99_ms", s.period_p99_ms),
+              real("period_p999_ms", s.period_p999_ms),
+              real("period_max_ms", s.period_max_ms),
+              real("interpolation_p50_us", s.interpolation_p50_us),
+              real("interpolation_p999_us", s.interpolation_p999_us),
+              count("initial_cloud_states", s.initial_cloud_states),
+              boolean("initial_cloud_complete", s.initial_cloud_complete),
+              count("shape_frames", s.shape_frames)};
     }
   } // namespace
 
@@ -158,8 +334,8 @@ namespace palpate
     if (!out)
       throw std::runtime_error("cannot write '" + filename + "'");
     out << "key,value\n";
-    for (const auto &[k, v] : fields(*this))
-      out << k << ",\"" << v << "\"\n";
+    for (const Field &f : fields(*this))
+      out << f.key << "," << csv_value(f) << "\n";
   }
 
 
@@ -173,21 +349,8 @@ namespace palpate
     const auto f = fields(*this);
     out << "{\n";
     for (std::size_t i = 0; i < f.size(); ++i)
-      {
-        const bool text = f[i].first == "scene" || f[i].first == "engine" ||
-                          f[i].first == "trajectory";
-        std::string value = f[i].second;
-        if (text)
-          {
-            std::string escaped;
-            for (const char c : value)
-              escaped += (c == '"' || c == '\\') ? std::string("\\") + c :
-                                                   std::string(1, c);
-            value = "\"" + escaped + "\"";
-          }
-        out << "  \"" << f[i].first << "\": " << value
-            << (i + 1 < f.size() ? "," : "") << "\n";
-      }
+      out << "  " << json_string(f[i].key) << ": " << json_value(f[i])
+          << (i + 1 < f.size() ? "," : "") << "\n";
     out << "}\n";
   }
 } // namespace palpate
