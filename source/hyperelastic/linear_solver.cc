@@ -145,6 +145,13 @@ namespace palpate
       void
       analyze(const SparsityCSR &pattern) override
       {
+        // A new analysis replaces the old one: forget the old pattern's
+        // entries (they would otherwise be kept and summed with the new
+        // ones).
+        irn.clear();
+        jcn.clear();
+        upper.clear();
+        permutation.clear();
         // Symmetric storage: the upper triangle only, 1-based.
         for (unsigned int i = 0; i < pattern.n_rows; ++i)
           for (unsigned int k = pattern.row_start[i];
@@ -159,12 +166,22 @@ namespace palpate
         values.resize(upper.size());
 
         std::lock_guard<std::mutex> lock(mumps_lock());
-        id.job          = -1; // initialise an instance
-        id.par          = 1;  // this process works
-        id.sym          = 2;  // general symmetric: LDL^T with 2x2 pivots
-        id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(MPI_COMM_SELF));
-        dmumps_c(&id);
-        initialized = true;
+        // A new analysis starts from a new MUMPS instance: the old one is
+        // terminated first (JOB = -2 frees its analysis and factors).
+        // Calling JOB = -1 over a live instance would lose it and all it
+        // holds. Running JOB = 1 again on the old instance is allowed by
+        // the MUMPS guide, but with Debian's MUMPS 5.5.1 and the AMD
+        // ordering the next factorisation of a regular matrix then failed
+        // as singular (tests/hyperelastic/mumps_reanalyze); a fresh
+        // instance costs microseconds next to an analysis.
+        if (initialized)
+          {
+            id.job = -2;
+            dmumps_c(&id);
+            initialized = false;
+            id          = {};
+          }
+        initialize();
 
         id.icntl[0]  = -1;            // no error messages on a stream
         id.icntl[1]  = -1;            // no diagnostics
@@ -177,12 +194,14 @@ namespace palpate
         id.nnz = irn.size();
         id.irn = irn.data();
         id.jcn = jcn.data();
+        id.a   = nullptr; // the values come with factorize()
+        id.rhs = nullptr;
         if (ordering_code == 1)
           {
             permutation = metis_nested_dissection(pattern);
             id.perm_in  = permutation.data();
           }
-        id.job = 1; // analysis, once
+        id.job = 1; // analysis
         dmumps_c(&id);
         if (id.infog[0] < 0)
           throw std::runtime_error("MUMPS analysis failed, INFOG(1) = " +
@@ -276,6 +295,36 @@ namespace palpate
       }
 
     private:
+      /**
+       * Initialise the MUMPS instance (JOB = -1), with the caller holding
+       * MUMPS's lock. MUMPS reports a failure here (e.g. -13: it could not
+       * allocate its workspace; an MPI communicator it cannot use) only in
+       * INFOG(1) and INFO(1); everything after would work on a broken
+       * instance, so it is an error at once.
+       */
+      void
+      initialize()
+      {
+        id.job          = -1; // initialise an instance
+        id.par          = 1;  // this process works
+        id.sym          = 2;  // general symmetric: LDL^T with 2x2 pivots
+        id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(MPI_COMM_SELF));
+        dmumps_c(&id);
+        const MUMPS_INT error = std::min(id.infog[0], id.info[0]);
+        if (error < 0)
+          {
+            std::ostringstream s;
+            s << "MUMPS could not be initialised (JOB = -1): INFOG(1) = "
+              << id.infog[0] << ", INFO(1) = " << id.info[0]
+              << ", INFO(2) = " << id.info[1]
+              << "; see the MUMPS users' guide, section 'Error "
+                 "diagnostics', for the code, or choose another linear "
+                 "solver (Linear solver / Solver = UMFPACK or KLU)";
+            throw std::runtime_error(s.str());
+          }
+        initialized = true;
+      }
+
       DMUMPS_STRUC_C           id          = {};
       bool                     initialized = false;
       int                      ordering_code;
@@ -302,6 +351,11 @@ namespace palpate
       void
       analyze(const SparsityCSR &pattern) override
       {
+        // A new analysis replaces the old one and its factors.
+        if (numeric)
+          umfpack_di_free_numeric(&numeric);
+        if (symbolic)
+          umfpack_di_free_symbolic(&symbolic);
         umfpack_di_defaults(control);
         n = pattern.n_rows;
         // The pattern is symmetric, so its CSR arrays are CSC arrays too.
@@ -398,6 +452,13 @@ namespace palpate
       void
       analyze(const SparsityCSR &pattern) override
       {
+        // A new analysis replaces the old one and its factors (which
+        // factorize() would otherwise try to refactor with the new
+        // pattern).
+        if (numeric)
+          klu_free_numeric(&numeric, &common);
+        if (symbolic)
+          klu_free_symbolic(&symbolic, &common);
         klu_defaults(&common);
         n = pattern.n_rows;
         ap.assign(pattern.row_start.begin(), pattern.row_start.end());
@@ -500,6 +561,12 @@ namespace palpate
       void
       analyze(const SparsityCSR &pattern) override
       {
+        // A new analysis replaces the old one: the old Amesos solver refers
+        // to the old problem, matrix and vectors, so it goes first.
+        {
+          const auto lock = mumps_guard();
+          solver.reset();
+        }
         map = std::make_unique<Epetra_Map>(static_cast<int>(pattern.n_rows),
                                            0,
                                            comm);

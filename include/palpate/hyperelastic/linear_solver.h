@@ -35,10 +35,10 @@ namespace palpate
 
   /**
    * A sparse direct solver for the symmetric (indefinite) linearised
-   * systems of the Newton method. The sparsity pattern is fixed for the
-   * lifetime of the solver: analyze() runs the symbolic analysis (ordering,
-   * elimination tree) once; factorize() then computes only the numbers, at
-   * every Newton iteration.
+   * systems of the Newton method. analyze() runs the symbolic analysis
+   * (ordering, elimination tree) of a sparsity pattern; factorize() then
+   * computes only the numbers, at every Newton iteration. analyze() may be
+   * called again for a new pattern: it drops the old analysis and factors.
    *
    * No method throws on a numerical failure: factorize() and solve() return
    * false (with message() set), so that the Newton solver can report a
@@ -51,7 +51,7 @@ namespace palpate
     virtual ~LinearSolver() = default;
 
     /** Symbolic analysis of @p pattern (kept by reference: it must outlive
-     * the solver). */
+     * the solver, or the next analyze()). */
     virtual void
     analyze(const SparsityCSR &pattern) = 0;
 
