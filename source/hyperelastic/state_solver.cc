@@ -223,11 +223,16 @@ namespace palpate
               const double               force_scale,
               const double               last_correction) const
     {
-      const double L = system->length_scale();
-      if (system->constraint_violation(residual) >
-          settings.increment_tolerance * L)
+      // Nothing non-finite is ever an equilibrium: with an infinite force
+      // scale (E = 1e300) every residual would pass the relative test.
+      const double L         = system->length_scale();
+      const double violation = system->constraint_violation(residual);
+      const double r         = system->force_residual_norm(residual);
+      if (!std::isfinite(force_scale) || !(force_scale > 0) ||
+          !std::isfinite(violation) || !std::isfinite(r))
         return false;
-      const double r = system->force_residual_norm(residual);
+      if (violation > settings.increment_tolerance * L)
+        return false;
       if (r <= settings.residual_tolerance * force_scale)
         return true;
       return last_correction >= 0 &&
@@ -278,6 +283,17 @@ namespace palpate
         if (converged(residual, scale, last_correction))
           {
             outcome.iterations = iteration;
+            return outcome;
+          }
+        if (!std::isfinite(scale) ||
+            !std::isfinite(system->force_residual_norm(residual)))
+          {
+            outcome.status     = SolveStatus::not_finite;
+            outcome.iterations = iteration;
+            outcome.message =
+              "the residual or its force scale is not finite (force scale " +
+              Utilities::to_string(scale, 3) +
+              " N: are the material constants within their physical range?)";
             return outcome;
           }
         if (iteration == settings.max_newton_iterations)
@@ -726,6 +742,16 @@ namespace palpate
       ok = increment(double(i - 1) / n, double(i) / n, 0);
 
     impl->system->to_state(x, state);
+    if (ok && !(std::isfinite(state.force[0]) &&
+                std::isfinite(state.force[1]) && std::isfinite(state.force[2])))
+      {
+        // The last line of defence: a force sent to a device is finite.
+        ok             = false;
+        failure.status = SolveStatus::not_finite;
+        failure.message =
+          "the force is not finite (are the material constants within "
+          "their physical range?)";
+      }
     if (!ok)
       {
         // A failure point: keep the last equilibrium reached on the way,

@@ -830,6 +830,30 @@ namespace palpate
                   "set C10 (and C01) in Pa; for Young's modulus E of an "
                   "incompressible solid, C10 + C01 = E/6.");
 
+    // Moduli beyond any solid's (diamond: E = 1.2e12 Pa) only overflow the
+    // force scale; soft tissue is 1e2 - 1e7 Pa.
+    {
+      const std::pair<const char *, double> moduli[] = {
+        {"Material model/St.Venant-Kirchhoff/Young's modulus",
+         m.model_name == "St.Venant-Kirchhoff" ? m.stvk_youngs_modulus : 0},
+        {"Material model/Neo-Hookean/Young's modulus",
+         m.model_name == "Neo-Hookean" ? m.nh_youngs_modulus : 0},
+        {"Material model/Mooney-Rivlin/C10",
+         m.model_name == "Mooney-Rivlin" ? m.mr_c10 : 0},
+        {"Material model/Mooney-Rivlin/C01",
+         m.model_name == "Mooney-Rivlin" ? m.mr_c01 : 0},
+        {"Material model/Mooney-Rivlin/Bulk modulus",
+         m.model_name == "Mooney-Rivlin" ? m.mr_bulk_modulus : 0}};
+      for (const auto &[entry, value] : moduli)
+        if (std::abs(value) > max_modulus)
+          throw error(entry,
+                      "at most " + Utilities::to_string(max_modulus, 3) +
+                        " Pa: stiffer than any solid (diamond is 1.2e12 Pa); "
+                        "such moduli only overflow the solver's force scale",
+                      "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
+                      "(liver: E = 15465 Pa).");
+    }
+
     // Mooney-Rivlin: the element pair fixes the displacement degree.
     if (m.model_name == "Mooney-Rivlin" &&
         line_of("Discretization/Polynomial degree") > 0)

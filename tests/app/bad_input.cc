@@ -333,6 +333,11 @@ main(int argc, char **argv)
       "subsection Boundary conditions\n  subsection Fixed nodes\n"
       "    set Selection = box\n    set Box lower corner = -1e9, -1e9, -1e9\n"
       "    set Box upper corner = 1e9, 1e9, -1\n  end\nend\n");
+  scene("Young's modulus = 1e300 (once: 'converged' with a NaN residual)",
+        "young-huge.prm",
+        beam + "subsection Material model\n"
+               "  subsection St.Venant-Kirchhoff\n"
+               "    set Young's modulus = 1e300\n  end\nend\n");
   scene("a number below the double range (1e-320)",
         "denormal.prm",
         beam + "subsection Mesh\n  set Scale factor = 1e-320\nend\n");

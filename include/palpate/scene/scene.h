@@ -29,6 +29,8 @@ namespace palpate
     constexpr double max_scheduler_rate = 1000;
     /** Effects / Shape output rate (Hz): one VTU file per frame. */
     constexpr double max_shape_output_rate = 240;
+    /** Elastic moduli (Pa): diamond's Young's modulus is 1.2e12 Pa. */
+    constexpr double max_modulus = 1e13;
     /** Nodes of a generated mesh (beam). */
     constexpr double max_generated_nodes = 1e5;
   } // namespace Limits
