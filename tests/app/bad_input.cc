@@ -234,7 +234,12 @@ main(int argc, char **argv)
         beam + "subsection Mesh\n  set Scale factor 2\nend\n");
   scene("an include line", "include.prm", "include other.prm\n" + beam);
   scene("a line that is no statement", "junk.prm", beam + "hello world\n");
-  run("a binary file given as the scene", palpate_executable);
+  // The first bytes of an executable, as when a binary is given by mistake.
+  write_file("binary",
+             std::string("\x7f"
+                         "ELF\x02\x01\x01\0\0\0\0\0",
+                         12));
+  run("a binary file given as the scene", "binary");
 
   // Values that are numbers but not physical.
   scene("a negative Young's modulus",

@@ -202,15 +202,20 @@ main(int argc, char **argv)
     if (e.path().extension() == ".prm")
       names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  // The scenes name their meshes relative to parameters/; the mutants are
-  // written here, so the seeds name them absolutely.
+  // The scenes name their meshes relative to parameters/ (../../shared/);
+  // the mutants are written here, where a link 'shared' points to the
+  // shared data. The seeds then have the same bytes wherever the project
+  // is checked out, and so have the mutants.
+  std::filesystem::remove("shared");
+  std::filesystem::create_directory_symlink(
+    std::filesystem::absolute(palpate_shared_dir), "shared");
   const std::string relative = "../../shared/";
   for (const auto &n : names)
     {
       std::string text = read_file(palpate_source_dir + "/parameters/" + n);
       for (auto at = text.find(relative); at != std::string::npos;
            at      = text.find(relative))
-        text.replace(at, relative.size(), palpate_shared_dir + "/");
+        text.replace(at, relative.size(), "shared/");
       seeds.push_back(text);
     }
   // The mutants, generated first: the same on every run.
