@@ -93,6 +93,8 @@ namespace palpate
 
     // Real-time state (touched by force() only).
     ForceFilter       filter;
+    ForceHold         hold;
+    MissingCause      previous_cause = MissingCause::none;
     Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
     Clock::time_point previous_call;
     bool first_call = true, was_complete = false, in_contact = false;
@@ -102,10 +104,14 @@ namespace palpate
     mutable std::atomic<bool> initial_done{false};
     std::atomic<std::uint64_t> corner_reads{0}, corner_hits{0},
       missing_events{0}, missing_nanoseconds{0}, non_finite{0};
-    std::atomic<double> largest_force{0}, largest_change{0};
-    std::atomic<double> event_position[3] = {};
-    std::uint64_t       reported_events   = 0;
-    Clock::time_point   attach_time;
+    // Held force, by cause: [0] failure region, [1] outside the state space.
+    std::atomic<std::uint64_t> held_events[2] = {}, held_nanoseconds[2] = {};
+    std::atomic<std::uint8_t>  event_cause{0}, last_cause{0};
+    std::atomic<double>        event_stiffness{0};
+    std::atomic<double>        largest_force{0}, largest_change{0};
+    std::atomic<double>        event_position[3] = {};
+    std::uint64_t              reported_events   = 0;
+    Clock::time_point          attach_time;
   };
 
 
@@ -166,8 +172,10 @@ namespace palpate
     Impl &s = *impl;
     if (s.reset.exchange(false, std::memory_order_acq_rel))
       {
-        s.in_contact   = false;
-        s.was_complete = false;
+        s.in_contact     = false;
+        s.was_complete   = false;
+        s.previous_cause = MissingCause::none;
+        s.hold.reset();
       }
     const auto now = Clock::now();
     double     dt  = s.first_call ?
@@ -214,29 +222,71 @@ namespace palpate
             s.used[c].store(1, std::memory_order_relaxed);
       }
     const bool complete = sample.complete;
-
-    // Missing data while in contact (from the first complete cell after
-    // attaching on): an event when it starts, time while it lasts.
     if (complete)
-      s.in_contact = true;
-    if (attached && s.in_contact && !complete)
       {
-        if (s.was_complete)
+        s.in_contact = true;
+        s.hold.update(position, sample, s.grid.spacing());
+      }
+
+    // No force here, while in contact (from the first complete cell after
+    // attaching on). Where states will come (not computed yet) the force
+    // fades to zero, as in the paper. Where none can come - a failure
+    // region, or outside the state space - the hand must not fall through
+    // the tissue: the force is held from the last complete cell
+    // (ForceHold, passive), until complete data is found again.
+    MissingCause cause = !attached ? MissingCause::none :
+                         finite    ? sample.cause() :
+                                     MissingCause::outside;
+    // Beyond a failure region the grid is not computed either (no
+    // converged neighbour to start from): a held force stays held there.
+    if (cause == MissingCause::not_computed &&
+        (s.previous_cause == MissingCause::failure_region ||
+         s.previous_cause == MissingCause::outside))
+      cause = s.previous_cause;
+    Utilities::Point3 target = sample.force;
+    bool              render = complete;
+    if (s.in_contact && cause != MissingCause::none)
+      {
+        const bool held =
+          cause != MissingCause::not_computed && finite && s.hold.valid();
+        if (held)
+          {
+            target = s.hold.force(position);
+            render = true;
+          }
+        const unsigned int slot = cause == MissingCause::failure_region ? 0 : 1;
+        if (cause != s.previous_cause)
           {
             for (unsigned int d = 0; d < 3; ++d)
               s.event_position[d].store(finite ? position[d] : 0.0,
                                         std::memory_order_relaxed);
-            s.missing_events.fetch_add(1, std::memory_order_release);
+            s.event_cause.store(static_cast<std::uint8_t>(cause) |
+                                  (held ? 0x10 : 0),
+                                std::memory_order_relaxed);
+            s.event_stiffness.store(s.hold.held_stiffness(),
+                                    std::memory_order_relaxed);
+            if (held)
+              s.held_events[slot].fetch_add(1, std::memory_order_release);
+            else
+              s.missing_events.fetch_add(1, std::memory_order_release);
           }
-        s.missing_nanoseconds.fetch_add(static_cast<std::uint64_t>(dt * 1e9),
-                                        std::memory_order_relaxed);
+        const auto nanoseconds = static_cast<std::uint64_t>(dt * 1e9);
+        if (held)
+          s.held_nanoseconds[slot].fetch_add(nanoseconds,
+                                             std::memory_order_relaxed);
+        else
+          s.missing_nanoseconds.fetch_add(nanoseconds,
+                                          std::memory_order_relaxed);
       }
+    s.previous_cause = s.in_contact ? cause : MissingCause::none;
+    s.last_cause.store(static_cast<std::uint8_t>(cause),
+                       std::memory_order_relaxed);
     s.was_complete = complete;
     s.complete.store(complete, std::memory_order_relaxed);
 
     // Never a NaN, never more than the device's limit, never a jump.
     bool                    rejected;
-    const Utilities::Point3 f = s.filter.next(sample.force, complete, rejected);
+    const Utilities::Point3 f = s.filter.next(target, render, rejected);
     if (rejected)
       s.non_finite.fetch_add(1, std::memory_order_relaxed);
     if (s.filter.change() > s.largest_change.load(std::memory_order_relaxed))
@@ -253,6 +303,15 @@ namespace palpate
   Interaction::data_complete() const noexcept
   {
     return impl->complete.load(std::memory_order_relaxed);
+  }
+
+
+
+  MissingCause
+  Interaction::missing_cause() const noexcept
+  {
+    return static_cast<MissingCause>(
+      impl->last_cause.load(std::memory_order_relaxed));
   }
 
 
@@ -357,7 +416,9 @@ namespace palpate
   {
     Impl               &s = *impl;
     const std::uint64_t events =
-      s.missing_events.load(std::memory_order_acquire);
+      s.missing_events.load(std::memory_order_acquire) +
+      s.held_events[0].load(std::memory_order_acquire) +
+      s.held_events[1].load(std::memory_order_acquire);
     if (events == s.reported_events)
       return 0;
     const unsigned int n = events - s.reported_events;
@@ -367,11 +428,31 @@ namespace palpate
       p[d] = s.event_position[d].load(std::memory_order_relaxed);
     const double t =
       std::chrono::duration<double>(Clock::now() - s.attach_time).count();
+    const std::uint8_t code  = s.event_cause.load(std::memory_order_relaxed);
+    const auto         cause = static_cast<MissingCause>(code & 0x0f);
+    const bool         held  = code & 0x10;
+    const std::string  why =
+      cause == MissingCause::failure_region ?
+         "the HIP is in a failure region (no equilibrium was found for a "
+         "corner of its cell)" :
+       cause == MissingCause::outside ?
+         "the HIP left the state space (extent +-" +
+          Utilities::to_string(1000 * s.grid.half_width() * s.grid.spacing(),
+                               4) +
+          " mm)" :
+         "the states of the HIP's cell are not computed yet";
+    const std::string what =
+      held ? "the force is held from the last computed cell, " +
+               Utilities::to_string(
+                 s.event_stiffness.load(std::memory_order_relaxed) / 1000, 3) +
+               " N/mm deeper" :
+      cause == MissingCause::not_computed ?
+             "the force fades to zero until they are computed" :
+             "the force fades to zero";
     log << "palpate: missing data at t = " << Utilities::to_string(t, 4)
-        << " s, HIP at (" << Utilities::to_string(p, 3)
-        << ") m: the force fades to zero until the cell's states "
-        << "are computed"
-        << (n > 1 ? " (" + std::to_string(n) + " events)" : "") << std::endl;
+        << " s, HIP at (" << Utilities::to_string(p, 3) << ") m: " << why
+        << "; " << what << (n > 1 ? " (" + std::to_string(n) + " events)" : "")
+        << std::endl;
     return n;
   }
 
@@ -423,13 +504,17 @@ namespace palpate
     r.worker_busy_fraction     = span > 0 ? e.busy_time / (span * workers) : 0;
     for (unsigned int p = 0; p < s.grid.size(); ++p)
       r.states_used += s.used[p].load(std::memory_order_relaxed);
-    r.corner_reads         = s.corner_reads.load();
-    r.corner_hits          = s.corner_hits.load();
-    r.missing_events       = s.missing_events.load();
-    r.missing_seconds      = 1e-9 * s.missing_nanoseconds.load();
-    r.non_finite_forces    = s.non_finite.load();
-    r.largest_force        = s.largest_force.load();
-    r.largest_force_change = s.largest_change.load();
+    r.corner_reads           = s.corner_reads.load();
+    r.corner_hits            = s.corner_hits.load();
+    r.missing_events         = s.missing_events.load();
+    r.missing_seconds        = 1e-9 * s.missing_nanoseconds.load();
+    r.failure_region_events  = s.held_events[0].load();
+    r.failure_region_seconds = 1e-9 * s.held_nanoseconds[0].load();
+    r.outside_events         = s.held_events[1].load();
+    r.outside_seconds        = 1e-9 * s.held_nanoseconds[1].load();
+    r.non_finite_forces      = s.non_finite.load();
+    r.largest_force          = s.largest_force.load();
+    r.largest_force_change   = s.largest_change.load();
     return r;
   }
 

@@ -228,6 +228,10 @@ namespace palpate
               count("corner_hits", s.corner_hits),
               count("missing_data_events", s.missing_events),
               real("missing_data_seconds", s.missing_seconds),
+              count("failure_region_events", s.failure_region_events),
+              real("failure_region_seconds", s.failure_region_seconds),
+              count("outside_events", s.outside_events),
+              real("outside_seconds", s.outside_seconds),
               count("non_finite_forces", s.non_finite_forces),
               real("largest_force_N", s.largest_force),
               real("largest_force_change_N", s.largest_force_change),
@@ -275,8 +279,13 @@ namespace palpate
       << "  missing data:      " << missing_events << " events, "
       << missing_seconds << " s in total"
       << (missing_events > 0 ? "  <-- the force faded to zero then" : "")
-      << "\n"
-      << "  forces:            largest " << largest_force
+      << "\n";
+    if (failure_region_events + outside_events > 0)
+      s << "  held force:        " << failure_region_events
+        << " times in failure regions (" << failure_region_seconds << " s), "
+        << outside_events << " times outside the state space ("
+        << outside_seconds << " s)  <-- no state can exist there\n";
+    s << "  forces:            largest " << largest_force
       << " N, largest change per tick " << largest_force_change
       << " N, non-finite " << non_finite_forces << "\n";
     if (messages > 0)

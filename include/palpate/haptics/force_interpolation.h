@@ -9,15 +9,47 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 namespace palpate
 {
   class StateCache;
   class StateGrid;
 
+  /** Why the interpolation at a position found no force. */
+  enum class MissingCause : std::uint8_t
+  {
+    /** Nothing missing: all 8 corners were there. */
+    none = 0,
+    /** Corners not computed yet: they will come. */
+    not_computed = 1,
+    /** A corner is a failure point: no equilibrium was found there. */
+    failure_region = 2,
+    /** The position is outside the state space (or not finite). */
+    outside = 3
+  };
+
   /** What the interpolation found for one position. */
   struct ForceSample
   {
+    /** Whether the position is inside the grid. */
+    bool inside = false;
+    /** How many corners are failure points (only counted if incomplete). */
+    unsigned int failed = 0;
+    /** The position in its cell, each coordinate in [0, 1]. */
+    std::array<double, 3> local = {};
+    /** The corners' forces (valid if complete). */
+    std::array<Utilities::Point3, 8> corner_forces = {};
+
+    MissingCause
+    cause() const noexcept
+    {
+      return complete   ? MissingCause::none :
+             !inside    ? MissingCause::outside :
+             failed > 0 ? MissingCause::failure_region :
+                          MissingCause::not_computed;
+    }
+
     /** Trilinear force (N); zero unless complete. */
     Utilities::Point3 force = {{0, 0, 0}};
     /** Whether all 8 corners were available. */
@@ -37,6 +69,91 @@ namespace palpate
   interpolate_force(const StateGrid         &grid,
                     const StateCache        &cache,
                     const Utilities::Point3 &x) noexcept;
+
+  /**
+   * The stiffness -n . (df/dx) n (N/m) of the trilinear force field of the
+   * complete sample @p s along the unit vector @p n, on a grid of spacing
+   * @p h: how fast the force along n grows when the probe moves against n.
+   */
+  double
+  directional_stiffness(const ForceSample       &s,
+                        const double             h,
+                        const Utilities::Point3 &n) noexcept;
+
+  /**
+   * A safe force where no force can be computed: beyond the last complete
+   * cell, in a failure region (no equilibrium exists, or none was found)
+   * or outside the state space. The hand must not fall through the tissue
+   * there, so the force is held from the last complete sample (position
+   * x0, force f0, stiffness k along n = f0/|f0|) and extended as a
+   * one-dimensional spring:
+   *
+   *   f(x) = max(0, |f0| - k (x - x0) . n) n.
+   *
+   * It is a gradient field (of a potential of s = (x - x0) . n alone), so
+   * moving around in it creates no energy: passive. Pushing on against n
+   * raises the force at the last stiffness; backing out releases it to zero.
+   * Real-time safe.
+   */
+  class ForceHold
+  {
+  public:
+    /** Remember the complete sample @p s at @p x (grid spacing @p h). */
+    void
+    update(const Utilities::Point3 &x,
+           const ForceSample       &s,
+           const double             h) noexcept
+    {
+      const double magnitude = Utilities::norm(s.force);
+      has_force              = magnitude > 1e-12;
+      if (!has_force)
+        return;
+      origin = x;
+      size   = magnitude;
+      for (unsigned int d = 0; d < 3; ++d)
+        normal[d] = s.force[d] / magnitude;
+      const double k = directional_stiffness(s, h, normal);
+      stiffness      = std::isfinite(k) ? std::max(0.0, k) : 0.0;
+    }
+
+    /** Whether a force is held (the last complete force was not zero). */
+    bool
+    valid() const noexcept
+    {
+      return has_force;
+    }
+
+    /** The held force at @p x (N). */
+    Utilities::Point3
+    force(const Utilities::Point3 &x) const noexcept
+    {
+      if (!has_force)
+        return {{0, 0, 0}};
+      double s = 0;
+      for (unsigned int d = 0; d < 3; ++d)
+        s += (x[d] - origin[d]) * normal[d];
+      const double g = std::max(0.0, size - stiffness * s);
+      return {{g * normal[0], g * normal[1], g * normal[2]}};
+    }
+
+    /** The stiffness along the held direction (N/m). */
+    double
+    held_stiffness() const noexcept
+    {
+      return stiffness;
+    }
+
+    void
+    reset() noexcept
+    {
+      has_force = false;
+    }
+
+  private:
+    bool              has_force = false;
+    Utilities::Point3 origin = {{0, 0, 0}}, normal = {{0, 0, 0}};
+    double            size = 0, stiffness = 0;
+  };
 
   /**
    * What turns interpolated forces into forces a device may render: a

@@ -5,6 +5,7 @@
 #define palpate_haptics_interaction_h
 
 #include <palpate/base/utilities.h>
+#include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/run_summary.h>
 
 #include <iosfwd>
@@ -81,6 +82,14 @@ namespace palpate
     /** Whether the last force() call found all 8 corners of its cell. */
     bool
     data_complete() const noexcept;
+
+    /**
+     * Why the last force() call found no force (MissingCause::none if it
+     * did): not computed yet (the force fades to zero), a failure region
+     * or outside the state space (the force is held, see ForceHold).
+     */
+    MissingCause
+    missing_cause() const noexcept;
 
     /** Whether the cloud around the attach position has been computed
      * (latched: stays true once it was). */

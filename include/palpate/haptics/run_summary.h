@@ -43,8 +43,14 @@ namespace palpate
     // What the haptic side read.
     unsigned int  states_used  = 0;
     std::uint64_t corner_reads = 0, corner_hits = 0;
-    std::uint64_t missing_events    = 0;
-    double        missing_seconds   = 0;
+    /** Missing data where states were not computed yet: the force faded
+     * to zero. */
+    std::uint64_t missing_events  = 0;
+    double        missing_seconds = 0;
+    /** Where no state can come, the force was held (ForceHold): in failure
+     * regions, and outside the state space. */
+    std::uint64_t failure_region_events = 0, outside_events = 0;
+    double        failure_region_seconds = 0, outside_seconds = 0;
     std::uint64_t non_finite_forces = 0;
     double        largest_force = 0, largest_force_change = 0;
 

@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The hand never falls through the tissue (issue 10). St.Venant-Kirchhoff
+// on the shipped liver (parameters/liver-stvk.prm) has no equilibrium
+// beyond about 2.5 cm of push at its active node: the cells there hold
+// failure points, and beyond 10 cm the grid ends. The HIP is pushed 11 cm
+// into the liver in 0.5 mm steps; at each step the engine is given the
+// time to compute what it can (so the run does not depend on the
+// machine's speed), then the force settles:
+// - while in contact (deeper than 3 mm) the rendered force is never below
+//   0.5 N, and never non-finite;
+// - the causes seen on the way are a failure region, then outside the
+//   state space, and the force there is held (it grows as the probe goes
+//   deeper);
+// - moving around a closed loop in the held region (a 1 cm circle at 6 cm
+//   depth, 2000 steps) creates no energy: the work of the rendered force
+//   over the loop is zero to round-off (the held force is a gradient
+//   field).
+
+#include <palpate/haptics/interaction.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "../tests.h"
+
+namespace
+{
+  using palpate::Utilities::Point3;
+
+  /** force() at @p x until the engine has done what it can for its cell
+   * (at most 2 minutes), then until the force settles. */
+  Point3
+  settled_force(palpate::Interaction &interaction, const Point3 &x)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    interaction.force(x);
+    while (interaction.missing_cause() == palpate::MissingCause::not_computed &&
+           std::chrono::steady_clock::now() - start < std::chrono::minutes(2))
+      {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        interaction.force(x);
+      }
+    Point3 f = interaction.force(x);
+    for (unsigned int i = 0; i < 1000; ++i)
+      {
+        const Point3 g = interaction.force(x);
+        if (palpate::Utilities::distance(f, g) == 0)
+          break;
+        f = g;
+      }
+    return f;
+  }
+
+  bool
+  finite(const Point3 &f)
+  {
+    return std::isfinite(f[0]) && std::isfinite(f[1]) && std::isfinite(f[2]);
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  palpate::Scene       scene = shipped_scene("liver-stvk.prm");
+  palpate::Interaction interaction(scene);
+  interaction.force({{0, 0, 0}});
+  interaction.attach();
+  while (!interaction.initial_cloud_complete())
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+
+  double       smallest = 1e9, at_30 = 0, at_110 = 0;
+  bool         all_finite = true, failure_region = false, outside = false;
+  bool         faded = false;
+  unsigned int steps = 0;
+  for (int i = 1; i <= 220; ++i)
+    {
+      const double z = -0.0005 * i;
+      const Point3 f = settled_force(interaction, {{0, 0, z}});
+      const auto   c = interaction.missing_cause();
+      all_finite     = all_finite && finite(f);
+      failure_region =
+        failure_region || c == palpate::MissingCause::failure_region;
+      outside = outside || c == palpate::MissingCause::outside;
+      faded   = faded || c == palpate::MissingCause::not_computed;
+      const double magnitude = palpate::Utilities::norm(f);
+      if (z < -0.003)
+        smallest = std::min(smallest, magnitude);
+      if (i == 60)
+        at_30 = magnitude;
+      if (i == 220)
+        at_110 = magnitude;
+      ++steps;
+    }
+  deallog << steps << " steps to 110 mm deep: forces finite: "
+          << (all_finite ? "yes" : "NO") << ", smallest force deeper than "
+          << "3 mm above 0.5 N: " << (smallest > 0.5 ? "yes" : "NO")
+          << std::endl;
+  deallog << "causes on the way: failure region "
+          << (failure_region ? "yes" : "NO") << ", outside the state space "
+          << (outside ? "yes" : "NO") << ", not computed (fade) "
+          << (faded ? "YES" : "no") << std::endl;
+  deallog << "held force grows deeper: |f(110 mm)| > |f(30 mm)|: "
+          << (at_110 > at_30 ? "yes" : "NO") << std::endl;
+
+  // A closed loop in the held region: x-z circle of radius 1 cm around
+  // (0, 0, -60 mm), started at its top.
+  const unsigned int n  = 2000;
+  const double       pi = std::acos(-1.0), r = 0.01, zc = -0.06;
+  const auto         point = [&](const unsigned int k) {
+    const double a = 2 * pi * k / n;
+    return Point3{{r * std::sin(a), 0, zc + r * std::cos(a)}};
+  };
+  Point3 f_previous = settled_force(interaction, point(0));
+  double work = 0, scale = 0;
+  bool   held = true;
+  for (unsigned int k = 1; k <= n; ++k)
+    {
+      const Point3 x = point(k), x_previous = point(k - 1);
+      const Point3 f = interaction.force(x);
+      held = held && interaction.missing_cause() != palpate::MissingCause::none;
+      for (unsigned int d = 0; d < 3; ++d)
+        {
+          const double step =
+            0.5 * (f[d] + f_previous[d]) * (x[d] - x_previous[d]);
+          work += step;
+          scale += std::abs(step);
+        }
+      f_previous = f;
+    }
+  interaction.detach();
+  deallog << "loop of " << n << " steps in the held region (held all the way: "
+          << (held ? "yes" : "NO") << "): work / sum |f . dx| "
+          << (std::abs(work) <= 1e-10 * scale ? "<= 1e-10" :
+                                                "> 1e-10: ENERGY CREATED")
+          << std::endl;
+}
