@@ -86,6 +86,21 @@ namespace palpate
             << " Pa";
       }
     s << "\n";
+    {
+      // Volumetric locking: a compressible law on linear tetrahedra near
+      // nu = 0.5 is far too stiff (the divergence-free displacements of P1
+      // tetrahedra are almost only rigid motions).
+      const double nu = m.model_name == "St.Venant-Kirchhoff" ?
+                          m.stvk_poissons_ratio :
+                        m.model_name == "Neo-Hookean" ? m.nh_poissons_ratio :
+                                                        0;
+      if (nu >= 0.495 && p.discretization.polynomial_degree == 1)
+        s << "  warning:       nu = " << nu
+          << " on linear tetrahedra locks (volumetric locking): the body "
+             "is too stiff and Newton may stagnate. For a nearly "
+             "incompressible organ use Mooney-Rivlin (mixed u-p, exactly "
+             "incompressible), or Polynomial degree = 2, or nu <= 0.49.\n";
+    }
 
     std::vector<std::string> on, off;
     (p.effects.gravity ? on : off).push_back("gravity");

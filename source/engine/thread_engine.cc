@@ -263,6 +263,9 @@ namespace palpate
         std::string  error;
         try
           {
+            if (faults.workers_throw)
+              throw std::runtime_error("fault injected for a test (task " +
+                                       std::to_string(task.target) + ")");
             if (const auto source = cache.state(task.source))
               {
                 // The state behind the source on the same grid line, if

@@ -99,6 +99,32 @@ main(int argc, char **argv)
   }
 
   {
+    deallog << "--- every worker throws in every task" << std::endl;
+    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
+    const palpate::NodeSelection nodes =
+      palpate::NodeSelection::create(scene, mesh);
+    const palpate::StateGrid grid(p.state_space.grid_spacing,
+                                  p.state_space.extent);
+    palpate::StateCache      cache(grid, 1 << 28);
+    palpate::HipChannel      hip;
+    palpate::EngineFaults    faults;
+    faults.workers_throw = true;
+    palpate::ThreadEngine engine(mesh, nodes, p, grid, cache, hip, faults);
+    engine.start();
+    const bool idle = wait_for([&] { return engine.idle(); }, 60);
+    engine.stop();
+    const auto stats = engine.statistics();
+    deallog << "engine idle: " << (idle ? "yes" : "NO") << "; every task a "
+            << "failure point with its error counted: "
+            << (stats.errors > 0 && stats.errors == stats.failed &&
+                    stats.computed == 0 &&
+                    cache.counts().second == stats.failed ?
+                  "yes" :
+                  "NO")
+            << " (" << stats.last_error.substr(0, 30) << "...)" << std::endl;
+  }
+
+  {
     deallog << "--- the shape output's directory disappears in mid-run"
             << std::endl;
     std::filesystem::remove_all("shapes");

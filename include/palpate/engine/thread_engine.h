@@ -20,6 +20,8 @@ namespace palpate
   {
     /** The scheduler throws at this plan (counting from 1); 0: never. */
     unsigned int scheduler_throws_at_plan = 0;
+    /** Every worker throws in every task (as if out of memory). */
+    bool workers_throw = false;
   };
 
   /**
