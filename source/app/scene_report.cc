@@ -66,6 +66,18 @@ namespace palpate
     if (a.selection == "nearest surface node")
       s << ", the surface node nearest to (" << Utilities::to_string(a.point, 4)
         << ") m, " << 1000 * nodes.active_distance << " mm away";
+    if (!nodes.tip_vertices.empty() ||
+        p.boundary_conditions.active_node.tip_radius > 0)
+      s << "\n  probe tip:     radius "
+        << 1000 * p.boundary_conditions.active_node.tip_radius
+        << " mm: " << nodes.tip_vertices.size()
+        << " more surface nodes move with the probe (rigid tip)"
+        << (nodes.tip_vertices.empty() ?
+              "; the nearest is " +
+                Utilities::to_string(1000 * nodes.tip_neighbour_distance, 3) +
+                " mm away, so on this mesh the tip is a point probe (a "
+                "finer mesh, or a radius of at least that, makes a tip)" :
+              std::string());
     s << "\n";
 
     const auto &m = p.material_model;

@@ -206,6 +206,11 @@ namespace palpate
       nodes.active_vertex != NodeSelection::no_active_node;
     std::vector<bool> dof_fixed(n_dofs, false);
     active.fill(static_cast<unsigned int>(-1));
+    // A rigid tip: its other nodes' DoFs, in the order of tip_vertices.
+    std::vector<int> tip_index(mesh.n_vertices(), -1);
+    for (unsigned int t = 0; t < nodes.tip_vertices.size(); ++t)
+      tip_index[nodes.tip_vertices[t]] = t;
+    std::vector<unsigned int> tip_dofs(3 * nodes.tip_vertices.size(), 0);
     dof_position.resize(n_dofs);
     dof_component.resize(n_dofs);
     std::vector<types::global_dof_index> dofs(dofs_per_cell);
@@ -230,6 +235,8 @@ namespace palpate
                       dof_fixed[dofs[i]] = true;
                     if (has_active && v == nodes.active_vertex)
                       active[component] = dofs[i];
+                    if (has_active && tip_index[v] >= 0)
+                      tip_dofs[3 * tip_index[v] + component] = dofs[i];
                   }
               }
             else if (i < first_quad)
@@ -261,7 +268,10 @@ namespace palpate
     if (has_active)
       {
         multiplier_dof.assign(active.begin(), active.end());
-        n_active_multipliers = 3;
+        multiplier_dof.insert(multiplier_dof.end(),
+                              tip_dofs.begin(),
+                              tip_dofs.end());
+        n_active_multipliers = multiplier_dof.size();
       }
     if (!eliminate)
       multiplier_dof.insert(multiplier_dof.end(), fixed.begin(), fixed.end());
@@ -927,7 +937,7 @@ namespace palpate
       {
         const unsigned int d = s.multiplier_dof[m];
         const double       value =
-          m < s.n_active_multipliers ? target[m] : s.fixed_value[d];
+          m < s.n_active_multipliers ? target[m % 3] : s.fixed_value[d];
         const double lambda = s.beta * x[s.n_free + m];
         residual[s.eq_of_dof[d]] += lambda;
         residual[s.n_free + m] = s.beta * (s.u_work[d] - value);
@@ -998,8 +1008,11 @@ namespace palpate
     state.multipliers.resize(s.multiplier_dof.size());
     for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
       state.multipliers[m] = s.beta * x[s.n_free + m];
-    for (unsigned int c = 0; c < 3; ++c)
-      state.force[c] = c < s.n_active_multipliers ? state.multipliers[c] : 0.0;
+    // The force on the probe: the sum over the tip's nodes (one for a
+    // point probe).
+    state.force = {{0, 0, 0}};
+    for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+      state.force[m % 3] += state.multipliers[m];
   }
 
 
@@ -1071,9 +1084,12 @@ namespace palpate
     scalar.distribute_dofs(fe_scalar);
     Vector<double> node_id(scalar.n_dofs()), fixed(scalar.n_dofs()),
       active(scalar.n_dofs());
-    std::vector<bool> vertex_fixed(s.mesh.n_vertices(), false);
+    std::vector<bool> vertex_fixed(s.mesh.n_vertices(), false),
+      vertex_tip(s.mesh.n_vertices(), false);
     for (const unsigned int v : s.nodes.fixed_vertices)
       vertex_fixed[v] = true;
+    for (const unsigned int v : s.nodes.tip_vertices)
+      vertex_tip[v] = true;
     for (const auto &cell : scalar.active_cell_iterators())
       for (unsigned int v = 0; v < 4; ++v)
         {
@@ -1081,7 +1097,7 @@ namespace palpate
           const auto g = cell->vertex_index(v);
           node_id[d]   = s.mesh.node_id(g);
           fixed[d]     = vertex_fixed[g] ? 1 : 0;
-          active[d]    = g == s.nodes.active_vertex ? 1 : 0;
+          active[d]    = g == s.nodes.active_vertex || vertex_tip[g] ? 1 : 0;
         }
 
     // Reactions: the force the body exerts at constrained DoFs (the probe
@@ -1091,9 +1107,8 @@ namespace palpate
     const auto     f = nodal_residual(state.solution);
     for (const unsigned int d : s.fixed)
       reaction[d] = -f[d];
-    if (has_active_node())
-      for (unsigned int c = 0; c < 3; ++c)
-        reaction[s.active[c]] = state.force[c];
+    for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+      reaction[s.multiplier_dof[m]] = state.multipliers[m];
 
     // With a pressure field the FE has a fourth, scalar component.
     std::vector<DataComponentInterpretation::DataComponentInterpretation>

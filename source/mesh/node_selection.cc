@@ -233,6 +233,20 @@ namespace palpate
           " m) is also a fixed node, so it cannot move",
         "choose an active node outside the fixed region, or "
         "shrink the region.");
+    if (a.tip_radius > 0)
+      {
+        selection.tip_neighbour_distance = std::numeric_limits<double>::max();
+        for (unsigned int v = 0; v < x.size(); ++v)
+          if (v != selection.active_vertex && surface[v] && !fixed.count(v))
+            {
+              const double d =
+                Utilities::distance(x[v], x[selection.active_vertex]);
+              selection.tip_neighbour_distance =
+                std::min(selection.tip_neighbour_distance, d);
+              if (d <= a.tip_radius)
+                selection.tip_vertices.push_back(v);
+            }
+      }
     return selection;
   }
 } // namespace palpate

@@ -269,6 +269,16 @@ namespace palpate
           "Displacement of the active node from its rest position for a "
           "static solve (`palpate solve`, or `palpate scene.prm` when it is "
           "non-zero), in metres; `palpate solve --to x,y,z` overrides it.");
+        prm.declare_entry(
+          "Tip radius",
+          "0",
+          Patterns::Double(0.),
+          "Radius of a rigid probe tip (m). Every surface node within this "
+          "distance of the active node (and not fixed) moves with the probe, "
+          "each held by its own multipliers; the force on the device is "
+          "their sum. A finite tip spreads the load over several elements, "
+          "where the paper's point probe (0, the default) concentrates it in "
+          "the elements around one node.");
       }
       prm.leave_subsection();
     }
@@ -284,6 +294,7 @@ namespace palpate
         point                   = get_point(prm, "Point");
         node_id                 = prm.get_integer("Node id");
         prescribed_displacement = get_point(prm, "Prescribed displacement");
+        tip_radius              = prm.get_double("Tip radius");
       }
       prm.leave_subsection();
     }

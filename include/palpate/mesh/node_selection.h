@@ -34,6 +34,15 @@ namespace palpate
     /** Distance from the scene's Point to the active node, metres (0 for
      * Selection = node id). */
     double active_distance = 0;
+    /**
+     * The other nodes of a rigid probe tip (Active node / Tip radius):
+     * surface vertices within the radius of the active vertex, not fixed.
+     * They move with the active node; empty for a point probe.
+     */
+    std::vector<unsigned int> tip_vertices;
+    /** With a tip: the distance (m) from the active vertex to the nearest
+     * other free surface vertex, the smallest radius that makes a tip. */
+    double tip_neighbour_distance = 0;
     /** One line describing how the fixed nodes were chosen. */
     std::string fixed_description;
 

@@ -88,6 +88,8 @@ namespace palpate
       long node_id;
       /** Displacement of the active node for a static solve, metres. */
       Point3 prescribed_displacement;
+      /** Radius of a rigid probe tip (m); 0: a point probe at one node. */
+      double tip_radius;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
