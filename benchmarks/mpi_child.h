@@ -54,13 +54,12 @@ namespace mpi_child
   }
 
   /**
-   * Run @p command and return the key=value pairs of its CHILD line;
-   * throws with the whole output if there is none. Variables that an MPI
-   * library set in this process's environment are removed first, so that
-   * the child's mpirun starts a job of its own.
+   * Remove the variables that an MPI library set in this process's
+   * environment, so that a child process (or its mpirun) starts a job of
+   * its own.
    */
-  inline std::map<std::string, std::string>
-  run(const std::string &command)
+  inline void
+  clean_environment()
   {
     for (bool removed = true; removed;)
       {
@@ -78,6 +77,17 @@ namespace mpi_child
               }
           }
       }
+  }
+
+  /**
+   * Run @p command and return the key=value pairs of its CHILD line;
+   * throws with the whole output if there is none. The environment is
+   * cleaned first (clean_environment()).
+   */
+  inline std::map<std::string, std::string>
+  run(const std::string &command)
+  {
+    clean_environment();
     FILE *pipe = popen(command.c_str(), "r");
     if (pipe == nullptr)
       throw std::runtime_error("cannot run " + command);
