@@ -19,6 +19,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -87,6 +88,30 @@ inline palpate::Scene
 shipped_scene(const std::string &name)
 {
   return palpate::Scene::read(palpate_source_dir + "/parameters/" + name);
+}
+
+/**
+ * The shipped beam with a small state space, for tests of the engine and
+ * the interaction: a 2 mm grid of +-6 mm, a 4.5 mm cloud (57 points around
+ * the rest position), 2 solver threads.
+ */
+inline palpate::Scene
+small_beam_scene()
+{
+  palpate::Scene scene       = shipped_scene("beam.prm");
+  auto          &p           = scene.parameters;
+  p.state_space.grid_spacing = 0.002;
+  p.state_space.extent       = 0.006;
+  p.scheduler.cloud_radius   = 0.0045;
+  p.engine.workers           = 2;
+  return scene;
+}
+
+/** Whether every component of @p f is finite. */
+inline bool
+all_finite(const std::array<double, 3> &f)
+{
+  return std::isfinite(f[0]) && std::isfinite(f[1]) && std::isfinite(f[2]);
 }
 
 /** The whole text of the file @p name ("" if it cannot be read). */

@@ -44,6 +44,21 @@ namespace
       }
     return true;
   }
+  /** What a ThreadEngine works on: a body, a grid, a cache, a HIP. */
+  struct Rig
+  {
+    explicit Rig(const palpate::Scene &scene)
+      : body(scene)
+      , grid(scene.parameters.state_space.grid_spacing,
+             scene.parameters.state_space.extent)
+      , cache(grid, 1 << 28)
+    {}
+
+    Body                body;
+    palpate::StateGrid  grid;
+    palpate::StateCache cache;
+    palpate::HipChannel hip;
+  };
 } // namespace
 
 int
@@ -52,25 +67,18 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene       = shipped_scene("beam.prm");
-  auto          &p           = scene.parameters;
-  p.state_space.grid_spacing = 0.002;
-  p.state_space.extent       = 0.006;
-  p.scheduler.cloud_radius   = 0.0045;
-  p.engine.workers           = 2;
+  palpate::Scene scene = small_beam_scene();
+  auto          &p     = scene.parameters;
 
   {
     deallog << "--- the scheduler throws at its 3rd plan" << std::endl;
-    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
-    const palpate::NodeSelection nodes =
-      palpate::NodeSelection::create(scene, mesh);
-    const palpate::StateGrid grid(p.state_space.grid_spacing,
-                                  p.state_space.extent);
-    palpate::StateCache      cache(grid, 1 << 28);
-    palpate::HipChannel      hip;
-    palpate::EngineFaults    faults;
+    Rig                   rig(scene);
+    auto                 &cache = rig.cache;
+    const auto           &grid  = rig.grid;
+    palpate::EngineFaults faults;
     faults.scheduler_throws_at_plan = 3;
-    palpate::ThreadEngine engine(mesh, nodes, p, grid, cache, hip, faults);
+    palpate::ThreadEngine engine(
+      rig.body.mesh, rig.body.nodes, p, grid, cache, rig.hip, faults);
     engine.start();
     const bool idle  = wait_for([&] { return engine.idle(); }, 60);
     const auto stats = engine.statistics();
@@ -100,16 +108,13 @@ main(int argc, char **argv)
 
   {
     deallog << "--- every worker throws in every task" << std::endl;
-    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
-    const palpate::NodeSelection nodes =
-      palpate::NodeSelection::create(scene, mesh);
-    const palpate::StateGrid grid(p.state_space.grid_spacing,
-                                  p.state_space.extent);
-    palpate::StateCache      cache(grid, 1 << 28);
-    palpate::HipChannel      hip;
-    palpate::EngineFaults    faults;
+    Rig                   rig(scene);
+    auto                 &cache = rig.cache;
+    const auto           &grid  = rig.grid;
+    palpate::EngineFaults faults;
     faults.workers_throw = true;
-    palpate::ThreadEngine engine(mesh, nodes, p, grid, cache, hip, faults);
+    palpate::ThreadEngine engine(
+      rig.body.mesh, rig.body.nodes, p, grid, cache, rig.hip, faults);
     engine.start();
     const bool idle = wait_for([&] { return engine.idle(); }, 60);
     engine.stop();
@@ -156,11 +161,7 @@ main(int argc, char **argv)
                   "NO: '" + failure + "'")
             << std::endl;
     deallog << "the interaction still answers: force at rest "
-            << (std::isfinite(f[0]) && std::isfinite(f[1]) &&
-                    std::isfinite(f[2]) ?
-                  "finite" :
-                  "NOT FINITE")
-            << std::endl;
+            << (all_finite(f) ? "finite" : "NOT FINITE") << std::endl;
     std::filesystem::remove("shapes");
   }
 }

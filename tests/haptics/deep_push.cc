@@ -53,12 +53,6 @@ namespace
       }
     return f;
   }
-
-  bool
-  finite(const Point3 &f)
-  {
-    return std::isfinite(f[0]) && std::isfinite(f[1]) && std::isfinite(f[2]);
-  }
 } // namespace
 
 int
@@ -75,7 +69,7 @@ main(int argc, char **argv)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
 
   double       smallest = 1e9, at_30 = 0, at_110 = 0;
-  bool         all_finite = true, failure_region = false, outside = false;
+  bool         finite = true, failure_region = false, outside = false;
   bool         faded = false;
   unsigned int steps = 0;
   for (int i = 1; i <= 220; ++i)
@@ -83,7 +77,7 @@ main(int argc, char **argv)
       const double z = -0.0005 * i;
       const Point3 f = settled_force(interaction, {{0, 0, z}});
       const auto   c = interaction.missing_cause();
-      all_finite     = all_finite && finite(f);
+      finite         = finite && all_finite(f);
       failure_region =
         failure_region || c == palpate::MissingCause::failure_region;
       outside = outside || c == palpate::MissingCause::outside;
@@ -97,8 +91,9 @@ main(int argc, char **argv)
         at_110 = magnitude;
       ++steps;
     }
-  deallog << steps << " steps to 110 mm deep: forces finite: "
-          << (all_finite ? "yes" : "NO") << ", smallest force deeper than "
+  deallog << steps
+          << " steps to 110 mm deep: forces finite: " << (finite ? "yes" : "NO")
+          << ", smallest force deeper than "
           << "3 mm above 0.5 N: " << (smallest > 0.5 ? "yes" : "NO")
           << std::endl;
   deallog << "causes on the way: failure region "

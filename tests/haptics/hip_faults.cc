@@ -26,12 +26,8 @@ main(int argc, char **argv)
   initlog();
   using palpate::Utilities::Point3;
 
-  palpate::Scene scene                 = shipped_scene("beam.prm");
+  palpate::Scene scene                 = small_beam_scene();
   auto          &p                     = scene.parameters;
-  p.state_space.grid_spacing           = 0.002;
-  p.state_space.extent                 = 0.006;
-  p.scheduler.cloud_radius             = 0.0045;
-  p.engine.workers                     = 2;
   p.material_model.stvk_youngs_modulus = 1e6;
   palpate::Interaction interaction(scene);
   const Point3         inside{{0.0005, -0.0003, -0.0015}};
@@ -45,8 +41,7 @@ main(int argc, char **argv)
   Point3       last{{0, 0, 0}};
   const auto   call = [&](const Point3 &x) {
     const Point3 f = interaction.force(x);
-    finite         = finite && std::isfinite(f[0]) && std::isfinite(f[1]) &&
-             std::isfinite(f[2]);
+    finite         = finite && all_finite(f);
     smooth =
       smooth && palpate::Utilities::distance(f, last) <= step * (1 + 1e-12);
     last = f;

@@ -104,12 +104,8 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene                 = shipped_scene("beam.prm");
+  palpate::Scene scene                 = small_beam_scene();
   auto          &p                     = scene.parameters;
-  p.state_space.grid_spacing           = 0.002;
-  p.state_space.extent                 = 0.006;
-  p.scheduler.cloud_radius             = 0.0045;
-  p.engine.workers                     = 2;
   p.haptics.force_limit                = 10;
   p.haptics.max_force_change           = 1e-3;
   p.material_model.stvk_youngs_modulus = 1e6;

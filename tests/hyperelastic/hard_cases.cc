@@ -43,9 +43,8 @@ namespace
       palpate::NodeSelection::create(scene, mesh);
     palpate::StateSolver solver(mesh, nodes, scene.parameters);
     const palpate::State s      = solver.solve(solver.rest_state(), target);
-    const bool           finite = std::isfinite(s.force[0]) &&
-                        std::isfinite(s.force[1]) && std::isfinite(s.force[2]);
-    const bool safe =
+    const bool           finite = all_finite(s.force);
+    const bool           safe =
       finite && (s.converged || palpate::Utilities::norm(s.force) == 0);
     ++n_cases;
     n_unsafe += !safe;

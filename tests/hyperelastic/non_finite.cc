@@ -26,8 +26,7 @@ namespace
   void
   report(const std::string &what, const palpate::State &s)
   {
-    const bool finite = std::isfinite(s.force[0]) &&
-                        std::isfinite(s.force[1]) && std::isfinite(s.force[2]);
+    const bool finite = all_finite(s.force);
     deallog << what << ": " << (s.converged ? "converged" : "failure point")
             << " (" << palpate::to_string(s.status) << "), force "
             << (finite ? "finite" : "NOT FINITE") << std::endl;

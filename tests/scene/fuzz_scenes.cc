@@ -268,9 +268,7 @@ main(int argc, char **argv)
                       const palpate::State s =
                         solver.solve(solver.rest_state(), target);
                       c.converged += s.converged;
-                      if (s.converged && !(std::isfinite(s.force[0]) &&
-                                           std::isfinite(s.force[1]) &&
-                                           std::isfinite(s.force[2])))
+                      if (s.converged && !(all_finite(s.force)))
                         {
                           ++c.non_finite;
                           std::lock_guard<std::mutex> lock(log_mutex);
