@@ -214,7 +214,10 @@ main(int argc, char **argv)
   std::cout << "failure-points: " << n
             << " random targets in the 10 cm ball on liver501, from rest "
                "(increments <= 1 cm, "
-            << (cutbacks >= 0 ? std::to_string(cutbacks) : std::string("0"))
+            << (cutbacks >= 0 ?
+                  std::to_string(cutbacks) :
+                  std::to_string(scene_for(configurations[0])
+                                   .parameters.nonlinear_solver.max_cutbacks))
             << " cutbacks)\nmachine: " << machine() << "\n\n";
 
   // Two configurations at a time, each in its own process (this program

@@ -725,7 +725,7 @@ namespace palpate
             return true;
           }
         x = saved;
-        if (depth < s.max_cutbacks)
+        if (depth < s.max_cutbacks && o.status != SolveStatus::inverted_element)
           {
             const double middle = 0.5 * (t0 + t1);
             return increment(t0, middle, depth + 1) &&
