@@ -8,7 +8,9 @@
 #ifndef palpate_tests_mesh_writers_h
 #define palpate_tests_mesh_writers_h
 
+#include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh_file.h>
+#include <palpate/scene/scene.h>
 
 #include <zlib.h>
 
@@ -229,6 +231,18 @@ namespace
       f << "<AppendedData encoding=\"raw\">\n_" << appended
         << "\n</AppendedData>\n";
     f << "</VTKFile>\n";
+  }
+  /** The default beam with 4 x 2 x 2 blocks (45 nodes, 80 tetrahedra):
+   * the mesh the format tests write and read back. */
+  MeshData
+  small_beam()
+  {
+    palpate::Scene scene;
+    auto          &p           = scene.parameters.mesh;
+    p.beam_subdivisions_length = 4;
+    p.beam_subdivisions_width  = 2;
+    p.beam_subdivisions_height = 2;
+    return palpate::generate_beam(p);
   }
 } // namespace
 

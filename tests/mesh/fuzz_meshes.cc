@@ -112,11 +112,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene;
-  auto          &p           = scene.parameters.mesh;
-  p.beam_subdivisions_length = 4, p.beam_subdivisions_width = 2,
-  p.beam_subdivisions_height   = 2;
-  const palpate::MeshData beam = palpate::generate_beam(p);
+  const palpate::MeshData beam = small_beam();
   write_gmsh(beam, "beam22.msh", false);
   write_gmsh(beam, "beam1.msh", true);
   write_vtk(beam, "beam30.vtk", false);

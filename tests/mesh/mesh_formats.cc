@@ -34,11 +34,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene;
-  auto          &p           = scene.parameters.mesh;
-  p.beam_subdivisions_length = 4, p.beam_subdivisions_width = 2,
-  p.beam_subdivisions_height   = 2;
-  const MeshData      original = palpate::generate_beam(p);
+  const MeshData      original = small_beam();
   const palpate::Mesh reference(original, 1.0, "beam");
   deallog << "original: " << reference.n_vertices() << " nodes, "
           << reference.n_cells() << " tetrahedra, volume " << reference.volume()
