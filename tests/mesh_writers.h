@@ -244,6 +244,29 @@ namespace
     p.beam_subdivisions_height = 2;
     return palpate::generate_beam(p);
   }
+  /** Write @p d in every format palpate reads (Gmsh 2.2 and 1, VTK
+   * classic and 5.1, VTU ascii / base64 / zlib / appended) as NAME.EXT
+   * files; their names, in that order. */
+  std::vector<std::string>
+  write_every_format(const MeshData &d)
+  {
+    write_gmsh(d, "beam22.msh", false);
+    write_gmsh(d, "beam1.msh", true);
+    write_vtk(d, "beam30.vtk", false);
+    write_vtk(d, "beam51.vtk", true);
+    write_vtu(d, "beam-ascii.vtu", Vtu::ascii);
+    write_vtu(d, "beam-base64.vtu", Vtu::base64);
+    write_vtu(d, "beam-zlib.vtu", Vtu::zlib);
+    write_vtu(d, "beam-appended.vtu", Vtu::appended);
+    return {"beam22.msh",
+            "beam1.msh",
+            "beam30.vtk",
+            "beam51.vtk",
+            "beam-ascii.vtu",
+            "beam-base64.vtu",
+            "beam-zlib.vtu",
+            "beam-appended.vtu"};
+  }
 } // namespace
 
 #endif

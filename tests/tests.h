@@ -25,6 +25,8 @@
 #include <iomanip>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 using dealii::deallog;
 
@@ -105,6 +107,18 @@ small_beam_scene()
   p.scheduler.cloud_radius   = 0.0045;
   p.engine.workers           = 2;
   return scene;
+}
+
+/** Every direct solver and ordering palpate offers, for the solver tests. */
+inline std::vector<std::pair<std::string, std::string>>
+every_linear_solver()
+{
+  return {{"MUMPS", "METIS"},
+          {"MUMPS", "AMD"},
+          {"UMFPACK", "METIS"},
+          {"KLU", "METIS"},
+          {"Amesos MUMPS", "METIS"},
+          {"Amesos KLU", "METIS"}};
 }
 
 /** Whether every component of @p f is finite. */

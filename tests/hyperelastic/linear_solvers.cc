@@ -17,14 +17,7 @@ main(int argc, char **argv)
   initlog();
 
   palpate::State reference;
-  for (const auto &[solver_name, ordering] :
-       std::vector<std::pair<std::string, std::string>>{
-         {"MUMPS", "METIS"},
-         {"MUMPS", "AMD"},
-         {"UMFPACK", "METIS"},
-         {"KLU", "METIS"},
-         {"Amesos MUMPS", "METIS"},
-         {"Amesos KLU", "METIS"}})
+  for (const auto &[solver_name, ordering] : every_linear_solver())
     {
       palpate::Scene scene                    = shipped_scene("liver-stvk.prm");
       scene.parameters.linear_solver.solver   = solver_name;

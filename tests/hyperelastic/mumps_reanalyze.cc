@@ -152,14 +152,7 @@ main(int argc, char **argv)
 
   // The patterns outlive the solvers (LinearSolver::analyze keeps them).
   const System first = tridiagonal(6), second = five_point(4);
-  for (const auto &[name, ordering] :
-       std::vector<std::pair<std::string, std::string>>{
-         {"MUMPS", "METIS"},
-         {"MUMPS", "AMD"},
-         {"UMFPACK", "METIS"},
-         {"KLU", "METIS"},
-         {"Amesos MUMPS", "METIS"},
-         {"Amesos KLU", "METIS"}})
+  for (const auto &[name, ordering] : every_linear_solver())
     {
       const auto solver = palpate::LinearSolver::create(name, ordering);
       deallog << name << " (" << ordering << ")" << std::endl;

@@ -112,26 +112,10 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  const palpate::MeshData beam = small_beam();
-  write_gmsh(beam, "beam22.msh", false);
-  write_gmsh(beam, "beam1.msh", true);
-  write_vtk(beam, "beam30.vtk", false);
-  write_vtk(beam, "beam51.vtk", true);
-  write_vtu(beam, "beam-ascii.vtu", Vtu::ascii);
-  write_vtu(beam, "beam-base64.vtu", Vtu::base64);
-  write_vtu(beam, "beam-zlib.vtu", Vtu::zlib);
-  write_vtu(beam, "beam-appended.vtu", Vtu::appended);
-  const std::vector<std::string> seeds = {
-    "beam22.msh",
-    "beam1.msh",
-    "beam30.vtk",
-    "beam51.vtk",
-    "beam-ascii.vtu",
-    "beam-base64.vtu",
-    "beam-zlib.vtu",
-    "beam-appended.vtu",
-    palpate_shared_dir + "/meshes/liver-tetgen/liver501.msh",
-    palpate_shared_dir + "/meshes/liver-tetgen/liver501.vtk"};
+  const palpate::MeshData  beam  = small_beam();
+  std::vector<std::string> seeds = write_every_format(beam);
+  seeds.push_back(palpate_shared_dir + "/meshes/liver-tetgen/liver501.msh");
+  seeds.push_back(palpate_shared_dir + "/meshes/liver-tetgen/liver501.vtk");
 
   std::mt19937       rng(20261123);
   const unsigned int per_seed    = 600;

@@ -40,14 +40,7 @@ main(int argc, char **argv)
           << reference.n_cells() << " tetrahedra, volume " << reference.volume()
           << " m^3" << std::endl;
 
-  write_gmsh(original, "beam22.msh", false);
-  write_gmsh(original, "beam1.msh", true);
-  write_vtk(original, "beam30.vtk", false);
-  write_vtk(original, "beam51.vtk", true);
-  write_vtu(original, "beam-ascii.vtu", Vtu::ascii);
-  write_vtu(original, "beam-base64.vtu", Vtu::base64);
-  write_vtu(original, "beam-zlib.vtu", Vtu::zlib);
-  write_vtu(original, "beam-appended.vtu", Vtu::appended);
+  write_every_format(original);
   {
     std::ofstream f("beam-dealii.vtu");
     dealii::GridOut().write_vtu(reference.triangulation(), f);
