@@ -73,8 +73,15 @@ namespace palpate
           << Utilities::to_string(Utilities::norm(state.force), 5) << " N\n";
     else
       out << "  FAILURE POINT:  " << to_string(state.status) << ": "
-          << state.message
-          << "\n  (no force is reported for a failure point)\n";
+          << state.message << "\n  (no force is reported for a failure point)\n"
+          << (state.status == SolveStatus::inverted_element &&
+                  scene.parameters.material_model.model_name ==
+                    "St.Venant-Kirchhoff" ?
+                "  hint:           St.Venant-Kirchhoff collapses under deep "
+                "compression (its energy stays finite as an element "
+                "flattens); Neo-Hookean or Mooney-Rivlin reach much further "
+                "(doc/benchmarks/failure-points.md)\n" :
+                "");
 
     if (!solver.linear_solver_statistics().empty())
       out << "  factorisation:  " << solver.linear_solver_statistics() << "\n";
