@@ -720,6 +720,14 @@ namespace palpate
 
 
 
+  unsigned int
+  HyperelasticSystem::n_active_multipliers() const
+  {
+    return impl->n_active_multipliers;
+  }
+
+
+
   const SparsityCSR &
   HyperelasticSystem::sparsity() const
   {

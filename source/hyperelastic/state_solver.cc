@@ -177,6 +177,9 @@ namespace palpate
          const Parameters::AllParameters &p)
       : settings(p.nonlinear_solver)
     {
+      settings.compute_stiffness =
+        settings.compute_stiffness ||
+        p.state_space.interpolation == "tricubic Hermite";
       const auto start = Clock::now();
       system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
       linear_solver =
@@ -251,9 +254,87 @@ namespace palpate
     // Whether the linear solver holds a factorisation (of the tangent of
     // an earlier Newton step, in this state or an earlier one), and the
     // Krylov bases of GMRES.
-    bool                             factorized = false;
+    bool factorized = false;
+    // Whether that factorisation is of the tangent in matrix.
+    bool                             factorized_current = false;
     std::vector<std::vector<double>> krylov_v, krylov_z;
+
+    /**
+     * The active-node stiffness of a converged @p state, from its tangent
+     * (in matrix). Moving
+     * the probe's target by dg changes the constraint residual by
+     * -beta dg, so K dx = beta dg at the probe's constraint rows gives the
+     * change of the multipliers, and -df/dg is the stiffness: three solves
+     * with the factorisation (direct if it is of this tangent, else GMRES
+     * preconditioned by it, else a new factorisation). False if the linear
+     * solver fails.
+     */
+    bool
+    active_stiffness(State &state);
   };
+
+
+
+  bool
+  StateSolver::Impl::active_stiffness(State &state)
+  {
+    const unsigned int n_eq  = system->n_equations();
+    const unsigned int first = n_eq - system->n_multipliers();
+    const unsigned int n_act = system->n_active_multipliers();
+    const double       beta  = system->constraint_scale();
+    if (n_act == 0 || matrix.empty())
+      return false;
+    std::vector<double> rhs;
+    const auto          fill = [&](const unsigned int j) {
+      rhs.assign(n_eq, 0.0);
+      for (unsigned int m = j; m < n_act; m += 3)
+        rhs[first + m] = beta;
+    };
+    for (unsigned int j = 0; j < 3; ++j)
+      {
+        fill(j);
+        bool solved = false;
+        if (factorized_current)
+          solved = linear_solver->solve(rhs);
+        else if (factorized)
+          {
+            solved = gmres(
+                       system->sparsity(),
+                       matrix,
+                       [this](std::vector<double> &v) {
+                         return linear_solver->solve(v);
+                       },
+                       rhs,
+                       1e-10,
+                       std::max(30u, settings.max_krylov_iterations),
+                       krylov_v,
+                       krylov_z) > 0;
+            if (!solved)
+              fill(j);
+          }
+        if (!solved)
+          {
+            factorized = factorized_current = false;
+            if (!linear_solver->factorize(matrix))
+              return false;
+            factorized = factorized_current = true;
+            solved                          = linear_solver->solve(rhs);
+          }
+        if (!solved)
+          return false;
+        for (unsigned int i = 0; i < 3; ++i)
+          {
+            double df = 0;
+            for (unsigned int m = i; m < n_act; m += 3)
+              df += beta * rhs[first + m];
+            state.stiffness[3 * i + j] = -df;
+          }
+      }
+    for (const double k : state.stiffness)
+      if (!std::isfinite(k))
+        return false;
+    return true;
+  }
 
 
 
@@ -265,7 +346,8 @@ namespace palpate
     Outcome outcome;
     double  scale = 0;
 
-    auto start = Clock::now();
+    auto start         = Clock::now();
+    factorized_current = false;
     if (!system->assemble(x, target, residual, &matrix, &scale))
       {
         // The starting state is a converged neighbour, so this is only
@@ -360,7 +442,8 @@ namespace palpate
           }
         if (record.factorized)
           {
-            factorized = false;
+            factorized         = false;
+            factorized_current = false;
             if (!linear_solver->factorize(matrix) ||
                 !linear_solver->solve(step))
               {
@@ -369,7 +452,8 @@ namespace palpate
                 outcome.message    = linear_solver->message();
                 return outcome;
               }
-            factorized = true;
+            factorized         = true;
+            factorized_current = true;
           }
         record.solve_time = seconds_since(start);
 
@@ -503,7 +587,8 @@ namespace palpate
             outcome.iterations = iteration + 1;
             return outcome;
           }
-        start = Clock::now();
+        start              = Clock::now();
+        factorized_current = false;
         if (!system->assemble(x, target, residual, &matrix, &scale))
           {
             outcome.status     = SolveStatus::not_finite;
@@ -533,8 +618,16 @@ namespace palpate
   State
   StateSolver::rest_state() const
   {
-    State state;
-    impl->system->to_state(impl->system->rest_unknowns(), state);
+    State                     state;
+    const std::vector<double> x = impl->system->rest_unknowns();
+    impl->system->to_state(x, state);
+    if (impl->settings.compute_stiffness &&
+        impl->system->assemble(
+          x, state.active_displacement, impl->residual, &impl->matrix))
+      {
+        impl->factorized_current = false;
+        state.has_stiffness      = impl->active_stiffness(state);
+      }
     return state;
   }
 
@@ -760,6 +853,14 @@ namespace palpate
         state.status    = failure.status;
         state.message   = failure.message;
         state.force     = {{0, 0, 0}};
+      }
+    else if (impl->settings.compute_stiffness &&
+             impl->system->assemble(x, target, impl->residual, &impl->matrix))
+      {
+        // The tangent at the converged state itself (the last Newton
+        // step's is one iterate behind: 1e-4 off in the stiffness).
+        impl->factorized_current = false;
+        state.has_stiffness      = impl->active_stiffness(state);
       }
     state.wall_time = seconds_since(start);
     return state;

@@ -752,6 +752,18 @@ namespace palpate
                           Patterns::Double(0.),
                           "Half-width of the grid along each axis, centred "
                           "on the active node's rest position (m).");
+        prm.declare_entry(
+          "Interpolation",
+          "trilinear",
+          Patterns::Selection("trilinear|tricubic Hermite"),
+          "How the haptic loop interpolates the force between grid points. "
+          "trilinear: the paper's, from the 8 corners' forces; continuous, "
+          "but the stiffness the hand feels jumps at every cell face. "
+          "tricubic Hermite: from the corners' forces and active-node "
+          "stiffnesses (three extra solves per state with the kept "
+          "factorisation) and the neighbours' stiffnesses; the force and "
+          "the stiffness are continuous, so a coarser grid gives the same "
+          "accuracy (doc/accuracy-vs-time.md).");
       }
       prm.leave_subsection();
     }
@@ -765,6 +777,7 @@ namespace palpate
       {
         grid_spacing = prm.get_double("Grid spacing");
         extent       = prm.get_double("Extent");
+        interpolation = prm.get("Interpolation");
       }
       prm.leave_subsection();
     }

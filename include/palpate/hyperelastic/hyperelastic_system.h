@@ -90,6 +90,11 @@ namespace palpate
     unsigned int
     n_multipliers() const;
 
+    /** Number of the probe's multipliers (3 per tip node; the first
+     * multipliers; 0 without an active node). */
+    unsigned int
+    n_active_multipliers() const;
+
     /** The fixed sparsity pattern of the tangent. */
     const SparsityCSR &
     sparsity() const;

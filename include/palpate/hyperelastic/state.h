@@ -6,6 +6,7 @@
 
 #include <palpate/base/utilities.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,17 @@ namespace palpate
      * device renders.
      */
     Utilities::Point3 force = {{0, 0, 0}};
+
+    /**
+     * The active-node stiffness K = -df/dx (N/m, row-major 3x3, K[3 i + j]
+     * = -d force_i / d x_j), the Schur complement of the converged tangent
+     * on the probe's constraint: how the force changes when the probe
+     * moves. Symmetric, as the force is the gradient of the strain energy.
+     * Computed only when asked for (tricubic Hermite interpolation needs
+     * it): valid if has_stiffness.
+     */
+    std::array<double, 9> stiffness = {};
+    bool                  has_stiffness = false;
 
     /** Nodal solution in deal.II DoF order (displacements, m). */
     std::vector<double> solution;

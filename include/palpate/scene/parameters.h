@@ -193,6 +193,9 @@ namespace palpate
        * max_krylov_iterations. */
       bool         reuse_factorization;
       unsigned int max_krylov_iterations;
+      /** Compute the active-node stiffness of every converged state (not an
+       * entry: on when State space / Interpolation needs it). */
+      bool compute_stiffness = false;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
@@ -222,6 +225,10 @@ namespace palpate
       double grid_spacing;
       /** Half-width of the grid along each axis, metres. */
       double extent;
+      /** How the haptic loop interpolates the force between grid points:
+       * "trilinear" (the paper's, C0) or "tricubic Hermite" (C1, from the
+       * corners' forces and stiffnesses). */
+      std::string interpolation;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);

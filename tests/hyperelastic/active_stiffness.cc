@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The active-node stiffness K = -df/dx of a converged state (three solves
+// with the tangent's factorisation), against central finite differences of
+// the force: K e_j = -(f(x + e e_j) - f(x - e e_j)) / 2e, each force a full
+// Newton solve from the state, e = 10 micrometres (truncation e^2 K'' is
+// far below the tolerance). On liver501, 1 cm into the liver from rest,
+// for StVK, neo-Hookean and Mooney-Rivlin (P1-P1, pressure multipliers),
+// with exact Newton steps and with factorisation reuse (GMRES), and at
+// rest; and for a rigid tip of three nodes on the beam. K must agree with
+// the differences to 1e-5 of its largest entry and be symmetric to 1e-7
+// (the force is the gradient of the strain energy), and positive definite.
+
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/state_solver.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+
+#include <cmath>
+
+#include "../tests.h"
+
+namespace
+{
+  void
+  check(const std::string                &name,
+        palpate::Scene                    scene,
+        const palpate::Utilities::Point3 &target,
+        const bool                        reuse)
+  {
+    auto &p                                = scene.parameters;
+    p.nonlinear_solver.reuse_factorization = reuse;
+    p.state_space.interpolation            = "tricubic Hermite";
+    const palpate::Mesh          mesh      = palpate::Mesh::create(scene);
+    const palpate::NodeSelection nodes =
+      palpate::NodeSelection::create(scene, mesh);
+    palpate::StateSolver solver(mesh, nodes, p);
+    const palpate::State rest = solver.rest_state();
+    const palpate::State s    = solver.solve(rest, target);
+    deallog << name << (reuse ? ", reuse" : ", exact steps") << ": "
+            << (s.converged && s.has_stiffness ? "converged" : "FAILED");
+    if (!s.converged || !s.has_stiffness)
+      {
+        deallog << std::endl;
+        return;
+      }
+    const double e       = 1e-5;
+    double       largest = 0, diff = 0, asym = 0;
+    for (const double k : s.stiffness)
+      largest = std::max(largest, std::abs(k));
+    for (unsigned int j = 0; j < 3; ++j)
+      {
+        auto plus = target, minus = target;
+        plus[j] += e;
+        minus[j] -= e;
+        const palpate::State a = solver.solve(s, plus);
+        const palpate::State b = solver.solve(s, minus);
+        for (unsigned int i = 0; i < 3; ++i)
+          {
+            const double fd = -(a.force[i] - b.force[i]) / (2 * e);
+            diff = std::max(diff, std::abs(fd - s.stiffness[3 * i + j]));
+            asym = std::max(asym,
+                            std::abs(s.stiffness[3 * i + j] -
+                                     s.stiffness[3 * j + i]));
+          }
+      }
+    // Positive definite: the leading minors of the symmetric part.
+    const auto  &K  = s.stiffness;
+    const double m1 = K[0], m2 = K[0] * K[4] - K[1] * K[3];
+    const double m3 = K[0] * (K[4] * K[8] - K[5] * K[7]) -
+                      K[1] * (K[3] * K[8] - K[5] * K[6]) +
+                      K[2] * (K[3] * K[7] - K[4] * K[6]);
+    deallog << ", |K| = " << palpate::Utilities::to_string(largest, 2)
+            << " N/m; against differences "
+            << (diff <= 1e-5 * largest ? "ok" : "WRONG") << ", symmetric "
+            << (asym <= 1e-7 * largest ? "ok" : "NO") << ", positive definite "
+            << (m1 > 0 && m2 > 0 && m3 > 0 ? "yes" : "NO") << std::endl;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  const palpate::Utilities::Point3 push    = {{0, 0, -0.01}};
+  const palpate::Utilities::Point3 at_rest = {{0, 0, 0}};
+  for (const bool reuse : {false, true})
+    {
+      check("liver501 StVK", shipped_scene("liver-stvk.prm"), push, reuse);
+      palpate::Scene nh                       = shipped_scene("liver-stvk.prm");
+      nh.parameters.material_model.model_name = "Neo-Hookean";
+      check("liver501 neo-Hookean", nh, push, reuse);
+      check("liver501 Mooney-Rivlin",
+            shipped_scene("liver-mooney-rivlin.prm"),
+            push,
+            reuse);
+    }
+  check("liver501 StVK at rest",
+        shipped_scene("liver-stvk.prm"),
+        at_rest,
+        false);
+  palpate::Scene tip = shipped_scene("beam.prm");
+  tip.parameters.boundary_conditions.active_node.tip_radius = 0.011;
+  check("beam, tip", tip, {{0.004, 0.002, -0.003}}, false);
+}
