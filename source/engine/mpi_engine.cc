@@ -174,6 +174,9 @@ namespace palpate
     const unsigned int        origin;
     std::vector<Server>       servers; // by rank; [0] unused
     std::string               linear_solver;
+    // The rest state's stiffness, from the servers' ready messages.
+    std::array<double, 9> rest_stiffness     = {};
+    bool                  has_rest_stiffness = false;
 
     // Which servers hold the whole state of each point (bit r-1 for rank
     // r), and which server computes it (its rank, or 0).
@@ -226,6 +229,11 @@ namespace palpate
             servers[from].ready      = true;
             servers[from].last_heard = Clock::now();
             linear_solver            = h.text;
+            if (h.flags & Flags::stiffness)
+              {
+                std::copy(h.stiffness, h.stiffness + 9, rest_stiffness.begin());
+                has_rest_stiffness = true;
+              }
             ++ready;
           }
         else if (Clock::now() > deadline)
@@ -338,9 +346,13 @@ namespace palpate
             else if (converged)
               {
                 holders[h.point] |= bit(from);
+                std::array<double, 9> stiffness;
+                std::copy(h.stiffness, h.stiffness + 9, stiffness.begin());
                 cache.publish_force(h.point,
                                     {{h.force[0], h.force[1], h.force[2]}},
-                                    h.generation);
+                                    h.generation,
+                                    (h.flags & Flags::stiffness) ? &stiffness :
+                                                                   nullptr);
                 ++stats.computed;
               }
             else
@@ -659,7 +671,10 @@ namespace palpate
       return;
     // The rest state is known without computing: the origin of the grid.
     if (s.cache.status(s.origin) != PointStatus::available)
-      s.cache.publish_force(s.origin, {{0, 0, 0}}, s.cache.generation());
+      s.cache.publish_force(s.origin,
+                            {{0, 0, 0}},
+                            s.cache.generation(),
+                            s.has_rest_stiffness ? &s.rest_stiffness : nullptr);
     std::lock_guard<std::mutex> lock(s.mutex);
     s.nothing_to_plan = false;
     s.replan          = true;

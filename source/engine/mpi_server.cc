@@ -101,13 +101,22 @@ namespace palpate
 
     // Set up; a failure is reported to the client, which tells the user.
     std::unique_ptr<StateSolver> solver;
+    std::shared_ptr<const State> rest;
     {
       Header ready;
       ready.kind = Kind::ready;
       try
         {
           solver = std::make_unique<StateSolver>(mesh, nodes, p);
+          rest   = std::make_shared<const State>(solver->rest_state());
           ready.set_text(solver->linear_solver_name());
+          if (rest->has_stiffness)
+            {
+              // The client publishes the rest state itself.
+              ready.flags |= Flags::stiffness;
+              for (unsigned int d = 0; d < 9; ++d)
+                ready.stiffness[d] = rest->stiffness[d];
+            }
         }
       catch (const std::exception &e)
         {
@@ -121,7 +130,6 @@ namespace palpate
           return 1;
         }
     }
-    const auto rest = std::make_shared<const State>(solver->rest_state());
 
     Shared shared;
     // The whole state of point p if this server holds it (the rest state
@@ -236,6 +244,12 @@ namespace palpate
               result.flags |= Flags::converged;
               for (unsigned int d = 0; d < 3; ++d)
                 result.force[d] = state.force[d];
+              if (state.has_stiffness)
+                {
+                  result.flags |= Flags::stiffness;
+                  for (unsigned int d = 0; d < 9; ++d)
+                    result.stiffness[d] = state.stiffness[d];
+                }
               state.history.clear();
               state.history.shrink_to_fit();
               auto held = std::make_shared<const State>(std::move(state));

@@ -92,8 +92,10 @@ namespace palpate
     std::unique_ptr<std::atomic<std::uint8_t>[]> used;
 
     // Real-time state (touched by force() only).
-    ForceFilter       filter;
-    ForceHold         hold;
+    ForceFilter         filter;
+    ForceHold           hold;
+    const Interpolation interpolation =
+      interpolation_from_name(scene.parameters.state_space.interpolation);
     MissingCause      previous_cause = MissingCause::none;
     Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
     Clock::time_point previous_call;
@@ -206,12 +208,13 @@ namespace palpate
     s.previous_call = now;
     s.first_call    = false;
 
-    // Trilinear interpolation from the 8 corners, if all are there.
+    // Interpolation from the 8 corners (and, for Hermite, their
+    // neighbours' stiffnesses), if all corners are there.
     const bool  attached = s.is_attached.load(std::memory_order_relaxed);
     ForceSample sample;
     if (attached && finite)
       {
-        sample = interpolate_force(s.grid, s.cache, position);
+        sample = interpolate_force(s.grid, s.cache, position, s.interpolation);
         if (sample.hits > 0 || sample.complete)
           {
             s.corner_reads.fetch_add(8, std::memory_order_relaxed);
@@ -225,7 +228,7 @@ namespace palpate
     if (complete)
       {
         s.in_contact = true;
-        s.hold.update(position, sample, s.grid.spacing());
+        s.hold.update(position, sample);
       }
 
     // No force here, while in contact (from the first complete cell after

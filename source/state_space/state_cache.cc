@@ -20,7 +20,9 @@ namespace palpate
     std::atomic<std::uint32_t> sequence{0};
     std::atomic<std::uint64_t> generation{0};
     std::atomic<std::uint8_t>  status{0};
-    std::atomic<double>        force[3] = {};
+    std::atomic<double>        force[3]     = {};
+    std::atomic<double>        stiffness[9] = {};
+    std::atomic<bool>          has_stiffness{false};
     /** Whether the whole state is held (written under the mutex). */
     std::atomic<bool> held{false};
   };
@@ -46,16 +48,21 @@ namespace palpate
      */
     template <typename Entry>
     void
-    write_entry(Entry                   &e,
-                const Utilities::Point3 &force,
-                const PointStatus        status,
-                const std::uint64_t      generation)
+    write_entry(Entry                       &e,
+                const Utilities::Point3     &force,
+                const std::array<double, 9> *stiffness,
+                const PointStatus            status,
+                const std::uint64_t          generation)
     {
       const std::uint32_t s = e.sequence.load(std::memory_order_relaxed);
       e.sequence.store(s + 1, std::memory_order_relaxed);
       std::atomic_thread_fence(std::memory_order_release);
       for (unsigned int d = 0; d < 3; ++d)
         e.force[d].store(force[d], std::memory_order_relaxed);
+      if (stiffness != nullptr)
+        for (unsigned int d = 0; d < 9; ++d)
+          e.stiffness[d].store((*stiffness)[d], std::memory_order_relaxed);
+      e.has_stiffness.store(stiffness != nullptr, std::memory_order_relaxed);
       e.status.store(static_cast<std::uint8_t>(status),
                      std::memory_order_relaxed);
       e.generation.store(generation, std::memory_order_relaxed);
@@ -67,15 +74,18 @@ namespace palpate
      * real-time read miss it. */
     template <typename Entry>
     void
-    make_available(Entry                   &e,
-                   const Utilities::Point3 &force,
-                   const std::uint64_t      generation)
+    make_available(Entry                       &e,
+                   const Utilities::Point3     &force,
+                   const std::array<double, 9> *stiffness,
+                   const std::uint64_t          generation)
     {
       if (e.generation.load(std::memory_order_relaxed) == generation &&
           e.status.load(std::memory_order_relaxed) ==
-            static_cast<std::uint8_t>(PointStatus::available))
+            static_cast<std::uint8_t>(PointStatus::available) &&
+          (stiffness == nullptr ||
+           e.has_stiffness.load(std::memory_order_relaxed)))
         return;
-      write_entry(e, force, PointStatus::available, generation);
+      write_entry(e, force, stiffness, PointStatus::available, generation);
     }
   } // namespace
 
@@ -124,14 +134,15 @@ namespace palpate
 
 
   void
-  StateCache::publish_force(const unsigned int       point,
-                            const Utilities::Point3 &force,
-                            const std::uint64_t      generation)
+  StateCache::publish_force(const unsigned int           point,
+                            const Utilities::Point3     &force,
+                            const std::uint64_t          generation,
+                            const std::array<double, 9> *stiffness)
   {
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
-    make_available(entries[point], force, generation);
+    make_available(entries[point], force, stiffness, generation);
   }
 
 
@@ -161,7 +172,10 @@ namespace palpate
     // A point that is already available (a state recomputed because its
     // whole state had been dropped, or fetched from an MPI server whose
     // force arrived first) keeps its force.
-    make_available(e, state->force, generation);
+    make_available(e,
+                   state->force,
+                   state->has_stiffness ? &state->stiffness : nullptr,
+                   generation);
 
     if (!states[point])
       ++held;
@@ -206,7 +220,8 @@ namespace palpate
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
-    write_entry(entries[point], {{0, 0, 0}}, PointStatus::failed, generation);
+    write_entry(
+      entries[point], {{0, 0, 0}}, nullptr, PointStatus::failed, generation);
   }
 
 
@@ -262,6 +277,39 @@ namespace palpate
         status != static_cast<std::uint8_t>(PointStatus::available))
       return false;
     force = f;
+    return true;
+  }
+
+
+
+  bool
+  StateCache::read_force_and_stiffness(const unsigned int     point,
+                                       const std::uint64_t    generation_read,
+                                       Utilities::Point3     &force,
+                                       std::array<double, 9> &stiffness,
+                                       bool &has_stiffness) const noexcept
+  {
+    const Entry        &e  = entries[point];
+    const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
+    if (s1 & 1)
+      return false;
+    const auto        status     = e.status.load(std::memory_order_relaxed);
+    const auto        generation = e.generation.load(std::memory_order_relaxed);
+    const bool        has = e.has_stiffness.load(std::memory_order_relaxed);
+    Utilities::Point3 f;
+    for (unsigned int d = 0; d < 3; ++d)
+      f[d] = e.force[d].load(std::memory_order_relaxed);
+    std::array<double, 9> k;
+    for (unsigned int d = 0; d < 9; ++d)
+      k[d] = e.stiffness[d].load(std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (e.sequence.load(std::memory_order_relaxed) != s1 ||
+        generation != generation_read ||
+        status != static_cast<std::uint8_t>(PointStatus::available))
+      return false;
+    force         = f;
+    stiffness     = k;
+    has_stiffness = has;
     return true;
   }
 

@@ -70,6 +70,8 @@ namespace palpate
       /** result: the solve threw (text holds the message); ready: set-up
        * failed. */
       constexpr std::uint32_t error = 8;
+      /** result, ready: stiffness holds the active-node stiffness. */
+      constexpr std::uint32_t stiffness = 16;
     } // namespace Flags
 
     /** Every message starts with this header (plain bytes). */
@@ -87,6 +89,9 @@ namespace palpate
       double duration = 0, fetch_seconds = 0;
       /** result: the force on the probe (N). */
       double force[3] = {0, 0, 0};
+      /** result, and ready (of the rest state): the active-node stiffness
+       * (N/m), if flags has Flags::stiffness. */
+      double stiffness[9] = {};
       /** task: the active node's displacement at the target (m). */
       double position[3] = {0, 0, 0};
       /** The sender's counters so far (servers, in results and

@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 namespace palpate
 {
@@ -28,6 +29,21 @@ namespace palpate
     /** The position is outside the state space (or not finite). */
     outside = 3
   };
+
+  /** How forces are interpolated between grid points. */
+  enum class Interpolation : std::uint8_t
+  {
+    /** The paper's: the 8 corners' forces, trilinear (C0: the stiffness
+     * jumps at every cell face). */
+    trilinear,
+    /** Tricubic Hermite (C1): the 8 corners' forces, their active-node
+     * stiffnesses and cross derivatives from the neighbours' stiffnesses. */
+    hermite
+  };
+
+  /** The Interpolation named by a `State space / Interpolation` entry. */
+  Interpolation
+  interpolation_from_name(const std::string &name);
 
   /** What the interpolation found for one position. */
   struct ForceSample
@@ -58,6 +74,13 @@ namespace palpate
     unsigned int hits = 0;
     /** The corners' grid numbers (valid if hits > 0 or complete). */
     std::array<unsigned int, 8> corners = {};
+    /** Whether the force is tricubic Hermite (Hermite asked for and every
+     * corner had its stiffness); else trilinear. */
+    bool hermite = false;
+    /** The stiffness of the interpolated field at the position, K = -df/dx
+     * (N/m, row-major; valid if complete): for a device that renders a
+     * local model between ticks. */
+    std::array<double, 9> stiffness = {};
   };
 
   /**
@@ -71,13 +94,33 @@ namespace palpate
                     const Utilities::Point3 &x) noexcept;
 
   /**
-   * The stiffness -n . (df/dx) n (N/m) of the trilinear force field of the
-   * complete sample @p s along the unit vector @p n, on a grid of spacing
-   * @p h: how fast the force along n grows when the probe moves against n.
+   * The force at @p x by @p scheme. Tricubic Hermite is the tensor product
+   * of 1-D cubic Hermite interpolation: at each corner it takes the force,
+   * its first derivatives (minus the corner's active-node stiffness), the
+   * mixed second derivatives d2f/dxdy.. (central differences of the
+   * neighbours' stiffnesses along the other axis, one-sided where a
+   * neighbour is missing, zero where both are) and d3f/dxdydz (mixed
+   * central differences over the four diagonal neighbours, zero where one
+   * is missing). Every corner value depends on the corner alone, so the
+   * force and its derivative are continuous across cell faces (C1); with
+   * all neighbours it reproduces any force field of total degree 3
+   * exactly. A cell with a corner that has no stiffness is interpolated
+   * trilinearly. Reads the 4x4x4 block of grid points around the cell;
+   * real-time safe: lock-free reads, no allocation.
+   */
+  ForceSample
+  interpolate_force(const StateGrid         &grid,
+                    const StateCache        &cache,
+                    const Utilities::Point3 &x,
+                    const Interpolation      scheme) noexcept;
+
+  /**
+   * The stiffness n . K n = -n . (df/dx) n (N/m) of the interpolated force
+   * field of the complete sample @p s along the unit vector @p n: how fast
+   * the force along n grows when the probe moves against n.
    */
   double
   directional_stiffness(const ForceSample       &s,
-                        const double             h,
                         const Utilities::Point3 &n) noexcept;
 
   /**
@@ -98,11 +141,9 @@ namespace palpate
   class ForceHold
   {
   public:
-    /** Remember the complete sample @p s at @p x (grid spacing @p h). */
+    /** Remember the complete sample @p s at @p x. */
     void
-    update(const Utilities::Point3 &x,
-           const ForceSample       &s,
-           const double             h) noexcept
+    update(const Utilities::Point3 &x, const ForceSample &s) noexcept
     {
       const double magnitude = Utilities::norm(s.force);
       has_force              = magnitude > 1e-12;
@@ -112,7 +153,7 @@ namespace palpate
       size   = magnitude;
       for (unsigned int d = 0; d < 3; ++d)
         normal[d] = s.force[d] / magnitude;
-      const double k = directional_stiffness(s, h, normal);
+      const double k = directional_stiffness(s, normal);
       stiffness      = std::isfinite(k) ? std::max(0.0, k) : 0.0;
     }
 

@@ -7,6 +7,7 @@
 #include <palpate/base/utilities.h>
 #include <palpate/state_space/state_grid.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -77,9 +78,10 @@ namespace palpate
      * the MPI engine) and travels here only when state() asks for it.
      */
     void
-    publish_force(const unsigned int       point,
-                  const Utilities::Point3 &force,
-                  const std::uint64_t      generation);
+    publish_force(const unsigned int           point,
+                  const Utilities::Point3     &force,
+                  const std::uint64_t          generation,
+                  const std::array<double, 9> *stiffness = nullptr);
 
     /**
      * The available points whose whole state was asked for by state() but
@@ -124,6 +126,18 @@ namespace palpate
     read_force(const unsigned int  point,
                const std::uint64_t generation,
                Utilities::Point3  &force) const noexcept;
+
+    /**
+     * Real-time read of the force and the active-node stiffness at
+     * @p point, as read_force(); @p has_stiffness says whether the state
+     * came with its stiffness (@p stiffness is valid only then).
+     */
+    bool
+    read_force_and_stiffness(const unsigned int     point,
+                             const std::uint64_t    generation,
+                             Utilities::Point3     &force,
+                             std::array<double, 9> &stiffness,
+                             bool &has_stiffness) const noexcept;
 
     /** Number of available and of failed points in this generation. */
     std::pair<unsigned int, unsigned int>
