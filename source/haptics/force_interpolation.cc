@@ -96,14 +96,6 @@ namespace palpate
       }
     };
 
-    /** The grid points around a cell, as the Hermite interpolation reads
-     * them: block offsets -1..2 along each axis. */
-    struct Block
-    {
-      bool                  available[4][4][4];
-      std::array<double, 9> stiffness[4][4][4];
-      Utilities::Point3     force[4][4][4];
-    };
   } // namespace
 
 
@@ -118,122 +110,37 @@ namespace palpate
     if (scheme != Interpolation::hermite || !sample.complete)
       return sample;
 
-    GridIndex             lower;
-    std::array<double, 3> local;
-    grid.locate(x, lower, local);
     const std::uint64_t generation = cache.generation();
-    Block               b;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        for (int k = 0; k < 4; ++k)
-          {
-            // The block's 8 outer corners are never used.
-            const bool outer  = (i % 3 == 0) && (j % 3 == 0) && (k % 3 == 0);
-            const GridIndex g = {
-              {lower[0] + i - 1, lower[1] + j - 1, lower[2] + k - 1}};
-            bool has = false;
-            b.available[i][j][k] =
-              !outer && grid.contains(g) &&
-              cache.read_force_and_stiffness(grid.linear(g),
-                                             generation,
-                                             b.force[i][j][k],
-                                             b.stiffness[i][j][k],
-                                             has) &&
-              has;
-          }
-    // Every corner must have its stiffness (a corner's force may also
-    // have been rewritten since the trilinear read: use the block's).
-    for (unsigned int c = 0; c < 8; ++c)
-      if (!b.available[1 + (c & 1)][1 + ((c >> 1) & 1)][1 + ((c >> 2) & 1)])
-        return sample;
-
-    const double h = grid.spacing();
+    const double        h          = grid.spacing();
     // D[c][m][i]: derivative m (bits x, y, z: which directions) of force
-    // component i at corner c, in the cell's unit coordinates.
+    // component i at corner c, in the cell's unit coordinates (so scaled
+    // by h per derivative).
     double D[8][8][3];
     for (unsigned int c = 0; c < 8; ++c)
       {
-        const int  o[3] = {1 + int(c & 1),
-                           1 + int((c >> 1) & 1),
-                           1 + int((c >> 2) & 1)};
-        const auto at   = [&](const int dx, const int dy, const int dz) {
-          return b.available[o[0] + dx][o[1] + dy][o[2] + dz];
-        };
-        const auto K = [&](const int          dx,
-                           const int          dy,
-                           const int          dz,
-                           const unsigned int i,
-                           const unsigned int j) {
-          return b.stiffness[o[0] + dx][o[1] + dy][o[2] + dz][3 * i + j];
-        };
-        const auto shift = [](const unsigned int axis, const int s) {
-          std::array<int, 3> d = {{0, 0, 0}};
-          d[axis]              = s;
-          return d;
-        };
+        Utilities::Point3      f;
+        std::array<double, 9>  K;
+        std::array<double, 12> cross;
+        bool                   has = false;
+        if (!cache.read_force_and_stiffness(
+              sample.corners[c], generation, f, K, has) ||
+            !has || !cache.read_cross_derivatives(sample.corners[c], cross))
+          return sample; // trilinear this tick
+        sample.corner_forces[c] = f;
         for (unsigned int i = 0; i < 3; ++i)
           {
-            D[c][0][i] = b.force[o[0]][o[1]][o[2]][i];
-            for (unsigned int a = 0; a < 3; ++a)
-              D[c][1u << a][i] = -h * K(0, 0, 0, i, a);
-            // Mixed second derivatives: d/db of df/da (= -K_ia), and d/da
-            // of df/db, each by a central difference if both neighbours
-            // along the other axis are there, one-sided if one is.
-            for (unsigned int a = 0; a < 3; ++a)
-              for (unsigned int e = a + 1; e < 3; ++e)
-                {
-                  double       sum = 0;
-                  unsigned int n   = 0;
-                  for (const auto &[along, of] :
-                       {std::pair<unsigned, unsigned>(e, a), {a, e}})
-                    {
-                      const auto p = shift(along, 1), m = shift(along, -1);
-                      const bool up = at(p[0], p[1], p[2]),
-                                 dn = at(m[0], m[1], m[2]);
-                      // h^2 d/d(along) (-K_i,of).
-                      if (up && dn)
-                        sum += 0.5 * h *
-                               (K(m[0], m[1], m[2], i, of) -
-                                K(p[0], p[1], p[2], i, of));
-                      else if (up)
-                        sum +=
-                          h * (K(0, 0, 0, i, of) - K(p[0], p[1], p[2], i, of));
-                      else if (dn)
-                        sum +=
-                          h * (K(m[0], m[1], m[2], i, of) - K(0, 0, 0, i, of));
-                      n += up || dn;
-                    }
-                  D[c][(1u << a) | (1u << e)][i] = n > 0 ? sum / n : 0;
-                }
-            // d3f/dxdydz: mixed central differences of df/da over the
-            // other two axes, averaged over a.
-            double       sum = 0;
-            unsigned int n   = 0;
-            for (unsigned int a = 0; a < 3; ++a)
-              {
-                const unsigned int e1 = (a + 1) % 3, e2 = (a + 2) % 3;
-                double             mixed = 0;
-                bool               all   = true;
-                for (const int s1 : {-1, 1})
-                  for (const int s2 : {-1, 1})
-                    {
-                      std::array<int, 3> d = {{0, 0, 0}};
-                      d[e1]                = s1;
-                      d[e2]                = s2;
-                      all                  = all && at(d[0], d[1], d[2]);
-                      if (all)
-                        mixed += s1 * s2 * K(d[0], d[1], d[2], i, a);
-                    }
-                if (all)
-                  {
-                    sum += -0.25 * h * mixed;
-                    ++n;
-                  }
-              }
-            D[c][7][i] = n > 0 ? sum / n : 0;
+            D[c][0][i] = f[i];
+            D[c][1][i] = -h * K[3 * i + 0];
+            D[c][2][i] = -h * K[3 * i + 1];
+            D[c][4][i] = -h * K[3 * i + 2];
+            D[c][3][i] = h * h * cross[4 * i + 0]; // xy
+            D[c][5][i] = h * h * cross[4 * i + 1]; // xz
+            D[c][6][i] = h * h * cross[4 * i + 2]; // yz
+            D[c][7][i] = h * h * h * cross[4 * i + 3];
           }
       }
 
+    const auto        &local = sample.local;
     const HermiteBasis bx(local[0]), by(local[1]), bz(local[2]);
     Utilities::Point3  f{{0, 0, 0}};
     double             g[3][3] = {}; // g[i][j] = df_i/du_j
@@ -262,9 +169,6 @@ namespace palpate
     for (unsigned int i = 0; i < 3; ++i)
       for (unsigned int j = 0; j < 3; ++j)
         sample.stiffness[3 * i + j] = -g[i][j] / h;
-    for (unsigned int c = 0; c < 8; ++c)
-      sample.corner_forces[c] =
-        b.force[1 + (c & 1)][1 + ((c >> 1) & 1)][1 + ((c >> 2) & 1)];
     return sample;
   }
 

@@ -23,6 +23,9 @@ namespace palpate
     std::atomic<double>        force[3]     = {};
     std::atomic<double>        stiffness[9] = {};
     std::atomic<bool>          has_stiffness{false};
+    /** The cross derivatives (Hermite), behind their own sequence lock. */
+    std::atomic<std::uint32_t> cross_sequence{0};
+    std::atomic<double>        cross[12] = {};
     /** Whether the whole state is held (written under the mutex). */
     std::atomic<bool> held{false};
   };
@@ -143,6 +146,8 @@ namespace palpate
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
     make_available(entries[point], force, stiffness, generation);
+    if (stiffness != nullptr)
+      update_cross_around(point);
   }
 
 
@@ -176,6 +181,8 @@ namespace palpate
                    state->force,
                    state->has_stiffness ? &state->stiffness : nullptr,
                    generation);
+    if (state->has_stiffness)
+      update_cross_around(point);
 
     if (!states[point])
       ++held;
@@ -222,6 +229,140 @@ namespace palpate
       return;
     write_entry(
       entries[point], {{0, 0, 0}}, nullptr, PointStatus::failed, generation);
+  }
+
+
+
+  void
+  StateCache::update_cross(const unsigned int point)
+  {
+    const std::uint64_t generation =
+      current_generation.load(std::memory_order_relaxed);
+    const GridIndex g = grid.index(point);
+    // Whether the point at offset d has a stiffness (the caller holds the
+    // mutex: the only writer, so relaxed loads are consistent), and its
+    // stiffness.
+    const auto has = [&](const GridIndex &d) {
+      const GridIndex q = {{g[0] + d[0], g[1] + d[1], g[2] + d[2]}};
+      if (!grid.contains(q))
+        return false;
+      const Entry &e = entries[grid.linear(q)];
+      return e.generation.load(std::memory_order_relaxed) == generation &&
+             e.status.load(std::memory_order_relaxed) ==
+               static_cast<std::uint8_t>(PointStatus::available) &&
+             e.has_stiffness.load(std::memory_order_relaxed);
+    };
+    const auto K =
+      [&](const GridIndex &d, const unsigned int i, const unsigned int j) {
+        const GridIndex q = {{g[0] + d[0], g[1] + d[1], g[2] + d[2]}};
+        return entries[grid.linear(q)].stiffness[3 * i + j].load(
+          std::memory_order_relaxed);
+      };
+    const GridIndex here = {{0, 0, 0}};
+    if (!has(here))
+      return;
+    const double           h = grid.spacing();
+    std::array<double, 12> cross;
+    for (unsigned int i = 0; i < 3; ++i)
+      {
+        // d2f_i/(da db) for (a, b) = (x, y), (x, z), (y, z).
+        unsigned int slot = 0;
+        for (unsigned int a = 0; a < 3; ++a)
+          for (unsigned int b = a + 1; b < 3; ++b, ++slot)
+            {
+              double       sum = 0;
+              unsigned int n   = 0;
+              for (const auto &[along, of] :
+                   {std::pair<unsigned int, unsigned int>(b, a), {a, b}})
+                {
+                  GridIndex up = {{0, 0, 0}}, down = {{0, 0, 0}};
+                  up[along]           = 1;
+                  down[along]         = -1;
+                  const bool has_up   = has(up);
+                  const bool has_down = has(down);
+                  // d/d(along) of df_i/d(of) = -K_i,of.
+                  if (has_up && has_down)
+                    sum += (K(down, i, of) - K(up, i, of)) / (2 * h);
+                  else if (has_up)
+                    sum += (K(here, i, of) - K(up, i, of)) / h;
+                  else if (has_down)
+                    sum += (K(down, i, of) - K(here, i, of)) / h;
+                  n += has_up || has_down;
+                }
+              cross[4 * i + slot] = n > 0 ? sum / n : 0;
+            }
+        // d3f_i/dxdydz.
+        double       sum = 0;
+        unsigned int n   = 0;
+        for (unsigned int a = 0; a < 3; ++a)
+          {
+            const unsigned int e1 = (a + 1) % 3, e2 = (a + 2) % 3;
+            double             mixed = 0;
+            bool               all   = true;
+            for (const int s1 : {-1, 1})
+              for (const int s2 : {-1, 1})
+                {
+                  GridIndex d = {{0, 0, 0}};
+                  d[e1]       = s1;
+                  d[e2]       = s2;
+                  all         = all && has(d);
+                  if (all)
+                    mixed += s1 * s2 * K(d, i, a);
+                }
+            if (all)
+              {
+                sum += -mixed / (4 * h * h);
+                ++n;
+              }
+          }
+        cross[4 * i + 3] = n > 0 ? sum / n : 0;
+      }
+    Entry              &e = entries[point];
+    const std::uint32_t s = e.cross_sequence.load(std::memory_order_relaxed);
+    e.cross_sequence.store(s + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    for (unsigned int k = 0; k < 12; ++k)
+      e.cross[k].store(cross[k], std::memory_order_relaxed);
+    e.cross_sequence.store(s + 2, std::memory_order_release);
+  }
+
+
+
+  void
+  StateCache::update_cross_around(const unsigned int point)
+  {
+    const GridIndex g = grid.index(point);
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k)
+          {
+            const GridIndex q = {{g[0] + i, g[1] + j, g[2] + k}};
+            if (grid.contains(q))
+              update_cross(grid.linear(q));
+          }
+  }
+
+
+
+  bool
+  StateCache::read_cross_derivatives(
+    const unsigned int      point,
+    std::array<double, 12> &cross) const noexcept
+  {
+    const Entry &e = entries[point];
+    for (unsigned int attempt = 0; attempt < 4; ++attempt)
+      {
+        const std::uint32_t s1 =
+          e.cross_sequence.load(std::memory_order_acquire);
+        if (s1 & 1)
+          continue;
+        for (unsigned int k = 0; k < 12; ++k)
+          cross[k] = e.cross[k].load(std::memory_order_relaxed);
+        std::atomic_thread_fence(std::memory_order_acquire);
+        if (e.cross_sequence.load(std::memory_order_relaxed) == s1)
+          return true;
+      }
+    return false;
   }
 
 

@@ -139,6 +139,20 @@ namespace palpate
                              std::array<double, 9> &stiffness,
                              bool &has_stiffness) const noexcept;
 
+    /**
+     * The cross derivatives of the force at @p point, for tricubic Hermite
+     * interpolation: d2f_i/dxdy, d2f_i/dxdz, d2f_i/dydz (N/m^2) and
+     * d3f_i/dxdydz (N/m^3) as cross[4 i + m], estimated from the
+     * neighbours' stiffnesses (see update_cross()). The writer keeps them
+     * current as neighbours arrive, behind a sequence lock of their own (so
+     * that updating them never hides the point's force); a read that races
+     * with an update is retried a few times. Real-time safe. False if no
+     * consistent read was had.
+     */
+    bool
+    read_cross_derivatives(const unsigned int      point,
+                           std::array<double, 12> &cross) const noexcept;
+
     /** Number of available and of failed points in this generation. */
     std::pair<unsigned int, unsigned int>
     counts() const;
@@ -153,6 +167,25 @@ namespace palpate
 
   private:
     struct Entry;
+
+    /**
+     * Recompute the cross derivatives of @p point (if it is available with
+     * a stiffness) from its neighbours' stiffnesses in the current
+     * generation: mixed second derivatives d/db (df/da) = -dK_ia/db by
+     * central differences along b (one-sided where one neighbour is
+     * missing, zero where both are), averaged with d/da (df/db); the third
+     * by mixed central differences of -K_ia over the four diagonal
+     * neighbours in the other two axes, averaged over a (zero where none
+     * is complete). Each value depends on the point and what is known
+     * around it only, so every cell that shares a corner sees the same
+     * value: the interpolant stays C1. Called by the writer (mutex held).
+     */
+    void
+    update_cross(const unsigned int point);
+
+    /** update_cross() for @p point and its 26 neighbours. */
+    void
+    update_cross_around(const unsigned int point);
 
     const StateGrid                          &grid;
     std::unique_ptr<Entry[]>                  entries;
