@@ -5,6 +5,8 @@
 //                          [--spacing 5,10] [--workers 1,2]
 //                          [--engine threads|mpi|all] [--mesh liver2k]
 //                          [--length CM] [--no-studies]
+//                          [--interpolation trilinear|hermite]
+//                          [--tolerance 1e-8]
 //
 // The paper's headline experiment, measured: the largest speed at which the
 // HIP can move along a straight line, after the initial cloud, with zero
@@ -77,6 +79,10 @@ namespace
     std::string mesh    = "liver501";
     double      length  = 0.08; // m
     bool        studies = true;
+    /** State space / Interpolation, and the residual tolerance of the
+     * main table. */
+    std::string interpolation = "trilinear";
+    double      tolerance     = 1e-8;
   };
 
   /** One interaction at one speed. */
@@ -96,8 +102,9 @@ namespace
     double       spacing_mm;
     unsigned int workers;
     double       tolerance;
-    std::string  engine = "threads";
-    std::string  mesh   = "liver501";
+    std::string  engine        = "threads";
+    std::string  mesh          = "liver501";
+    std::string  interpolation = "trilinear";
   };
 
   const Point3 direction{{-1, 0, 0}};
@@ -118,12 +125,14 @@ namespace
     p.engine.workers                      = c.workers;
     p.engine.type                         = c.engine;
     p.nonlinear_solver.residual_tolerance = c.tolerance;
-    p.haptics.loop_rate                   = 1000;
-    p.haptics.trajectory.type             = "straight line";
-    p.haptics.trajectory.direction        = direction;
-    p.haptics.trajectory.start            = "after initial cloud";
-    p.effects.shape_output                = false;
-    p.effects.force_log                   = false;
+    p.state_space.interpolation =
+      c.interpolation == "hermite" ? "tricubic Hermite" : "trilinear";
+    p.haptics.loop_rate            = 1000;
+    p.haptics.trajectory.type      = "straight line";
+    p.haptics.trajectory.direction = direction;
+    p.haptics.trajectory.start     = "after initial cloud";
+    p.effects.shape_output         = false;
+    p.effects.force_log            = false;
     scene.validate();
     return scene;
   }
@@ -369,13 +378,23 @@ main(int argc, char **argv)
         o.length = 0.01 * std::stod(next());
       else if (a == "--no-studies")
         o.studies = false;
+      else if (a == "--interpolation")
+        {
+          o.interpolation = next();
+          if (o.interpolation != "trilinear" && o.interpolation != "hermite")
+            throw std::invalid_argument(
+              "--interpolation must be trilinear or hermite");
+        }
+      else if (a == "--tolerance")
+        o.tolerance = std::stod(next());
       else
         {
           std::cerr
             << "max-speed: unknown option " << a
             << "\nusage: benchmarks/run max-speed [--quick] [--material stvk|mr|all] "
                "[--spacing 5,10] [--workers 1,2] [--engine threads|mpi|all] "
-               "[--length CM] [--no-studies]\n";
+               "[--length CM] [--no-studies] [--interpolation "
+               "trilinear|hermite] [--tolerance 1e-8]\n";
           return 2;
         }
     }
@@ -423,7 +442,8 @@ main(int argc, char **argv)
         for (const unsigned int w :
              e == "mpi" ? std::vector<unsigned int>{2} : o.workers)
           {
-            const Configuration c{m, h, w, 1e-8, e, o.mesh};
+            const Configuration c{
+              m, h, w, o.tolerance, e, o.mesh, o.interpolation};
             std::cout << (m == "stvk" ? "St.Venant-Kirchhoff" :
                                         "Mooney-Rivlin (P1-P1)")
                       << ", h = " << h << " mm, " << w
@@ -486,6 +506,17 @@ main(int argc, char **argv)
               << " mesh=" << x.c.mesh << " h_mm=" << std::setprecision(0)
               << x.c.spacing_mm << " engine=" << x.c.engine
               << " workers=" << x.c.workers
+              << (x.c.interpolation != "trilinear" ?
+                    " interpolation=" + x.c.interpolation :
+                    std::string())
+              << (x.c.tolerance != 1e-8 ?
+                    [&] {
+                      std::ostringstream s;
+                      s << " residual_tolerance=" << std::scientific
+                        << std::setprecision(0) << x.c.tolerance << std::fixed;
+                      return s.str();
+                    }() :
+                    std::string())
               << " speed_mm_s=" << std::setprecision(1) << 1000 * x.t.speed
               << " state_ms=" << x.t.state_ms
               << " deadline_misses=" << x.t.deadline_misses

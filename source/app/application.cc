@@ -5,6 +5,7 @@
 #include <palpate/app/interaction_run.h>
 #include <palpate/app/scene_report.h>
 #include <palpate/app/static_solve.h>
+#include <palpate/app/study.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/engine/mpi_engine.h>
 #include <palpate/haptics/run_summary.h>
@@ -12,6 +13,7 @@
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -33,6 +35,13 @@ namespace palpate
       "                                  displaced by X,Y,Z metres from rest\n"
       "                                  (default: the scene's Prescribed\n"
       "                                  displacement) and print the force\n"
+      "  palpate study SCENE.prm [--quick] [--samples N] [--finer-mesh FILE]\n"
+      "                [--csv FILE]\n"
+      "                                  what accuracy costs in time for this\n"
+      "                                  scene: grid spacing, interpolation,\n"
+      "                                  tolerance, staging, mesh and element\n"
+      "                                  against direct solves; recommends a\n"
+      "                                  setting (doc/accuracy-vs-time.md)\n"
       "  mpirun -np N palpate SCENE.prm  the same with Engine / Type = mpi:\n"
       "                                  rank 0 is the haptic client, ranks\n"
       "                                  1..N-1 are solver servers\n"
@@ -220,6 +229,70 @@ namespace palpate
                                "unexpected argument '" + args[i] + "'",
                                "run 'palpate --help' for the usage.");
           return run_scene(args[1], target, true, out);
+        }
+      if (args[0] == "study")
+        {
+          if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
+            throw InputError("command line",
+                             0,
+                             "study",
+                             "'study' needs a scene file",
+                             "run 'palpate study SCENE.prm [--quick]'.");
+          StudyOptions options;
+          for (unsigned int i = 2; i < args.size(); ++i)
+            {
+              const bool has_value = i + 1 < args.size();
+              if (args[i] == "--quick")
+                options.quick = true;
+              else if (args[i] == "--finer-mesh" && has_value)
+                options.finer_mesh = args[++i];
+              else if (args[i] == "--csv" && has_value)
+                options.csv_file = args[++i];
+              else if (args[i] == "--samples" && has_value)
+                {
+                  const std::string v   = args[++i];
+                  std::size_t       end = 0;
+                  long              n   = 0;
+                  try
+                    {
+                      n = std::stol(v, &end);
+                    }
+                  catch (const std::exception &)
+                    {
+                      end = 0;
+                    }
+                  if (end != v.size() || n < 8 || n > 5000)
+                    throw InputError("command line",
+                                     0,
+                                     "--samples " + v,
+                                     "the number of HIP positions must be a "
+                                     "whole number from 8 to 5000",
+                                     "e.g. --samples 240 (the default; 80 "
+                                     "with --quick).");
+                  options.samples = static_cast<unsigned int>(n);
+                }
+              else
+                throw InputError("command line",
+                                 0,
+                                 args[i],
+                                 "unexpected argument '" + args[i] + "'",
+                                 "run 'palpate --help' for the usage.");
+            }
+          if (!options.finer_mesh.empty() && !std::ifstream(options.finer_mesh))
+            throw InputError("command line",
+                             0,
+                             "--finer-mesh " + options.finer_mesh,
+                             "the mesh file '" + options.finer_mesh +
+                               "' cannot be read",
+                             "give a finer mesh of the same organ, in the "
+                             "scene's file unit (its Scale factor applies).");
+          const Scene         scene = Scene::read(args[1]);
+          const Mesh          mesh  = Mesh::create(scene);
+          const NodeSelection nodes = NodeSelection::create(scene, mesh);
+          print_scene_report(out, scene, mesh, nodes);
+          out << "\n";
+          run_study(out, scene, options);
+          return ExitStatus::success;
         }
       if (args.size() > 1)
         throw InputError("command line",

@@ -860,7 +860,11 @@ namespace palpate
         state.force     = {{0, 0, 0}};
       }
     else if (impl->settings.compute_stiffness)
-      state.has_stiffness = impl->active_stiffness(state);
+      {
+        const auto stiffness_start = Clock::now();
+        state.has_stiffness        = impl->active_stiffness(state);
+        state.stiffness_time       = seconds_since(stiffness_start);
+      }
     state.wall_time = seconds_since(start);
     return state;
   }

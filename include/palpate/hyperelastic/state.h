@@ -82,6 +82,8 @@ namespace palpate
      */
     std::array<double, 9> stiffness = {};
     bool                  has_stiffness = false;
+    /** Seconds of wall_time spent on the stiffness. */
+    double stiffness_time = 0;
 
     /** Nodal solution in deal.II DoF order (displacements, m). */
     std::vector<double> solution;

@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// benchmarks/run accuracy [--quick] [--material stvk|mr|all]
+//
+// What accuracy costs in time, on the liver scenes of parameters/: the
+// study of `palpate study` (source/app/study.cc) on liver-stvk.prm and
+// liver-mooney-rivlin.prm. One knob at a time from the scene's settings -
+// grid spacing (2.5, 5, 10, 20 mm) with trilinear and tricubic Hermite
+// interpolation, the Newton residual tolerance, the staging increment -
+// then the fastest passing grid setting with the loosest passing
+// tolerance; and the discretisation knobs (liver501 vs liver2k, P1 vs P2
+// or P1-P1 vs Taylor-Hood), with a point probe and a 25 mm tip. Accuracy:
+// the interpolated force against direct FE solves (tolerance 1e-10) at
+// 240 HIP positions on smooth random trajectories within 12 mm of rest.
+// Cost: time per state, states per cm of straight path, precomputation
+// time and memory of the visited region, implied straight-line speed.
+//
+// Targets (issue 12): the recommended liver501 StVK setting has
+// force_err_p95_pct <= 3.5 at speed_mm_s >= 150 with 2 workers; Hermite
+// at h = 10 mm is at least as accurate as trilinear at h = 5 mm.
+//
+// --quick: StVK only, 80 positions, fewer knob values (about 45 s).
+
+#include <palpate/app/study.h>
+#include <palpate/base/environment.h>
+#include <palpate/scene/scene.h>
+
+#include <iostream>
+#include <sstream>
+
+#include "machine.h"
+
+using namespace palpate;
+
+int
+main(int argc, char **argv)
+{
+  Environment env(argc, argv);
+  bool        quick    = false;
+  std::string material = "all";
+  for (int i = 1; i < argc; ++i)
+    {
+      const std::string a = argv[i];
+      if (a == "--quick")
+        quick = true;
+      else if (a == "--material" && i + 1 < argc)
+        material = argv[++i];
+      else
+        {
+          std::cerr << "usage: benchmarks/run accuracy [--quick] "
+                       "[--material stvk|mr|all]\n";
+          return 2;
+        }
+    }
+  if (quick && material == "all")
+    material = "stvk";
+  std::cout << "Accuracy against time; machine: " << machine() << "\n\n";
+
+  std::ostringstream results;
+  for (const std::string m : {"stvk", "mr"})
+    {
+      if (material != "all" && material != m)
+        continue;
+      const Scene scene = Scene::read(
+        std::string(PALPATE_SOURCE_DIR) + "/parameters/" +
+        (m == "stvk" ? "liver-stvk.prm" : "liver-mooney-rivlin.prm"));
+      StudyOptions options;
+      options.quick       = quick;
+      options.csv_file    = "accuracy-" + m + ".csv";
+      const StudyResult r = run_study(std::cout, scene, options);
+      std::cout << "\n";
+
+      const auto element = [&]() -> std::string {
+        return m == "mr" ?
+                 " element=" + scene.parameters.material_model.mr_element :
+                 "";
+      };
+      double hermite10 = -1, trilinear5 = -1;
+      for (unsigned int k = 0; k < r.rows.size(); ++k)
+        {
+          const StudyRow &row   = r.rows[k];
+          std::string     value = row.value;
+          for (char &c : value)
+            if (c == ' ')
+              c = '_';
+            else if (c == ',')
+              c = '+';
+          results << "RESULT accuracy"
+                  << (int(k) == r.recommended ? " recommended=yes" : "")
+                  << " material=" << r.material << element()
+                  << " knob=" << row.knob << " value=" << value
+                  << " interpolation=" << row.interpolation
+                  << (row.interpolation == "direct" ?
+                        " probe=" + std::string(row.probe == "point" ?
+                                                  "point" :
+                                                  "tip25mm") :
+                        "")
+                  << " h_mm=" << row.h_mm
+                  << " force_err_p95_pct=" << row.err_p95_pct
+                  << " force_err_max_N=" << row.err_max_N
+                  << " covered=" << row.covered << "/" << row.samples
+                  << " state_ms=" << row.state_ms
+                  << " speed_mm_s=" << row.speed_mm_s << "\n";
+          if (row.knob == "grid" && row.h_mm == 10 &&
+              row.interpolation == "Hermite")
+            hermite10 = row.err_p95_pct;
+          if (row.knob == "grid" && row.h_mm == 5 &&
+              row.interpolation == "trilinear")
+            trilinear5 = row.err_p95_pct;
+        }
+      if (r.recommended >= 0)
+        {
+          const StudyRow &row = r.rows[r.recommended];
+          results << "RESULT accuracy target material=" << r.material
+                  << " recommended_p95_pct=" << row.err_p95_pct
+                  << " recommended_speed_mm_s=" << row.speed_mm_s
+                  << " p95_target_met="
+                  << (row.err_p95_pct <= 3.5 ? "yes" : "no")
+                  << " speed_target_met="
+                  << (row.speed_mm_s >= 150 ? "yes" : "no")
+                  << " hermite10_p95_pct=" << hermite10
+                  << " trilinear5_p95_pct=" << trilinear5
+                  << " hermite10_as_accurate="
+                  << (hermite10 >= 0 && hermite10 <= trilinear5 ? "yes" : "no")
+                  << "\n";
+        }
+      else
+        results << "RESULT accuracy target material=" << r.material
+                << " recommended=none\n";
+    }
+  std::cout << results.str();
+}

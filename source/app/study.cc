@@ -1,0 +1,1084 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/app/study.h>
+#include <palpate/base/exceptions.h>
+#include <palpate/haptics/force_interpolation.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/state.h>
+#include <palpate/hyperelastic/state_solver.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <random>
+#include <set>
+#include <sstream>
+#include <thread>
+
+namespace palpate
+{
+  namespace
+  {
+    using Point3 = Utilities::Point3;
+    using Clock  = std::chrono::steady_clock;
+
+    /** Relative errors are taken against max(|f_ref|, this) (N): near
+     * rest a force of a few mN has no meaningful relative error. */
+    constexpr double force_floor = 0.1;
+
+    /**
+     * Two solvers on the two cores at once each run this much slower than
+     * one alone: they share the memory bandwidth (measured 12.5 -> 19 ms
+     * per StVK state on liver501, doc/benchmarks/scaling.md).
+     */
+    constexpr double two_solver_slowdown = 1.5;
+
+    double
+    seconds_since(const Clock::time_point start)
+    {
+      return std::chrono::duration<double>(Clock::now() - start).count();
+    }
+
+    double
+    percentile(std::vector<double> v, const double q)
+    {
+      if (v.empty())
+        return 0;
+      std::sort(v.begin(), v.end());
+      const double r = q * (v.size() - 1);
+      const auto   i = static_cast<std::size_t>(r);
+      return i + 1 < v.size() ? v[i] + (r - i) * (v[i + 1] - v[i]) : v[i];
+    }
+
+    std::string
+    fixed(const double x, const int digits)
+    {
+      std::ostringstream s;
+      s << std::fixed << std::setprecision(digits) << x;
+      return s.str();
+    }
+
+    /** A progress bar on stderr (a terminal), else a line per step. */
+    class Progress
+    {
+    public:
+      Progress(std::ostream &out, const bool enabled, const double total)
+        : out(out)
+        , enabled(enabled)
+        , terminal(isatty(2))
+        , total(total)
+        , start(Clock::now())
+      {}
+
+      void
+      step(const double amount, const std::string &what)
+      {
+        done += amount;
+        if (!enabled)
+          return;
+        const double      fraction = std::min(1.0, done / total);
+        const double      elapsed  = seconds_since(start);
+        const std::string eta      = fraction > 0.02 ?
+                                       ", about " +
+                                    std::to_string(static_cast<int>(std::ceil(
+                                      elapsed * (1 - fraction) / fraction))) +
+                                    " s left" :
+                                       "";
+        if (terminal)
+          {
+            const int width = 30, full = static_cast<int>(fraction * width);
+            std::cerr << "\r  [" << std::string(full, '#')
+                      << std::string(width - full, '.') << "] " << std::setw(3)
+                      << static_cast<int>(fraction * 100) << " %" << eta << "  "
+                      << what << "\033[K" << std::flush;
+          }
+        else if (what != last || fraction >= next_line)
+          {
+            // Not a terminal (a log): a line per step of the study, and
+            // every 10 %.
+            out << "  ... " << static_cast<int>(fraction * 100) << " %" << eta
+                << ": " << what << "\n"
+                << std::flush;
+            last      = what;
+            next_line = std::floor(fraction * 10 + 1) / 10;
+          }
+      }
+
+      void
+      finish()
+      {
+        if (enabled && terminal)
+          std::cerr << "\r\033[K" << std::flush;
+      }
+
+    private:
+      std::ostream     &out;
+      bool              enabled, terminal;
+      double            total, done = 0, next_line = 0;
+      std::string       last;
+      Clock::time_point start;
+    };
+
+    /**
+     * HIP positions along smooth random trajectories in the ball of
+     * @p radius around rest: Catmull-Rom splines through 5 random points,
+     * @p per_trajectory positions each, in order along the path.
+     */
+    std::vector<std::vector<Point3>>
+    trajectories(const unsigned int n,
+                 const unsigned int per_trajectory,
+                 const double       radius,
+                 const unsigned int seed)
+    {
+      std::mt19937                           rng(seed);
+      std::uniform_real_distribution<double> u(-1, 1);
+      const auto                             random_point = [&]() {
+        Point3 p;
+        do
+          p = {{u(rng), u(rng), u(rng)}};
+        while (Utilities::norm(p) > 1);
+        for (double &c : p)
+          c *= radius;
+        return p;
+      };
+      std::vector<std::vector<Point3>> result(n);
+      for (auto &path : result)
+        {
+          std::vector<Point3> c(5);
+          for (auto &p : c)
+            p = random_point();
+          // Catmull-Rom through c[1..3], with c[0] and c[4] as the ends'
+          // tangent guides.
+          for (unsigned int k = 0; k < per_trajectory; ++k)
+            {
+              const double       s = 2.0 * k / std::max(1u, per_trajectory - 1);
+              const unsigned int seg = std::min(1u, static_cast<unsigned>(s));
+              const double       t   = s - seg;
+              const Point3 &p0 = c[seg], &p1 = c[seg + 1], &p2 = c[seg + 2],
+                           &p3 = c[seg + 3];
+              Point3 x;
+              for (unsigned int d = 0; d < 3; ++d)
+                x[d] =
+                  0.5 * (2 * p1[d] + (-p0[d] + p2[d]) * t +
+                         (2 * p0[d] - 5 * p1[d] + 4 * p2[d] - p3[d]) * t * t +
+                         (-p0[d] + 3 * p1[d] - 3 * p2[d] + p3[d]) * t * t * t);
+              // Keep it in the ball.
+              const double r = Utilities::norm(x);
+              if (r > radius)
+                for (double &v : x)
+                  v *= radius / r;
+              path.push_back(x);
+            }
+        }
+      return result;
+    }
+
+    /** A HIP position and the direct FE solution there. */
+    struct Sample
+    {
+      Point3              x;
+      bool                ok = false;
+      Point3              force{{0, 0, 0}};
+      std::vector<double> solution;
+    };
+
+    /** The body of one discretisation: mesh, nodes and their solver's
+     * settings. */
+    struct Body
+    {
+      Scene         scene;
+      Mesh          mesh;
+      NodeSelection nodes;
+
+      explicit Body(const Scene &s)
+        : scene(s)
+        , mesh(Mesh::create(scene))
+        , nodes(NodeSelection::create(scene, mesh))
+      {}
+    };
+
+    /**
+     * Direct solves at @p x (in trajectory order: each from the last
+     * converged one of its trajectory, the first from rest), with the
+     * Newton tolerance tightened to @p tolerance.
+     */
+    std::vector<Sample>
+    direct_solves(const Body                             &body,
+                  const std::vector<std::vector<Point3>> &paths,
+                  const unsigned int                      limit,
+                  const double                            tolerance,
+                  std::vector<double>                    *state_times,
+                  Progress                               &progress,
+                  const double                            weight,
+                  const std::string                      &what)
+    {
+      auto p                                 = body.scene.parameters;
+      p.nonlinear_solver.residual_tolerance  = tolerance;
+      p.nonlinear_solver.reuse_factorization = false;
+      p.state_space.interpolation            = "trilinear";
+      StateSolver         solver(body.mesh, body.nodes, p);
+      const State         rest = solver.rest_state();
+      std::vector<Sample> samples;
+      for (const auto &path : paths)
+        {
+          State previous = rest;
+          for (const Point3 &x : path)
+            {
+              if (samples.size() == limit)
+                return samples;
+              Sample s;
+              s.x           = x;
+              const State a = solver.solve(previous, x);
+              s.ok          = a.converged;
+              if (a.converged)
+                {
+                  s.force    = a.force;
+                  s.solution = a.solution;
+                  previous   = a;
+                  if (state_times != nullptr)
+                    state_times->push_back(a.wall_time);
+                }
+              samples.push_back(std::move(s));
+              progress.step(weight, what);
+            }
+        }
+      return samples;
+    }
+
+    /** The grid states of one setting, computed as the engine computes
+     * them. */
+    struct GridStates
+    {
+      std::map<unsigned int, std::shared_ptr<const State>> states;
+      std::set<unsigned int>                               failed;
+      std::vector<double> times, stiffness_times;
+    };
+
+    /**
+     * Compute the states at @p needed on @p grid with one solver (keeping
+     * its factorisation from state to state, as a worker does): each from
+     * an axis neighbour one step closer to rest (computed first, down to
+     * rest), with the states behind it on the same grid line for the
+     * second-/third-order start, as the engines do.
+     */
+    GridStates
+    compute_grid(const Body                      &body,
+                 const Parameters::AllParameters &p,
+                 const StateGrid                 &grid,
+                 const std::set<unsigned int>    &needed,
+                 Progress                        &progress,
+                 const double                     weight,
+                 const std::string               &what)
+    {
+      StateSolver        solver(body.mesh, body.nodes, p);
+      GridStates         g;
+      const unsigned int origin = grid.linear({{0, 0, 0}});
+      g.states[origin] = std::make_shared<const State>(solver.rest_state());
+      const auto get   = [&](const unsigned int q) -> const State   *{
+        const auto i = g.states.find(q);
+        return i == g.states.end() ? nullptr : i->second.get();
+      };
+      std::function<void(unsigned int)> ensure = [&](const unsigned int q) {
+        if (g.states.count(q) || g.failed.count(q))
+          return;
+        const GridIndex i = grid.index(q);
+        unsigned int    a = 0;
+        for (unsigned int d = 1; d < 3; ++d)
+          if (std::abs(i[d]) > std::abs(i[a]))
+            a = d;
+        GridIndex parent = i;
+        parent[a] -= (i[a] > 0) - (i[a] < 0);
+        ensure(grid.linear(parent));
+        // The source: that parent, else any computed axis neighbour.
+        unsigned int source = grid.linear(parent);
+        if (get(source) == nullptr)
+          for (unsigned int d = 0; d < 3 && get(source) == nullptr; ++d)
+            for (const int s : {-1, 1})
+              {
+                GridIndex n = i;
+                n[d] += s;
+                if (grid.contains(n) && get(grid.linear(n)) != nullptr)
+                  {
+                    source = grid.linear(n);
+                    break;
+                  }
+              }
+        if (get(source) == nullptr)
+          {
+            g.failed.insert(q);
+            return;
+          }
+        unsigned int b = 0, bb = 0;
+        const State *behind = grid.behind(source, q, b) ? get(b) : nullptr;
+        const State *behind2 =
+          behind != nullptr && grid.behind(b, source, bb) ? get(bb) : nullptr;
+        const State s =
+          solver.solve(*get(source), grid.position(q), behind, behind2);
+        g.times.push_back(s.wall_time);
+        g.stiffness_times.push_back(s.stiffness_time);
+        if (s.converged)
+          {
+            State kept = s;
+            kept.history.clear();
+            g.states[q] = std::make_shared<const State>(std::move(kept));
+          }
+        else
+          g.failed.insert(q);
+        progress.step(weight, what);
+      };
+      // Nearest to rest first.
+      std::vector<unsigned int> order(needed.begin(), needed.end());
+      std::sort(order.begin(), order.end(), [&](unsigned int x, unsigned y) {
+        return Utilities::norm(grid.position(x)) <
+               Utilities::norm(grid.position(y));
+      });
+      for (const unsigned int q : order)
+        ensure(q);
+      return g;
+    }
+
+    /** The 8 corners of the cells of @p samples. */
+    std::set<unsigned int>
+    cell_corners(const StateGrid &grid, const std::vector<Point3> &x)
+    {
+      std::set<unsigned int> c;
+      for (const Point3 &p : x)
+        {
+          GridIndex             lower;
+          std::array<double, 3> local;
+          if (grid.locate(p, lower, local))
+            for (const unsigned int k : grid.corners(lower))
+              c.insert(k);
+        }
+      return c;
+    }
+
+    /** @p points and their 26 neighbours (what Hermite reads). */
+    std::set<unsigned int>
+    with_neighbours(const StateGrid &grid, const std::set<unsigned int> &points)
+    {
+      std::set<unsigned int> r;
+      for (const unsigned int q : points)
+        {
+          const GridIndex g = grid.index(q);
+          for (int i = -1; i <= 1; ++i)
+            for (int j = -1; j <= 1; ++j)
+              for (int k = -1; k <= 1; ++k)
+                {
+                  const GridIndex n = {{g[0] + i, g[1] + j, g[2] + k}};
+                  if (grid.contains(n))
+                    r.insert(grid.linear(n));
+                }
+        }
+      return r;
+    }
+
+    /**
+     * Distinct grid points whose states the interpolation needs per cm of
+     * a straight path: the corners of the cells crossed by 200 random
+     * lines of 10 cm through the ball of 2 cm around rest.
+     */
+    double
+    states_per_cm(const double h)
+    {
+      const StateGrid                        grid(h, 0.2);
+      std::mt19937                           rng(3);
+      std::uniform_real_distribution<double> u(-1, 1);
+      double                                 total = 0;
+      const unsigned int                     lines = 200;
+      for (unsigned int l = 0; l < lines; ++l)
+        {
+          Point3 start = {{0.02 * u(rng), 0.02 * u(rng), 0.02 * u(rng)}}, dir;
+          do
+            dir = {{u(rng), u(rng), u(rng)}};
+          while (Utilities::norm(dir) > 1 || Utilities::norm(dir) < 0.1);
+          const double        n = Utilities::norm(dir);
+          std::vector<Point3> x;
+          const unsigned int  steps = static_cast<unsigned>(0.1 / (h / 20));
+          for (unsigned int k = 0; k <= steps; ++k)
+            {
+              Point3 p;
+              for (unsigned int d = 0; d < 3; ++d)
+                p[d] = start[d] + dir[d] / n * 0.1 * k / steps;
+              x.push_back(p);
+            }
+          total += cell_corners(grid, x).size();
+        }
+      return total / lines / 10.0;
+    }
+
+    /** Bytes of one state held by the engine. */
+    double
+    state_bytes(const State &s)
+    {
+      return sizeof(State) +
+             (s.solution.size() + s.multipliers.size()) * sizeof(double);
+    }
+
+    /** The node of each DoF (-1: a pressure DoF), for nodal
+     * displacements. */
+    std::vector<int>
+    nodes_of_dofs(const HyperelasticSystem &system)
+    {
+      const auto                          &position  = system.dof_positions();
+      const auto                          &component = system.dof_components();
+      std::map<std::array<double, 3>, int> number;
+      std::vector<int>                     node(position.size(), -1);
+      for (std::size_t d = 0; d < position.size(); ++d)
+        if (component[d] < 3)
+          node[d] = number
+                      .emplace(std::array<double, 3>{{position[d][0],
+                                                      position[d][1],
+                                                      position[d][2]}},
+                               number.size())
+                      .first->second;
+      return node;
+    }
+
+    /** Largest nodal displacement difference (m) of two solutions. */
+    double
+    shape_difference(const std::vector<int>    &node,
+                     const std::vector<double> &a,
+                     const std::vector<double> &b)
+    {
+      const int           n = *std::max_element(node.begin(), node.end()) + 1;
+      std::vector<double> e2(n, 0.0);
+      for (std::size_t d = 0; d < a.size(); ++d)
+        if (node[d] >= 0)
+          e2[node[d]] += (a[d] - b[d]) * (a[d] - b[d]);
+      return std::sqrt(*std::max_element(e2.begin(), e2.end()));
+    }
+
+    /** Fill in the error columns of @p row from force pairs. */
+    void
+    errors(StudyRow                  &row,
+           const std::vector<double> &absolute,
+           const std::vector<double> &relative)
+    {
+      if (absolute.empty())
+        return;
+      double sum = 0, rsum = 0;
+      for (const double e : absolute)
+        sum += e;
+      for (const double e : relative)
+        rsum += e;
+      row.err_mean_N   = sum / absolute.size();
+      row.err_p95_N    = percentile(absolute, 0.95);
+      row.err_max_N    = *std::max_element(absolute.begin(), absolute.end());
+      row.err_mean_pct = 100 * rsum / relative.size();
+      row.err_p95_pct  = 100 * percentile(relative, 0.95);
+      row.err_max_pct =
+        100 * *std::max_element(relative.begin(), relative.end());
+    }
+
+    double
+    relative_error(const Point3 &f, const Point3 &reference)
+    {
+      return Utilities::distance(f, reference) /
+             std::max(Utilities::norm(reference), force_floor);
+    }
+
+    std::string
+    material_key(const Parameters::MaterialModel &m)
+    {
+      return m.model_name == "St.Venant-Kirchhoff" ? "stvk" :
+             m.model_name == "Neo-Hookean"         ? "nh" :
+                                                     "mooney-rivlin";
+    }
+
+    std::string
+    scientific(const double x)
+    {
+      std::ostringstream s;
+      s << std::scientific << std::setprecision(0) << x;
+      return s.str();
+    }
+
+    /** Whether a grid-knob row qualifies for the recommendation: p95
+     * force error within @p threshold (%) on 95 % of the positions. */
+    bool
+    passes(const StudyRow &row, const double threshold)
+    {
+      return row.interpolation != "direct" && row.samples > 0 &&
+             row.covered >= 0.95 * row.samples && row.err_p95_pct <= threshold;
+    }
+
+    std::string
+    mm(const double metres)
+    {
+      std::ostringstream s;
+      s << metres * 1000 << " mm";
+      return s.str();
+    }
+  } // namespace
+
+
+
+  StudyResult
+  run_study(std::ostream &out, const Scene &scene, const StudyOptions &options)
+  {
+    const auto         study_start = Clock::now();
+    const auto        &p0          = scene.parameters;
+    const bool         quick       = options.quick;
+    const unsigned int workers =
+      std::max(1u,
+               std::min(p0.engine.workers,
+                        std::max(1u, std::thread::hardware_concurrency())));
+    StudyResult result;
+    result.material = material_key(p0.material_model);
+
+    // --- The HIP positions: smooth random trajectories in a ball of
+    // 12 mm around rest (cells of up to 20 mm around them stay within the
+    // range where the liver scenes' states exist).
+    const unsigned int n_samples =
+      options.samples > 0 ? options.samples : (quick ? 80 : 240);
+    const unsigned int  per_path = 20;
+    const unsigned int  n_paths  = (n_samples + per_path - 1) / per_path;
+    const double        radius   = 0.012;
+    const auto          paths = trajectories(n_paths, per_path, radius, 2026);
+    std::vector<Point3> positions;
+    for (const auto &path : paths)
+      for (const Point3 &x : path)
+        if (positions.size() < n_samples)
+          positions.push_back(x);
+
+    // --- The knobs and their values, one at a time from the scene's.
+    const double        h0 = p0.state_space.grid_spacing;
+    std::vector<double> spacings =
+      quick ? std::vector<double>{0.005, 0.01, 0.02} :
+              std::vector<double>{0.0025, 0.005, 0.01, 0.02};
+    if (std::find(spacings.begin(), spacings.end(), h0) == spacings.end())
+      spacings.push_back(h0);
+    std::sort(spacings.begin(), spacings.end());
+    std::vector<double> tolerances =
+      quick ? std::vector<double>{1e-4} : std::vector<double>{1e-3, 1e-4, 1e-6};
+    std::vector<double> increments =
+      quick ? std::vector<double>{0.0025} : std::vector<double>{0.001, 0.0025};
+    tolerances.erase(std::remove(tolerances.begin(),
+                                 tolerances.end(),
+                                 p0.nonlinear_solver.residual_tolerance),
+                     tolerances.end());
+    increments.erase(std::remove(increments.begin(),
+                                 increments.end(),
+                                 p0.nonlinear_solver.max_increment_length),
+                     increments.end());
+
+    // The finer mesh for the mesh knob.
+    std::optional<Scene> finer;
+    std::string          coarse_name = "scene mesh", finer_name;
+    {
+      Scene       f = scene;
+      auto       &m = f.parameters.mesh;
+      std::string why_not;
+      if (!options.finer_mesh.empty())
+        {
+          m.source    = "file";
+          m.file_name = std::filesystem::absolute(options.finer_mesh).string();
+          finer_name  = std::filesystem::path(options.finer_mesh).stem();
+          finer       = f;
+        }
+      else if (m.source == "file")
+        {
+          std::filesystem::path file(m.file_name);
+          if (file.is_relative() && !scene.file().empty())
+            file = std::filesystem::path(scene.file()).parent_path() / file;
+          const auto sibling = file.parent_path() / "liver2k.msh";
+          if (file.filename() == "liver501.msh" &&
+              std::filesystem::exists(sibling))
+            {
+              m.file_name = std::filesystem::absolute(sibling).string();
+              finer_name  = "liver2k";
+              coarse_name = "liver501";
+              finer       = f;
+            }
+        }
+      else if (m.source == "blob")
+        {
+          ++m.blob_refinements;
+          finer_name =
+            "blob, " + std::to_string(m.blob_refinements) + " refinements";
+          finer = f;
+        }
+      else if (m.source == "beam")
+        {
+          m.beam_subdivisions_length *= 2;
+          m.beam_subdivisions_width *= 2;
+          m.beam_subdivisions_height *= 2;
+          finer_name = "beam, twice the subdivisions";
+          finer      = f;
+        }
+    }
+    // The probe: the scene's, and a rigid tip of 25 mm (or the scene's
+    // tip) for the discretisation knobs, where a point probe has no
+    // mesh-converged force.
+    const double       tip = p0.boundary_conditions.active_node.tip_radius > 0 ?
+                               p0.boundary_conditions.active_node.tip_radius :
+                               0.025;
+    const unsigned int n_disc = quick ? 8 : 40;
+    const bool         p2_knob =
+      !quick || p0.material_model.model_name != "Mooney-Rivlin";
+
+    // --- Work, for the progress bar: states to compute (estimated from
+    // the cells and their neighbours) and direct solves, weighted by
+    // their relative cost.
+    const Body base(scene);
+    out << "Study: what accuracy costs in time, for '" << scene.file() << "'\n"
+        << "  " << positions.size() << " HIP positions on " << n_paths
+        << " smooth random trajectories within " << mm(radius)
+        << " of rest; one knob at a time from the scene's settings; " << workers
+        << " worker(s)"
+        << (quick ? "; --quick: fewer knob values and positions" : "") << "\n";
+    double total = positions.size();
+    for (const double h : spacings)
+      total += with_neighbours(StateGrid(h, p0.state_space.extent),
+                               cell_corners(StateGrid(h, p0.state_space.extent),
+                                            positions))
+                 .size();
+    const double h0_states =
+      with_neighbours(StateGrid(h0, p0.state_space.extent),
+                      cell_corners(StateGrid(h0, p0.state_space.extent),
+                                   positions))
+        .size();
+    total += (tolerances.size() + increments.size()) * h0_states;
+    const double finer_cost = 12, p2_cost = 20;
+    if (finer)
+      total += 2 * n_disc * (1 + finer_cost);
+    if (p2_knob)
+      total += 2 * n_disc * p2_cost;
+    Progress progress(out, options.progress, total);
+
+    // --- Reference: direct solves at every position, tolerance 1e-10.
+    const std::vector<Sample> reference   = direct_solves(base,
+                                                        paths,
+                                                        positions.size(),
+                                                        1e-10,
+                                                        nullptr,
+                                                        progress,
+                                                        1,
+                                                        "reference solves");
+    unsigned int              n_reference = 0;
+    for (const auto &s : reference)
+      n_reference += s.ok;
+    const std::vector<int> node_of_dof =
+      nodes_of_dofs(StateSolver(base.mesh, base.nodes, p0).system());
+
+    // --- One setting of the grid knobs: compute its states, interpolate
+    // with both schemes, compare.
+    const auto grid_setting = [&](const std::string              &knob,
+                                  const std::string              &value,
+                                  const Parameters::AllParameters p) {
+      const StateGrid grid(p.state_space.grid_spacing, p.state_space.extent);
+      const auto      corners     = cell_corners(grid, positions);
+      const auto      needed      = with_neighbours(grid, corners);
+      auto            q           = p;
+      q.state_space.interpolation = "tricubic Hermite"; // stiffness too
+      const GridStates g =
+        compute_grid(base, q, grid, needed, progress, 1, knob + " " + value);
+      StateCache cache(grid, std::size_t(1) << 40);
+      for (const auto &[point, state] : g.states)
+        cache.publish(point, state, cache.generation());
+      for (const unsigned int point : g.failed)
+        cache.publish_failure(point, cache.generation());
+
+      // Cost: state time with and without the stiffness.
+      std::vector<double> plain, with;
+      for (std::size_t i = 0; i < g.times.size(); ++i)
+        {
+          with.push_back(g.times[i]);
+          plain.push_back(g.times[i] - g.stiffness_times[i]);
+        }
+      unsigned int region = 0;
+      double       bytes  = 0;
+      for (const unsigned int c : corners)
+        if (const auto i = g.states.find(c); i != g.states.end())
+          {
+            ++region;
+            bytes += state_bytes(*i->second);
+          }
+        else
+          ++region;
+      const double per_cm = states_per_cm(grid.spacing());
+
+      // Shape: trilinear blend of the corners' displacement fields.
+      std::vector<double> shape;
+      for (std::size_t k = 0; k < positions.size(); ++k)
+        {
+          if (!reference[k].ok)
+            continue;
+          GridIndex             lower;
+          std::array<double, 3> local;
+          if (!grid.locate(positions[k], lower, local))
+            continue;
+          const auto          c = grid.corners(lower);
+          const auto          w = trilinear_weights(local);
+          std::vector<double> u(reference[k].solution.size(), 0.0);
+          bool                complete = true;
+          for (unsigned int j = 0; j < 8 && complete; ++j)
+            {
+              const auto i = g.states.find(c[j]);
+              complete     = i != g.states.end();
+              if (complete)
+                for (std::size_t d = 0; d < u.size(); ++d)
+                  u[d] += w[j] * i->second->solution[d];
+            }
+          if (complete)
+            shape.push_back(
+              shape_difference(node_of_dof, u, reference[k].solution));
+        }
+
+      for (const auto scheme :
+           {Interpolation::trilinear, Interpolation::hermite})
+        {
+          StudyRow row;
+          row.knob  = knob;
+          row.value = value;
+          row.interpolation =
+            scheme == Interpolation::hermite ? "Hermite" : "trilinear";
+          row.h_mm               = grid.spacing() * 1000;
+          row.residual_tolerance = p.nonlinear_solver.residual_tolerance;
+          row.max_increment      = p.nonlinear_solver.max_increment_length;
+          std::vector<double> absolute, relative;
+          for (std::size_t k = 0; k < positions.size(); ++k)
+            {
+              if (!reference[k].ok)
+                continue;
+              ++row.samples;
+              const ForceSample s =
+                interpolate_force(grid, cache, positions[k], scheme);
+              if (!s.complete)
+                continue;
+              ++row.covered;
+              absolute.push_back(
+                Utilities::distance(s.force, reference[k].force));
+              relative.push_back(relative_error(s.force, reference[k].force));
+            }
+          errors(row, absolute, relative);
+          if (!shape.empty())
+            row.shape_err_mm =
+              1000 * *std::max_element(shape.begin(), shape.end());
+          row.state_ms =
+            1000 *
+            percentile(scheme == Interpolation::hermite ? with : plain, 0.5);
+          row.states            = g.times.size();
+          row.failures          = g.failed.size();
+          row.states_per_cm     = per_cm;
+          row.region_states     = region;
+          const double slowdown = workers > 1 ? two_solver_slowdown : 1.0;
+          row.precompute_s = region * row.state_ms / 1000 * slowdown / workers;
+          row.memory_MiB   = bytes / 1048576.0;
+          // The engine keeps up while it computes the corners ahead as
+          // fast as the HIP reaches them: workers / (state time) states
+          // per second, per_cm states per cm (doc/accuracy-vs-time.md
+          // compares it with benchmarks/run max-speed).
+          row.speed_mm_s =
+            workers / (row.state_ms / 1000 * slowdown) / per_cm * 10;
+          result.rows.push_back(row);
+        }
+    };
+
+    for (const double h : spacings)
+      {
+        auto p                     = p0;
+        p.state_space.grid_spacing = h;
+        grid_setting("grid", mm(h), p);
+      }
+    for (const double t : tolerances)
+      {
+        auto p                                = p0;
+        p.nonlinear_solver.residual_tolerance = t;
+        grid_setting("tolerance", scientific(t), p);
+      }
+    for (const double l : increments)
+      {
+        auto p                                  = p0;
+        p.nonlinear_solver.max_increment_length = l;
+        grid_setting("increment", mm(l), p);
+      }
+
+    // The knobs together: the fastest grid setting that passes, with the
+    // loosest tolerance that passes at the scene's spacing with the same
+    // interpolation.
+    {
+      const StudyRow *best_grid = nullptr;
+      double          loosest   = p0.nonlinear_solver.residual_tolerance;
+      for (const auto &row : result.rows)
+        if (passes(row, result.threshold_pct) && row.knob == "grid" &&
+            (best_grid == nullptr || row.speed_mm_s > best_grid->speed_mm_s))
+          best_grid = &row;
+      if (best_grid != nullptr)
+        for (const auto &row : result.rows)
+          if (passes(row, result.threshold_pct) && row.knob == "tolerance" &&
+              row.interpolation == best_grid->interpolation)
+            loosest = std::max(loosest, row.residual_tolerance);
+      if (best_grid != nullptr &&
+          (best_grid->h_mm / 1000 != h0 ||
+           loosest != p0.nonlinear_solver.residual_tolerance))
+        {
+          auto p                                = p0;
+          p.state_space.grid_spacing            = best_grid->h_mm / 1000;
+          p.nonlinear_solver.residual_tolerance = loosest;
+          const std::string value =
+            mm(p.state_space.grid_spacing) + ", " + scientific(loosest);
+          grid_setting("combined", value, p);
+        }
+    }
+
+    // --- Discretisation knobs: direct solves at the first n_disc
+    // positions, against the finest setting of the knob, with the point
+    // probe and with a rigid tip.
+    const auto discretisation = [&](const std::string              &knob,
+                                    const std::vector<Scene>       &variants,
+                                    const std::vector<std::string> &names,
+                                    const std::vector<double>      &cost) {
+      for (const double radius : {0.0, tip})
+        {
+          std::vector<std::vector<Sample>> forces;
+          std::vector<std::vector<double>> times(variants.size());
+          for (unsigned int v = 0; v < variants.size(); ++v)
+            {
+              Scene s = variants[v];
+              s.parameters.boundary_conditions.active_node.tip_radius = radius;
+              const Body body(s);
+              forces.push_back(direct_solves(
+                body,
+                paths,
+                std::min<unsigned>(n_disc, positions.size()),
+                p0.nonlinear_solver.residual_tolerance,
+                &times[v],
+                progress,
+                cost[v],
+                knob + " " + names[v] +
+                  (radius > 0 ? ", tip " + mm(radius) : ", point probe")));
+            }
+          const auto &finest = forces.back();
+          for (unsigned int v = 0; v < variants.size(); ++v)
+            {
+              StudyRow row;
+              row.knob          = knob;
+              row.value         = names[v];
+              row.interpolation = "direct";
+              row.probe         = radius > 0 ? "tip " + mm(radius) : "point";
+              row.h_mm          = 0;
+              std::vector<double> absolute, relative;
+              for (std::size_t k = 0; k < finest.size(); ++k)
+                {
+                  ++row.samples;
+                  if (!finest[k].ok || !forces[v][k].ok)
+                    {
+                      row.failures += !forces[v][k].ok;
+                      continue;
+                    }
+                  ++row.covered;
+                  absolute.push_back(
+                    Utilities::distance(forces[v][k].force, finest[k].force));
+                  relative.push_back(
+                    relative_error(forces[v][k].force, finest[k].force));
+                }
+              errors(row, absolute, relative);
+              row.state_ms = 1000 * percentile(times[v], 0.5);
+              row.states   = times[v].size();
+              result.rows.push_back(row);
+            }
+        }
+    };
+    if (finer)
+      discretisation("mesh",
+                     {scene, *finer},
+                     {coarse_name, finer_name},
+                     {1, finer_cost});
+    if (p2_knob)
+      {
+        Scene p2 = scene;
+        auto &m  = p2.parameters.material_model;
+        if (m.model_name == "Mooney-Rivlin" && m.incompressible())
+          m.mr_element = "Taylor-Hood";
+        else
+          p2.parameters.discretization.polynomial_degree = 2;
+        const std::string low =
+          m.model_name == "Mooney-Rivlin" && m.incompressible() ? "P1-P1" :
+                                                                  "P1";
+        const std::string high =
+          m.model_name == "Mooney-Rivlin" && m.incompressible() ?
+            "Taylor-Hood P2-P1" :
+            "P2";
+        if (p0.discretization.polynomial_degree == 1 &&
+            !(m.model_name == "Mooney-Rivlin" &&
+              p0.material_model.mr_element == "Taylor-Hood"))
+          discretisation("element", {scene, p2}, {low, high}, {1, p2_cost});
+      }
+    progress.finish();
+
+    // --- The recommendation: the fastest grid-knob setting whose p95
+    // force error is below the threshold and that covers 95 % of the
+    // positions.
+    for (unsigned int r = 0; r < result.rows.size(); ++r)
+      {
+        const auto &row = result.rows[r];
+        if (!passes(row, result.threshold_pct))
+          continue;
+        if (result.recommended < 0 ||
+            row.speed_mm_s > result.rows[result.recommended].speed_mm_s)
+          result.recommended = r;
+      }
+
+    // --- Tables.
+    const auto print_grid_table = [&](const std::string &knob,
+                                      const std::string &title) {
+      bool any = false;
+      for (const auto &row : result.rows)
+        any = any || row.knob == knob;
+      if (!any)
+        return;
+      out << "\n" << title << "\n";
+      out << "| " << std::left << std::setw(10) << knob
+          << " | interpolation | covered | force error mean / p95 / max (%) "
+             "| max (N) | shape (mm) | state (ms) | states/cm | region: "
+             "states, precompute (s), MiB | speed (mm/s) |\n";
+      out << "|---|---|---|---|---|---|---|---|---|---|\n";
+      for (unsigned int r = 0; r < result.rows.size(); ++r)
+        {
+          const auto &row = result.rows[r];
+          if (row.knob != knob)
+            continue;
+          out << "| " << std::setw(10) << row.value << " | " << std::setw(13)
+              << row.interpolation << " | " << row.covered << "/" << row.samples
+              << " | " << fixed(row.err_mean_pct, 2) << " / "
+              << fixed(row.err_p95_pct, 2) << " / " << fixed(row.err_max_pct, 2)
+              << " | " << fixed(row.err_max_N, 4) << " | "
+              << (row.shape_err_mm >= 0 ? fixed(row.shape_err_mm, 3) : "-")
+              << " | " << fixed(row.state_ms, 1) << " | "
+              << fixed(row.states_per_cm, 1) << " | " << row.region_states
+              << ", " << fixed(row.precompute_s, 1) << ", "
+              << fixed(row.memory_MiB, 1) << " | " << fixed(row.speed_mm_s, 0)
+              << (int(r) == result.recommended ? " (recommended)" : "")
+              << " |\n";
+        }
+    };
+    print_grid_table("grid",
+                     "Grid spacing and interpolation (the scene's "
+                     "tolerance and staging):");
+    print_grid_table("tolerance",
+                     "Newton residual tolerance (grid spacing " + mm(h0) +
+                       "):");
+    print_grid_table("increment",
+                     "Staging: longest increment (grid spacing " + mm(h0) +
+                       "):");
+    print_grid_table("combined",
+                     "Together: the fastest grid setting that passes, with "
+                     "the loosest tolerance that passes:");
+    for (const std::string knob : {"mesh", "element"})
+      {
+        bool any = false;
+        for (const auto &row : result.rows)
+          any = any || row.knob == knob;
+        if (!any)
+          continue;
+        out << "\n"
+            << (knob == "mesh" ? "Mesh resolution" : "Element order")
+            << ": direct solves at "
+            << std::min<unsigned>(n_disc, positions.size())
+            << " positions, against the finest (the last row of each probe):\n";
+        out << "| " << knob
+            << " | probe | converged | force difference mean / p95 / max (%) "
+               "| max (N) | state (ms) |\n|---|---|---|---|---|---|\n";
+        for (const auto &row : result.rows)
+          if (row.knob == knob)
+            out << "| " << row.value << " | " << row.probe << " | "
+                << row.samples - row.failures << "/" << row.samples << " | "
+                << fixed(row.err_mean_pct, 2) << " / "
+                << fixed(row.err_p95_pct, 2) << " / "
+                << fixed(row.err_max_pct, 2) << " | " << fixed(row.err_max_N, 4)
+                << " | " << fixed(row.state_ms, 1) << " |\n";
+        if (knob == "mesh")
+          out << "A point probe has no mesh-converged force (a point load in "
+                 "3-D has infinite compliance): compare the point rows with "
+                 "the tip rows.\n";
+      }
+
+    out << "\nRecommendation (fastest setting with p95 force error <= "
+        << result.threshold_pct
+        << " %, half the human force discrimination threshold):\n";
+    if (result.recommended >= 0)
+      {
+        const auto &row = result.rows[result.recommended];
+        out << "  " << row.knob << " " << row.value << ", " << row.interpolation
+            << ", h = " << row.h_mm << " mm: p95 force error "
+            << fixed(row.err_p95_pct, 2) << " %, " << fixed(row.state_ms, 1)
+            << " ms per state, about " << fixed(row.speed_mm_s, 0)
+            << " mm/s straight-line speed with " << workers << " worker(s).\n"
+            << "  In the scene: State space / Grid spacing = "
+            << row.h_mm / 1000 << ", Interpolation = "
+            << (row.interpolation == "Hermite" ? "tricubic Hermite" :
+                                                 "trilinear");
+        if (row.residual_tolerance != p0.nonlinear_solver.residual_tolerance)
+          out << "; Nonlinear solver / Residual tolerance = "
+              << row.residual_tolerance;
+        if (row.max_increment != p0.nonlinear_solver.max_increment_length)
+          out << "; Nonlinear solver / Maximum increment length = "
+              << row.max_increment;
+        out << ".\n";
+      }
+    else
+      out << "  none of the settings keeps the p95 error below "
+          << result.threshold_pct
+          << " % on 95 % of the positions: use a finer grid or Hermite.\n";
+
+    // --- CSV.
+    result.csv_file = options.csv_file;
+    if (result.csv_file.empty())
+      {
+        std::filesystem::create_directories(p0.output.directory);
+        result.csv_file =
+          (std::filesystem::path(p0.output.directory) /
+           ("study-" + std::filesystem::path(scene.file()).stem().string() +
+            ".csv"))
+            .string();
+      }
+    std::ofstream csv(result.csv_file);
+    csv << "material,knob,value,interpolation,probe,h_mm,samples,covered,"
+           "err_mean_N,err_p95_N,err_max_N,err_mean_pct,err_p95_pct,"
+           "err_max_pct,shape_err_mm,state_ms,states,failures,states_per_cm,"
+           "region_states,precompute_s,memory_MiB,speed_mm_s,recommended\n";
+    for (unsigned int r = 0; r < result.rows.size(); ++r)
+      {
+        const auto &row = result.rows[r];
+        csv << result.material << "," << row.knob << "," << row.value << ","
+            << row.interpolation << "," << row.probe << "," << row.h_mm << ","
+            << row.samples << "," << row.covered << "," << row.err_mean_N << ","
+            << row.err_p95_N << "," << row.err_max_N << "," << row.err_mean_pct
+            << "," << row.err_p95_pct << "," << row.err_max_pct << ","
+            << row.shape_err_mm << "," << row.state_ms << "," << row.states
+            << "," << row.failures << "," << row.states_per_cm << ","
+            << row.region_states << "," << row.precompute_s << ","
+            << row.memory_MiB << "," << row.speed_mm_s << ","
+            << (int(r) == result.recommended ? "yes" : "no") << "\n";
+      }
+    csv.close();
+    if (!csv)
+      throw OutputError("the study's CSV '" + result.csv_file +
+                        "' could not be written");
+    result.seconds = seconds_since(study_start);
+    out << "\nThe table as CSV: " << result.csv_file
+        << " (Pareto plot: /usr/bin/python3 doc/images/accuracy_pareto.py "
+        << result.csv_file << " pareto.png). Study time "
+        << fixed(result.seconds, 0) << " s; " << n_reference << " of "
+        << positions.size() << " reference solves converged.\n";
+    return result;
+  }
+} // namespace palpate
