@@ -92,9 +92,10 @@ namespace palpate
     std::unique_ptr<std::atomic<std::uint8_t>[]> used;
 
     // Real-time state (touched by force() only).
-    ForceFilter         filter;
-    ForceHold           hold;
-    const Interpolation interpolation =
+    ForceFilter           filter;
+    ForceHold             hold;
+    std::array<double, 9> stiffness = {}; // of the last force()
+    const Interpolation   interpolation =
       interpolation_from_name(scene.parameters.state_space.interpolation);
     MissingCause      previous_cause = MissingCause::none;
     Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
@@ -248,14 +249,16 @@ namespace palpate
       cause = s.previous_cause;
     Utilities::Point3 target = sample.force;
     bool              render = complete;
+    s.stiffness = complete ? sample.stiffness : std::array<double, 9>{};
     if (s.in_contact && cause != MissingCause::none)
       {
         const bool held =
           cause != MissingCause::not_computed && finite && s.hold.valid();
         if (held)
           {
-            target = s.hold.force(position);
-            render = true;
+            target      = s.hold.force(position);
+            render      = true;
+            s.stiffness = s.hold.stiffness_matrix(position);
           }
         const unsigned int slot = cause == MissingCause::failure_region ? 0 : 1;
         if (cause != s.previous_cause)
@@ -306,6 +309,14 @@ namespace palpate
   Interaction::data_complete() const noexcept
   {
     return impl->complete.load(std::memory_order_relaxed);
+  }
+
+
+
+  const std::array<double, 9> &
+  Interaction::stiffness() const noexcept
+  {
+    return impl->stiffness;
   }
 
 

@@ -271,8 +271,9 @@ namespace palpate
      * -beta dg, so K dx = beta dg at the probe's constraint rows gives the
      * change of the multipliers, and -df/dg is the stiffness: three solves
      * with the factorisation (direct if it is of this tangent, else GMRES
-     * preconditioned by it, else a new factorisation). False if the linear
-     * solver fails.
+     * to 1e-6 preconditioned by it, else - when GMRES needs more than
+     * Maximum Krylov iterations - a new factorisation, which then also
+     * preconditions the next states). False if the linear solver fails.
      */
     bool
     active_stiffness(State &state);
@@ -310,8 +311,8 @@ namespace palpate
                          return linear_solver->solve(v);
                        },
                        rhs,
-                       1e-10,
-                       std::max(30u, settings.max_krylov_iterations),
+                       1e-6,
+                       settings.max_krylov_iterations,
                        krylov_v,
                        krylov_z) > 0;
             if (!solved)

@@ -175,6 +175,20 @@ namespace palpate
       return {{g * normal[0], g * normal[1], g * normal[2]}};
     }
 
+    /** The held field's stiffness matrix -df/dx at @p x (N/m, row-major):
+     * k n n^T while the spring pushes, zero once released. */
+    std::array<double, 9>
+    stiffness_matrix(const Utilities::Point3 &x) const noexcept
+    {
+      std::array<double, 9> K = {};
+      if (!has_force || Utilities::norm(force(x)) == 0)
+        return K;
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int j = 0; j < 3; ++j)
+          K[3 * i + j] = stiffness * normal[i] * normal[j];
+      return K;
+    }
+
     /** The stiffness along the held direction (N/m). */
     double
     held_stiffness() const noexcept

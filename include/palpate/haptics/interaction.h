@@ -8,6 +8,7 @@
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/run_summary.h>
 
+#include <array>
 #include <iosfwd>
 #include <memory>
 
@@ -38,8 +39,10 @@ namespace palpate
    *
    * Positions are displacements of the active node from its rest position
    * (m, in the mesh's frame; a host maps its device frame onto it); forces
-   * are what the device should render (N): the trilinear interpolation of
-   * the states at the 8 corners of the position's grid cell, clamped to
+   * are what the device should render (N): the interpolation (State space
+   * / Interpolation: trilinear, or tricubic Hermite from the corners'
+   * stiffnesses too) of the states at the 8 corners of the position's
+   * grid cell, clamped to
    * Haptics / Force limit and changing by at most Haptics / Maximum force
    * change per call. Where a corner is missing (not computed yet, a failure
    * point, outside the grid, detached) the force fades to zero at that
@@ -78,6 +81,19 @@ namespace palpate
      */
     Utilities::Point3
     force(const Utilities::Point3 &position) noexcept;
+
+    /**
+     * The stiffness K = -df/dx (N/m, row-major: K[3 i + j] = -d f_i /
+     * d x_j) of the force field at the last force() call's position:
+     * the interpolated field's (continuous across cells with tricubic
+     * Hermite interpolation), the held spring's where a force is held,
+     * zero where none is rendered. For a device that renders a local model
+     * f + K (x - x_last) between ticks. Call from the thread that calls
+     * force(); real-time safe. (Not limited like the force: a device that
+     * uses it must apply its own stiffness limit.)
+     */
+    const std::array<double, 9> &
+    stiffness() const noexcept;
 
     /** Whether the last force() call found all 8 corners of its cell. */
     bool
