@@ -254,42 +254,6 @@ namespace
     return {best, trials};
   }
 
-  /**
-   * The platform's own timer noise: a bare 1 kHz loop with the haptic
-   * loop's settings (SCHED_FIFO 80, locked memory, absolute deadlines on
-   * CLOCK_MONOTONIC) and nothing else to do. Deadlines it misses are the
-   * machine's (a virtual machine's host, interrupts), not palpate's.
-   */
-  std::pair<std::uint64_t, double>
-  baseline(const double seconds)
-  {
-    std::uint64_t misses = 0;
-    double        late   = 0;
-    std::thread   loop([&] {
-      sched_param parameters{};
-      parameters.sched_priority = 80;
-      pthread_setschedparam(pthread_self(), SCHED_FIFO, &parameters);
-      mlockall(MCL_CURRENT);
-      timespec now;
-      clock_gettime(CLOCK_MONOTONIC, &now);
-      long long deadline = now.tv_sec * 1000000000LL + now.tv_nsec;
-      for (long k = 0; k < static_cast<long>(1000 * seconds); ++k)
-        {
-          deadline += 1000000;
-          const timespec next{static_cast<time_t>(deadline / 1000000000LL),
-                              static_cast<long>(deadline % 1000000000LL)};
-          clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
-          clock_gettime(CLOCK_MONOTONIC, &now);
-          const double l =
-            1e-9 * (now.tv_sec * 1000000000LL + now.tv_nsec - deadline);
-          misses += l > 0.5e-3;
-          late = std::max(late, l);
-        }
-    });
-    loop.join();
-    return {misses, late};
-  }
-
 } // namespace
 
 namespace
@@ -422,7 +386,7 @@ main(int argc, char **argv)
     << " cm along -x from rest, 1 kHz haptic loop"
     << (o.quick ? "  [--quick]" : "") << "\n";
   const double noise_seconds     = o.quick ? 5 : 60;
-  const auto [noise, noise_late] = baseline(noise_seconds);
+  const auto [noise, noise_late] = bare_loop(noise_seconds, 1000);
   std::cout
     << "  platform timer noise: a bare SCHED_FIFO 1 kHz loop, nothing else "
        "running, misses "

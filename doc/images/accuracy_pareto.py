@@ -70,7 +70,7 @@ for ax, source in zip(axes[0], sources):
     ax.set_yscale("log")
     ax.set_xlabel("implied straight-line HIP speed, 2 workers (mm/s)")
     ax.set_ylabel("p95 relative force error (%)")
-    ax.set_title(names.get(material, material) + " (" + source.stem + ")")
+    ax.set_title(names.get(material, material))
     ax.grid(True, which="both", lw=0.3)
     ax.legend(fontsize=8, loc="lower right")
 fig.tight_layout()

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -1058,7 +1059,7 @@ namespace palpate
     for (unsigned int r = 0; r < result.rows.size(); ++r)
       {
         const auto &row = result.rows[r];
-        csv << result.material << "," << row.knob << "," << row.value << ","
+        csv << result.material << "," << row.knob << ",\"" << row.value << "\","
             << row.interpolation << "," << row.probe << "," << row.h_mm << ","
             << row.samples << "," << row.covered << "," << row.err_mean_N << ","
             << row.err_p95_N << "," << row.err_max_N << "," << row.err_mean_pct
@@ -1073,12 +1074,35 @@ namespace palpate
     if (!csv)
       throw OutputError("the study's CSV '" + result.csv_file +
                         "' could not be written");
+    out << "\nThe table as CSV: " << result.csv_file << "\n";
+
+    // --- The Pareto plot, by the plotting script of the source tree
+    // (matplotlib), next to the CSV.
+    if (options.plot)
+      {
+        const std::filesystem::path script =
+          std::filesystem::path(PALPATE_SOURCE_DIR) / "doc" / "images" /
+          "accuracy_pareto.py";
+        std::filesystem::path png(result.csv_file);
+        png.replace_extension(".png");
+        const std::string command = "/usr/bin/python3 '" + script.string() +
+                                    "' '" + result.csv_file + "' '" +
+                                    png.string() + "'";
+        if (std::filesystem::exists(script) &&
+            std::system((command + " > /dev/null 2>&1").c_str()) == 0)
+          {
+            result.plot_file = png.string();
+            out << "The Pareto plot (force error against speed): "
+                << result.plot_file << "\n";
+          }
+        else
+          out << "No Pareto plot: it needs python3 with matplotlib (Debian: "
+                 "apt install python3-matplotlib); then run "
+              << command << "\n";
+      }
     result.seconds = seconds_since(study_start);
-    out << "\nThe table as CSV: " << result.csv_file
-        << " (Pareto plot: /usr/bin/python3 doc/images/accuracy_pareto.py "
-        << result.csv_file << " pareto.png). Study time "
-        << fixed(result.seconds, 0) << " s; " << n_reference << " of "
-        << positions.size() << " reference solves converged.\n";
+    out << "Study time " << fixed(result.seconds, 0) << " s; " << n_reference
+        << " of " << positions.size() << " reference solves converged.\n";
     return result;
   }
 } // namespace palpate

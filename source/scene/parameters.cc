@@ -775,8 +775,8 @@ namespace palpate
     {
       prm.enter_subsection("State space");
       {
-        grid_spacing = prm.get_double("Grid spacing");
-        extent       = prm.get_double("Extent");
+        grid_spacing  = prm.get_double("Grid spacing");
+        extent        = prm.get_double("Extent");
         interpolation = prm.get("Interpolation");
       }
       prm.leave_subsection();

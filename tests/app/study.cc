@@ -35,6 +35,7 @@ main(int argc, char **argv)
   options.quick    = true;
   options.samples  = 24;
   options.progress = false;
+  options.plot     = false;
   options.csv_file = "study.csv";
   std::ostringstream         out;
   const palpate::StudyResult r = palpate::run_study(out, scene, options);

@@ -28,6 +28,9 @@ namespace palpate
     std::string finer_mesh;
     /** The CSV to write (empty: study-SCENE.csv in Output / Directory). */
     std::string csv_file;
+    /** Draw the Pareto plot (PNG next to the CSV) with the source tree's
+     * doc/images/accuracy_pareto.py, if python3 and matplotlib are there. */
+    bool plot = true;
     /** Show a progress bar on stderr (a line per step if not a terminal). */
     bool progress = true;
   };
@@ -82,8 +85,8 @@ namespace palpate
     int recommended = -1;
     /** The error bound of the recommendation: p95 (%). */
     double threshold_pct = 3.5;
-    /** Where the CSV went. */
-    std::string csv_file;
+    /** Where the CSV and the plot went (plot empty: none drawn). */
+    std::string csv_file, plot_file;
     /** Wall time of the study (s). */
     double seconds = 0;
   };

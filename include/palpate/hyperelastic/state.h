@@ -80,7 +80,7 @@ namespace palpate
      * Computed only when asked for (tricubic Hermite interpolation needs
      * it): valid if has_stiffness.
      */
-    std::array<double, 9> stiffness = {};
+    std::array<double, 9> stiffness     = {};
     bool                  has_stiffness = false;
     /** Seconds of wall_time spent on the stiffness. */
     double stiffness_time = 0;
