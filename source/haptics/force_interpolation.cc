@@ -7,59 +7,84 @@
 
 namespace palpate
 {
+  namespace
+  {
+    /** Locate @p x: inside, local coordinates and corners of @p sample;
+     * false outside the grid. */
+    bool
+    locate(const StateGrid         &grid,
+           const Utilities::Point3 &x,
+           ForceSample             &sample) noexcept
+    {
+      GridIndex lower;
+      if (!grid.locate(x, lower, sample.local))
+        return false;
+      sample.inside  = true;
+      sample.corners = grid.corners(lower);
+      return true;
+    }
+
+    /** Count the failure points among the corners of an incomplete
+     * sample (bounded lock-free reads). */
+    void
+    count_failures(const StateCache &cache, ForceSample &sample) noexcept
+    {
+      for (unsigned int k = 0; k < 8; ++k)
+        sample.failed += cache.status(sample.corners[k]) == PointStatus::failed;
+    }
+
+    /** The trilinear force and its stiffness K_ij = -df_i/dx_j from the
+     * corner forces of a complete sample. */
+    void
+    trilinear(ForceSample &sample, const double h) noexcept
+    {
+      const auto &local = sample.local;
+      const auto  w     = trilinear_weights(local);
+      sample.force      = {{0, 0, 0}};
+      sample.stiffness  = {};
+      for (unsigned int k = 0; k < 8; ++k)
+        for (unsigned int i = 0; i < 3; ++i)
+          sample.force[i] += w[k] * sample.corner_forces[k][i];
+      for (unsigned int k = 0; k < 8; ++k)
+        for (unsigned int j = 0; j < 3; ++j)
+          {
+            double dw = 1;
+            for (unsigned int e = 0; e < 3; ++e)
+              {
+                const bool upper = (k >> e) & 1;
+                if (e == j)
+                  dw *= upper ? 1.0 : -1.0;
+                else
+                  dw *= upper ? local[e] : 1.0 - local[e];
+              }
+            for (unsigned int i = 0; i < 3; ++i)
+              sample.stiffness[3 * i + j] -=
+                sample.corner_forces[k][i] * dw / h;
+          }
+    }
+  } // namespace
+
+
+
   ForceSample
   interpolate_force(const StateGrid         &grid,
                     const StateCache        &cache,
                     const Utilities::Point3 &x) noexcept
   {
-    ForceSample           sample;
-    GridIndex             lower;
-    std::array<double, 3> local;
-    if (!grid.locate(x, lower, local))
+    ForceSample sample;
+    if (!locate(grid, x, sample))
       return sample;
-    sample.inside         = true;
-    sample.local          = local;
-    sample.corners        = grid.corners(lower);
-    const auto          w = trilinear_weights(local);
-    Utilities::Point3   sum{{0, 0, 0}};
     const std::uint64_t generation = cache.generation();
     for (unsigned int k = 0; k < 8; ++k)
-      {
-        Utilities::Point3 f;
-        if (cache.read_force(sample.corners[k], generation, f))
-          {
-            ++sample.hits;
-            sample.corner_forces[k] = f;
-            for (unsigned int d = 0; d < 3; ++d)
-              sum[d] += w[k] * f[d];
-          }
-      }
+      if (cache.read_force(sample.corners[k],
+                           generation,
+                           sample.corner_forces[k]))
+        ++sample.hits;
     sample.complete = sample.hits == 8;
-    // Why not: a failure point among the corners (bounded lock-free reads).
-    if (!sample.complete)
-      for (unsigned int k = 0; k < 8; ++k)
-        sample.failed += cache.status(sample.corners[k]) == PointStatus::failed;
     if (sample.complete)
-      {
-        sample.force = sum;
-        // K_ij = -df_i/dx_j of the trilinear field.
-        for (unsigned int k = 0; k < 8; ++k)
-          for (unsigned int j = 0; j < 3; ++j)
-            {
-              double dw = 1;
-              for (unsigned int e = 0; e < 3; ++e)
-                {
-                  const bool upper = (k >> e) & 1;
-                  if (e == j)
-                    dw *= upper ? 1.0 : -1.0;
-                  else
-                    dw *= upper ? local[e] : 1.0 - local[e];
-                }
-              for (unsigned int i = 0; i < 3; ++i)
-                sample.stiffness[3 * i + j] -=
-                  sample.corner_forces[k][i] * dw / grid.spacing();
-            }
-      }
+      trilinear(sample, grid.spacing());
+    else
+      count_failures(cache, sample);
     return sample;
   }
 
@@ -106,27 +131,34 @@ namespace palpate
                     const Utilities::Point3 &x,
                     const Interpolation      scheme) noexcept
   {
-    ForceSample sample = interpolate_force(grid, cache, x);
-    if (scheme != Interpolation::hermite || !sample.complete)
+    if (scheme != Interpolation::hermite)
+      return interpolate_force(grid, cache, x);
+    ForceSample sample;
+    if (!locate(grid, x, sample))
       return sample;
-
     const std::uint64_t generation = cache.generation();
     const double        h          = grid.spacing();
     // D[c][m][i]: derivative m (bits x, y, z: which directions) of force
     // component i at corner c, in the cell's unit coordinates (so scaled
-    // by h per derivative).
+    // by h per derivative). One read per corner: force and stiffness
+    // under its sequence lock, then the cross derivatives under theirs.
     double D[8][8][3];
+    bool   all_stiffness = true;
     for (unsigned int c = 0; c < 8; ++c)
       {
-        Utilities::Point3      f;
+        Utilities::Point3     &f = sample.corner_forces[c];
         std::array<double, 9>  K;
         std::array<double, 12> cross;
         bool                   has = false;
         if (!cache.read_force_and_stiffness(
-              sample.corners[c], generation, f, K, has) ||
-            !has || !cache.read_cross_derivatives(sample.corners[c], cross))
-          return sample; // trilinear this tick
-        sample.corner_forces[c] = f;
+              sample.corners[c], generation, f, K, has))
+          continue;
+        ++sample.hits;
+        if (!has || !cache.read_cross_derivatives(sample.corners[c], cross))
+          {
+            all_stiffness = false;
+            continue;
+          }
         for (unsigned int i = 0; i < 3; ++i)
           {
             D[c][0][i] = f[i];
@@ -138,6 +170,18 @@ namespace palpate
             D[c][6][i] = h * h * cross[4 * i + 2]; // yz
             D[c][7][i] = h * h * h * cross[4 * i + 3];
           }
+      }
+    sample.complete = sample.hits == 8;
+    if (!sample.complete)
+      {
+        count_failures(cache, sample);
+        return sample;
+      }
+    if (!all_stiffness)
+      {
+        // A corner without its stiffness: trilinear in this cell.
+        trilinear(sample, h);
+        return sample;
       }
 
     const auto        &local = sample.local;
