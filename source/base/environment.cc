@@ -8,6 +8,7 @@
 #include <dlfcn.h>
 #include <mpi.h>
 
+#include <atomic>
 #include <cstdlib>
 
 namespace palpate
@@ -63,12 +64,34 @@ namespace palpate
 
 
 
+  namespace
+  {
+    std::atomic<bool> a_peer_was_lost{false};
+  } // namespace
+
+
+
+  void
+  Environment::peer_lost() noexcept
+  {
+    a_peer_was_lost = true;
+  }
+
+
+
   Environment::~Environment()
   {
     int finalized = 0;
     MPI_Finalized(&finalized);
-    if (finalize_mpi && !finalized)
-      MPI_Finalize();
+    if (!finalize_mpi || finalized)
+      return;
+    if (a_peer_was_lost)
+      // Looked up at run time: only Open MPI has it, and it needs no
+      // link-time dependency on Open MPI's internals.
+      if (auto *asynchronous =
+            static_cast<bool *>(dlsym(RTLD_DEFAULT, "ompi_async_mpi_finalize")))
+        *asynchronous = true;
+    MPI_Finalize();
   }
 
 

@@ -5,6 +5,7 @@
 // design; the servers are in mpi_server.cc, the messages in
 // mpi_protocol.h.
 
+#include <palpate/base/environment.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/engine/hip_channel.h>
 #include <palpate/engine/mpi_engine.h>
@@ -41,6 +42,9 @@ namespace palpate
     {
       Header h;
       h.kind = Kind::shutdown;
+      for (const bool l : lost)
+        if (l)
+          h.flags |= Flags::peers_lost;
       for (int r = 1; r < messenger.size(); ++r)
         if (r >= static_cast<int>(lost.size()) || !lost[r])
           messenger.send(r, pack(h));
@@ -262,6 +266,7 @@ namespace palpate
     if (s.lost)
       return;
     s.lost = true;
+    Environment::peer_lost();
     std::ostringstream what;
     what << "solver server " << rank << " lost at t = " << std::fixed
          << std::setprecision(2) << now() << " s: " << why;

@@ -11,6 +11,7 @@
 //   heartbeats. MUMPS runs on MPI_COMM_SELF in the solver thread at the
 //   same time, which is why palpate asks for MPI_THREAD_MULTIPLE.
 
+#include <palpate/base/environment.h>
 #include <palpate/engine/mpi_engine.h>
 #include <palpate/engine/mpi_protocol.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -350,6 +351,8 @@ namespace palpate
                   }
                 case Kind::shutdown:
                   running = false;
+                  if (h.flags & Flags::peers_lost)
+                    Environment::peer_lost();
                   break;
                 default:
                   break;

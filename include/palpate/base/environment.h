@@ -34,6 +34,17 @@ namespace palpate
     static bool
     mpi_thread_multiple();
 
+    /**
+     * A rank of MPI_COMM_WORLD died (a lost solver server): MPI_Finalize
+     * must not wait for it. Open MPI's finalize ends with a fence over
+     * every process, which a dead one never joins: the survivors of
+     * `mpirun --enable-recovery` hung there, now and then, after the run
+     * was over. With a peer lost, finalize is asynchronous (Open MPI's
+     * ompi_async_mpi_finalize; a no-op elsewhere).
+     */
+    static void
+    peer_lost() noexcept;
+
   private:
     bool finalize_mpi;
   };

@@ -72,6 +72,8 @@ namespace palpate
       constexpr std::uint32_t error = 8;
       /** result, ready: stiffness holds the active-node stiffness. */
       constexpr std::uint32_t stiffness = 16;
+      /** shutdown: a server was lost (finalise without waiting for it). */
+      constexpr std::uint32_t peers_lost = 32;
     } // namespace Flags
 
     /** Every message starts with this header (plain bytes). */
