@@ -546,12 +546,13 @@ namespace palpate
 
     // --- The HIP positions: smooth random trajectories in a ball of
     // 12 mm around rest (cells of up to 20 mm around them stay within the
-    // range where the liver scenes' states exist).
+    // range where the liver scenes' states exist), or of half the state
+    // space's extent if that is smaller.
     const unsigned int n_samples =
       options.samples > 0 ? options.samples : (quick ? 80 : 240);
     const unsigned int  per_path = 20;
     const unsigned int  n_paths  = (n_samples + per_path - 1) / per_path;
-    const double        radius   = 0.012;
+    const double        radius   = std::min(0.012, 0.5 * p0.state_space.extent);
     const auto          paths = trajectories(n_paths, per_path, radius, 2026);
     std::vector<Point3> positions;
     for (const auto &path : paths)
@@ -564,6 +565,14 @@ namespace palpate
     std::vector<double> spacings =
       quick ? std::vector<double>{0.005, 0.01, 0.02} :
               std::vector<double>{0.0025, 0.005, 0.01, 0.02};
+    // A spacing beyond half the extent leaves the positions' cells outside
+    // the grid.
+    spacings.erase(std::remove_if(spacings.begin(),
+                                  spacings.end(),
+                                  [&](const double h) {
+                                    return h > 0.5 * p0.state_space.extent;
+                                  }),
+                   spacings.end());
     if (std::find(spacings.begin(), spacings.end(), h0) == spacings.end())
       spacings.push_back(h0);
     std::sort(spacings.begin(), spacings.end());
