@@ -5,8 +5,8 @@
 // second task, as a crashed machine would; mpirun --enable-recovery keeps
 // the others alive). The second, because every server gets two tasks in
 // the first wave around rest (one to compute, one queued); later tasks go
-// where their sources are, so under load a fourth might never come. The client must not hang and must not lose its
-// haptic side:
+// where their sources are, so under load a fourth might never come. The client
+// must not hang and must not lose its haptic side:
 // - within Engine / Server timeout (1 s here) the server is declared lost,
 //   by number, and its task is planned again;
 // - the survivor computes the whole cloud; no force is non-finite;
