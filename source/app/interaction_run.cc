@@ -122,13 +122,16 @@ namespace palpate
         "default" :
         std::filesystem::path(scene.file()).stem().string();
     std::unique_ptr<ShapeInterpolator> shape;
+    HapticLoop loop(interaction, device, p.haptics.loop_rate, max_seconds);
     if (p.effects.shape_output)
       shape = std::make_unique<ShapeInterpolator>(interaction,
                                                   p.effects.shape_output_rate,
                                                   p.output.directory,
-                                                  stem);
+                                                  stem,
+                                                  [&loop] {
+                                                    return loop.motion_time();
+                                                  });
 
-    HapticLoop loop(interaction, device, p.haptics.loop_rate, max_seconds);
     const auto t0 = Clock::now();
     interaction.attach();
     loop.start(duration);
@@ -239,8 +242,11 @@ namespace palpate
       }
     if (shape)
       out << "  wrote " << p.output.directory << "/" << stem << "-shape.pvd ("
-          << shape->frames().first << " frames, " << shape->frames().second
-          << " skipped for missing states)\n";
+          << shape->frames().first << " frames while the probe moved, "
+          << shape->frames().second << " skipped for missing states, "
+          << shape->frames_skipped_busy()
+          << " skipped while the machine was "
+             "busy)\n";
     if (!output_failures.empty())
       {
         std::string what;

@@ -68,7 +68,9 @@ namespace palpate
   SimulatedDevice::render(const Utilities::Point3 &force) noexcept
   {
     Impl &s = *impl;
-    if (s.n < s.capacity)
+    // The force log starts with the motion (the device's clock runs from
+    // 0 then); the wait for the initial cloud is not logged.
+    if (s.last_t > 0 && s.n < s.capacity)
       {
         s.time[s.n]     = s.last_t;
         s.position[s.n] = s.last_position;
@@ -284,6 +286,21 @@ namespace palpate
   {
     impl->motion_duration = motion_duration;
     impl->thread          = std::thread([this] { impl->run(); });
+  }
+
+
+
+  double
+  HapticLoop::motion_time() const noexcept
+  {
+    const long long start =
+      impl->motion_start_ns.load(std::memory_order_acquire);
+    const long long t0 = impl->t0_ns.load(std::memory_order_acquire);
+    if (start < 0 || t0 < 0)
+      return -1;
+    timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return 1e-9 * (nanoseconds(now) - t0 - start);
   }
 
 

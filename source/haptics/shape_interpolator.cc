@@ -11,6 +11,10 @@
 
 #include <deal.II/base/data_out_base.h>
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -23,14 +27,16 @@ namespace palpate
 {
   struct ShapeInterpolator::Impl
   {
-    Impl(const Interaction &i,
-         const double       r,
-         const std::string &d,
-         const std::string &s)
+    Impl(const Interaction             &i,
+         const double                   r,
+         const std::string             &d,
+         const std::string             &s,
+         const std::function<double()> &c)
       : interaction(i)
       , rate(r)
       , directory(d)
       , stem(s)
+      , clock(c)
       , system(i.mesh(), i.nodes(), i.scene().parameters)
     {}
 
@@ -40,13 +46,14 @@ namespace palpate
     void
     write_frames();
 
-    const Interaction        &interaction;
-    const double              rate;
-    const std::string         directory, stem;
-    HyperelasticSystem        system; // for the FE space and VTU output
-    std::atomic<bool>         running{false};
-    std::atomic<unsigned int> written{0}, skipped{0};
-    std::string               failure; // written by the thread before it ends
+    const Interaction            &interaction;
+    const double                  rate;
+    const std::string             directory, stem;
+    const std::function<double()> clock;
+    HyperelasticSystem            system; // for the FE space and VTU output
+    std::atomic<bool>             running{false};
+    std::atomic<unsigned int>     written{0}, skipped{0}, busy{0};
+    std::string failure; // written by the thread before it ends
     std::vector<std::pair<double, std::string>> records;
     std::thread                                 thread;
   };
@@ -78,18 +85,38 @@ namespace palpate
   void
   ShapeInterpolator::Impl::write_frames()
   {
-    using Clock        = std::chrono::steady_clock;
-    const auto  t0     = Clock::now();
-    const auto  period = std::chrono::duration<double>(1.0 / rate);
-    auto        next   = t0;
-    const auto &grid   = interaction.grid();
+    using Clock = std::chrono::steady_clock;
+    // Behind the solvers: a frame is for the eye, a state for the hand.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+    const auto t0     = Clock::now();
+    const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / rate));
+    auto              next = t0;
+    const auto       &grid = interaction.grid();
+    Utilities::Point3 last{{0, 0, 0}};
+    bool              any = false;
     while (running.load())
       {
-        next += std::chrono::duration_cast<Clock::duration>(period);
+        next += period;
+        const auto now = Clock::now();
+        if (now > next + period)
+          {
+            // Writing fell behind: skip the frames that were due, do not
+            // write them in a burst.
+            busy += static_cast<unsigned int>((now - next) / period);
+            next = now;
+          }
         std::this_thread::sleep_until(next);
 
+        const double t =
+          clock ? clock() :
+                  std::chrono::duration<double>(Clock::now() - t0).count();
+        if (clock && t < 0)
+          continue; // before the motion: nothing moves
         Utilities::Point3 x, v;
         interaction.hip().read(x, v);
+        if (any && Utilities::distance(x, last) <= 1e-6)
+          continue; // not moving: the last frame still shows it
         GridIndex             lower;
         std::array<double, 3> local;
         if (!grid.locate(x, lower, local))
@@ -132,9 +159,10 @@ namespace palpate
         std::snprintf(name, sizeof(name), "-shape-%05u.vtu", written.load());
         const std::string file = stem + name;
         system.write_vtu(blend, directory + "/" + file);
-        records.emplace_back(
-          std::chrono::duration<double>(Clock::now() - t0).count(), file);
+        records.emplace_back(t, file);
         ++written;
+        last = x;
+        any  = true;
       }
   }
 
@@ -143,8 +171,9 @@ namespace palpate
   ShapeInterpolator::ShapeInterpolator(const Interaction &interaction,
                                        const double       rate,
                                        const std::string &directory,
-                                       const std::string &stem)
-    : impl(std::make_unique<Impl>(interaction, rate, directory, stem))
+                                       const std::string &stem,
+                                       const std::function<double()> &clock)
+    : impl(std::make_unique<Impl>(interaction, rate, directory, stem, clock))
   {}
 
 
@@ -195,5 +224,13 @@ namespace palpate
   ShapeInterpolator::frames() const
   {
     return {impl->written.load(), impl->skipped.load()};
+  }
+
+
+
+  unsigned int
+  ShapeInterpolator::frames_skipped_busy() const
+  {
+    return impl->busy.load();
   }
 } // namespace palpate

@@ -139,12 +139,30 @@ main(int argc, char **argv)
       wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
     palpate::ShapeInterpolator shape(interaction, 50, "shapes", "beam");
     shape.start();
-    const bool some = wait_for([&] { return shape.frames().first >= 3; }, 60);
+    // Frames are written while the probe moves: move it.
+    unsigned int step = 0;
+    const auto   move = [&] {
+      interaction.force({{1e-5 * (++step % 20), 0, 0}});
+    };
+    const bool some = wait_for(
+      [&] {
+        move();
+        return shape.frames().first >= 3;
+      },
+      60);
     std::filesystem::remove_all("shapes");
     write_file("shapes", "a file where the directory was\n");
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    for (unsigned int k = 0; k < 20; ++k)
+      {
+        move();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
     const unsigned int before = shape.frames().first;
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    for (unsigned int k = 0; k < 20; ++k)
+      {
+        move();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
     const bool stopped_writing = shape.frames().first == before;
     shape.stop();
     const palpate::Utilities::Point3 f = interaction.force({{0, 0, 0}});

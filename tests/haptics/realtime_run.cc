@@ -11,7 +11,12 @@
 //   summary and in every row of the force log;
 // - states were computed and used, no missing-data event (the HIP is slow
 //   for this scene), fewer than 5 % of the ticks late;
-// - the summary files and the shape frames (PVD + one VTU per frame) exist.
+// - the summary files and the shape frames (PVD + one VTU per frame) exist;
+// - the force log and the shape frames share the device's clock and start
+//   with the motion: the log has a row per tick of the motion (not of the
+//   wait for the initial cloud), times in (0, motion], increasing; the
+//   frames' times are in [0, motion], at most one per 1/30 s;
+// - with every effect off and no summary file, the run leaves no file.
 
 #include <palpate/app/interaction_run.h>
 
@@ -140,8 +145,8 @@ end
   std::getline(log, line);
   deallog << "force log header: " << line << std::endl;
   unsigned int rows   = 0;
-  bool         finite = true, smooth = true;
-  double       previous[3] = {0, 0, 0};
+  bool         finite = true, smooth = true, clock = true;
+  double       previous[3] = {0, 0, 0}, previous_t = 0;
   while (std::getline(log, line))
     {
       double             v[7];
@@ -152,6 +157,9 @@ end
         in >> comma >> v[k];
       for (unsigned int k = 0; k < 7; ++k)
         finite = finite && std::isfinite(v[k]);
+      clock = clock && v[0] > previous_t &&
+              v[0] <= number("motion_duration_s") + 0.01;
+      previous_t          = v[0];
       const double change = std::sqrt(std::pow(v[4] - previous[0], 2) +
                                       std::pow(v[5] - previous[1], 2) +
                                       std::pow(v[6] - previous[2], 2));
@@ -160,7 +168,10 @@ end
         previous[d] = v[4 + d];
       ++rows;
     }
-  deallog << "force log: one row per tick: " << (rows == ticks ? "yes" : "NO")
+  const double motion_ticks = number("motion_duration_s") * rate;
+  deallog << "force log: one row per tick of the motion (2 %): "
+          << (std::abs(rows / motion_ticks - 1) < 0.02 ? "yes" : "NO")
+          << ", times in (0, motion] and increasing: " << (clock ? "yes" : "NO")
           << ", all finite: " << (finite ? "yes" : "NO")
           << ", change per row <= 0.01 N: " << (smooth ? "yes" : "NO")
           << std::endl;
@@ -176,10 +187,52 @@ end
   for (std::size_t at = pvd_text.find("<DataSet"); at != std::string::npos;
        at             = pvd_text.find("<DataSet", at + 1))
     ++datasets;
+  // The frames' times (file="...") in the PVD: timestep="t".
+  bool   in_motion = true;
+  double last_t    = -1;
+  for (std::size_t at = pvd_text.find("timestep=\""); at != std::string::npos;
+       at             = pvd_text.find("timestep=\"", at + 1))
+    {
+                  const double t = std::stod(pvd_text.substr(at + 10));
+                  in_motion      = in_motion && t >= 0 &&
+                              t <= number("motion_duration_s") + 0.05 && t > last_t;
+                  last_t = t;
+    }
+  deallog << "shape frames on the device's clock, during the motion only, at "
+             "most 30 per s: "
+          << (in_motion && frames <= number("motion_duration_s") * 30 + 2 ?
+                "yes" :
+                "NO")
+          << std::endl;
   deallog << "shape frames: " << (frames > 0 ? "some" : "NONE")
           << ", one VTU each: " << (vtus == frames ? "yes" : "NO")
           << ", all in the PVD: " << (datasets == frames ? "yes" : "NO")
           << std::endl;
+  // Every effect off, no summary file: no file at all.
+  {
+    std::string quiet = text;
+    for (const auto &[from, to] :
+         std::vector<std::pair<std::string, std::string>>{
+           {"set Shape output      = true", "set Shape output      = false"},
+           {"set Force log         = true", "set Force log         = false"},
+           {"set Directory       = realtime-output",
+            "set Directory       = quiet-output"},
+           {"set Summary formats = csv, json", "set Summary formats ="},
+           {"set Duration  = 1.5", "set Duration  = 0.3"}})
+      {
+        const auto at = quiet.find(from);
+        AssertThrow(at != std::string::npos, dealii::ExcInternalError());
+        quiet.replace(at, from.size(), to);
+      }
+    write_file("quiet.prm", quiet);
+    std::filesystem::remove_all("quiet-output");
+    std::ostringstream quiet_report;
+    palpate::run_interaction(quiet_report, palpate::Scene::read("quiet.prm"));
+    const bool none = !std::filesystem::exists("quiet-output") ||
+                      std::filesystem::is_empty("quiet-output");
+    deallog << "every effect off: no file written: " << (none ? "yes" : "NO")
+            << std::endl;
+  }
   deallog << "JSON summary written: "
           << (std::filesystem::exists("realtime-output/realtime-summary.json") ?
                 "yes" :

@@ -117,6 +117,13 @@ namespace palpate
     bool
     finished() const noexcept;
 
+    /**
+     * The device's clock: seconds since the motion started (the force
+     * log's time base), negative before it did. Any thread.
+     */
+    double
+    motion_time() const noexcept;
+
     /** Stop (if still running) and wait for the thread. */
     void
     join();

@@ -4,6 +4,7 @@
 #ifndef palpate_haptics_shape_interpolator_h
 #define palpate_haptics_shape_interpolator_h
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -18,15 +19,24 @@ namespace palpate
    * VTU frame, with a PVD file that ParaView opens as a time series. It
    * exists only when the scene switches shape output on. Frames whose cell
    * is not complete are skipped (and counted).
+   *
+   * It writes only what changes and never competes with the solvers: a
+   * frame is written only while the probe moves (the HIP moved since the
+   * last frame; with a clock, also only once the motion started), its
+   * thread runs at nice 19, and when writing falls behind (a busy
+   * machine) the frames it missed are skipped and counted, not written in
+   * a burst. With @p clock (the haptic loop's motion_time()) the frames'
+   * times are the force log's.
    */
   class ShapeInterpolator
   {
   public:
     /** Frames go to @p directory as STEM-shape-NNNNN.vtu and STEM-shape.pvd. */
-    ShapeInterpolator(const Interaction &interaction,
-                      const double       rate,
-                      const std::string &directory,
-                      const std::string &stem);
+    ShapeInterpolator(const Interaction             &interaction,
+                      const double                   rate,
+                      const std::string             &directory,
+                      const std::string             &stem,
+                      const std::function<double()> &clock = nullptr);
 
     ~ShapeInterpolator();
 
@@ -41,6 +51,10 @@ namespace palpate
     /** Frames written, and frames skipped for missing states. */
     std::pair<unsigned int, unsigned int>
     frames() const;
+
+    /** Frames skipped because writing fell behind (a busy machine). */
+    unsigned int
+    frames_skipped_busy() const;
 
     /**
      * After stop(): why the shape output stopped early (a frame or the PVD
