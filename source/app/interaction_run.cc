@@ -7,6 +7,8 @@
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/haptics/trajectory.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/state.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
@@ -223,6 +225,52 @@ namespace palpate
           output_failures.push_back(file + ": " + e.what());
         }
     };
+    if (p.effects.vtu_export)
+      {
+        // The states the haptic loop used, for ParaView, and an index.
+        const std::string index =
+          p.output.directory + "/" + stem + "-states.csv";
+        write(index, [&] {
+          const HyperelasticSystem system(interaction.mesh(),
+                                          interaction.nodes(),
+                                          p);
+          std::ofstream            csv(index);
+          csv << "point,i,j,k,x_m,y_m,z_m,fx_N,fy_N,fz_N,file\n"
+              << std::setprecision(9);
+          unsigned int written = 0, not_held = 0;
+          for (const unsigned int point : interaction.used_points())
+            {
+              const auto state = interaction.cache().state(point);
+              if (!state)
+                {
+                  ++not_held; // dropped for the memory budget, or on a server
+                  continue;
+                }
+              const GridIndex   g    = interaction.grid().index(point);
+              const std::string file = stem + "-state-" + std::to_string(g[0]) +
+                                       "_" + std::to_string(g[1]) + "_" +
+                                       std::to_string(g[2]) + ".vtu";
+              system.write_vtu(*state, p.output.directory + "/" + file);
+              csv << point << "," << g[0] << "," << g[1] << "," << g[2] << ","
+                  << state->active_displacement[0] << ","
+                  << state->active_displacement[1] << ","
+                  << state->active_displacement[2] << "," << state->force[0]
+                  << "," << state->force[1] << "," << state->force[2] << ","
+                  << file << "\n";
+              ++written;
+            }
+          if (!csv)
+            throw std::runtime_error("cannot write '" + index + "'");
+          out << "  wrote " << written
+              << " states the haptic loop used as VTU (" << stem
+              << "-state-I_J_K.vtu; warp by 'displacement' in ParaView)"
+              << (not_held > 0 ? ", " + std::to_string(not_held) +
+                                   " not held here (dropped for the memory "
+                                   "budget, or kept by an MPI server)" :
+                                 std::string())
+              << "\n";
+        });
+      }
     for (const auto &format : p.output.summary_formats)
       {
         const std::string file =

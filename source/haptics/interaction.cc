@@ -313,6 +313,18 @@ namespace palpate
 
 
 
+  std::vector<unsigned int>
+  Interaction::used_points() const
+  {
+    std::vector<unsigned int> points;
+    for (unsigned int p = 0; p < impl->grid.size(); ++p)
+      if (impl->used[p].load(std::memory_order_relaxed))
+        points.push_back(p);
+    return points;
+  }
+
+
+
   const std::array<double, 9> &
   Interaction::stiffness() const noexcept
   {

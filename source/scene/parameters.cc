@@ -547,7 +547,11 @@ namespace palpate
                           Patterns::Bool(),
                           "Whether computed states (deformed mesh, "
                           "displacement, fixed and active nodes) are written "
-                          "as VTU files for ParaView.");
+                          "as VTU files for ParaView: with palpate solve, the "
+                          "state; in an interaction, at its end, every state "
+                          "the haptic loop interpolated from "
+                          "(STEM-state-I_J_K.vtu, grid index I, J, K), with "
+                          "an index STEM-states.csv.");
         prm.declare_entry("Force log",
                           "false",
                           Patterns::Bool(),

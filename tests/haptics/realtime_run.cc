@@ -16,6 +16,7 @@
 //   with the motion: the log has a row per tick of the motion (not of the
 //   wait for the initial cloud), times in (0, motion], increasing; the
 //   frames' times are in [0, motion], at most one per 1/30 s;
+// - VTU export writes every state the haptic loop used, with an index;
 // - with every effect off and no summary file, the run leaves no file.
 
 #include <palpate/app/interaction_run.h>
@@ -67,6 +68,7 @@ subsection Effects
   set Shape output      = true
   set Shape output rate = 30
   set Force log         = true
+  set VTU export        = true
 end
 subsection State space
   set Grid spacing = 0.002
@@ -181,7 +183,9 @@ end
   unsigned int       vtus   = 0;
   for (const auto &entry :
        std::filesystem::directory_iterator("realtime-output"))
-    vtus += entry.path().extension() == ".vtu";
+    vtus +=
+      entry.path().extension() == ".vtu" &&
+      entry.path().filename().string().find("-shape-") != std::string::npos;
   const std::string pvd_text = read_file("realtime-output/realtime-shape.pvd");
   unsigned int      datasets = 0;
   for (std::size_t at = pvd_text.find("<DataSet"); at != std::string::npos;
@@ -208,6 +212,24 @@ end
           << ", one VTU each: " << (vtus == frames ? "yes" : "NO")
           << ", all in the PVD: " << (datasets == frames ? "yes" : "NO")
           << std::endl;
+  // VTU export in an interaction: every state the haptic loop used.
+  {
+    std::ifstream index("realtime-output/realtime-states.csv");
+    std::string   row;
+    std::getline(index, row);
+    unsigned int states = 0, files = 0;
+    while (std::getline(index, row))
+      {
+        ++states;
+        files += std::filesystem::exists("realtime-output/" +
+                                         row.substr(row.rfind(',') + 1));
+      }
+    deallog << "VTU export: one file per state the loop used: "
+            << (states == number("states_used") && files == states ? "yes" :
+                                                                     "NO")
+            << std::endl;
+  }
+
   // Every effect off, no summary file: no file at all.
   {
     std::string quiet = text;
@@ -215,6 +237,7 @@ end
          std::vector<std::pair<std::string, std::string>>{
            {"set Shape output      = true", "set Shape output      = false"},
            {"set Force log         = true", "set Force log         = false"},
+           {"set VTU export        = true", "set VTU export        = false"},
            {"set Directory       = realtime-output",
             "set Directory       = quiet-output"},
            {"set Summary formats = csv, json", "set Summary formats ="},

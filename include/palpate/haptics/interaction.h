@@ -11,6 +11,7 @@
 #include <array>
 #include <iosfwd>
 #include <memory>
+#include <vector>
 
 namespace palpate
 {
@@ -94,6 +95,12 @@ namespace palpate
      */
     const std::array<double, 9> &
     stiffness() const noexcept;
+
+    /** The grid points whose states the haptic loop interpolated from
+     * (the corners of the complete cells it visited), in grid order. Not
+     * for the real-time side. */
+    std::vector<unsigned int>
+    used_points() const;
 
     /** Whether the last force() call found all 8 corners of its cell. */
     bool
