@@ -114,12 +114,22 @@ namespace palpate
              "incompressible), or Polynomial degree = 2, or nu <= 0.49.\n";
     }
 
+    // Effects are what a scene switches on; incompressibility is the
+    // material's (see Material above), not an effect.
     std::vector<std::string> on, off;
     (p.effects.gravity ? on : off).push_back("gravity");
-    (m.incompressible() ? on : off)
-      .push_back(m.incompressible() ?
-                   "incompressibility (implied by " + m.model_name + ")" :
-                   "incompressibility");
+    if (p.effects.surface_traction)
+      on.push_back("surface traction (" +
+                   Utilities::to_string(p.effects.traction, 4) + " Pa on " +
+                   std::to_string(nodes.traction_faces) +
+                   " faces with boundary id " +
+                   std::to_string(p.effects.traction_boundary_id) + ", " +
+                   Utilities::to_string(nodes.traction_area, 4) + " m^2)");
+    else
+      off.push_back("surface traction");
+    if (p.boundary_conditions.active_node.tip_radius > 0)
+      on.push_back("probe tip (" +
+                   std::to_string(1 + nodes.tip_vertices.size()) + " nodes)");
     (p.effects.shape_output ? on : off).push_back("shape output");
     (p.effects.vtu_export ? on : off).push_back("VTU export");
     (p.effects.force_log ? on : off).push_back("force log");

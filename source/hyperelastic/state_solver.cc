@@ -182,6 +182,9 @@ namespace palpate
         p.state_space.interpolation == "tricubic Hermite";
       const auto start = Clock::now();
       system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
+      if (p.effects.surface_traction)
+        system->add_surface_traction(p.effects.traction_boundary_id,
+                                     p.effects.traction);
       linear_solver =
         LinearSolver::create(p.linear_solver.solver, p.linear_solver.ordering);
       linear_solver->analyze(system->sparsity());

@@ -194,6 +194,37 @@ namespace palpate
     }
     selection.fixed_description = description.str();
 
+    // The surface traction's faces: they must exist.
+    if (const auto &e = scene.parameters.effects; e.surface_traction)
+      {
+        std::set<unsigned int> ids;
+        for (const auto &face : mesh.surface_faces())
+          {
+            ids.insert(face.boundary_id);
+            if (face.boundary_id != e.traction_boundary_id)
+              continue;
+            const Point3 a = minus(x[face.vertices[1]], x[face.vertices[0]]);
+            const Point3 b = minus(x[face.vertices[2]], x[face.vertices[0]]);
+            const Point3 n = {{a[1] * b[2] - a[2] * b[1],
+                               a[2] * b[0] - a[0] * b[2],
+                               a[0] * b[1] - a[1] * b[0]}};
+            ++selection.traction_faces;
+            selection.traction_area += 0.5 * Utilities::norm(n);
+          }
+        if (selection.traction_faces == 0)
+          {
+            std::string list;
+            for (const unsigned int id : ids)
+              list += (list.empty() ? "" : ", ") + std::to_string(id);
+            throw scene.error("Effects/Traction boundary id",
+                              "no boundary face of the mesh has id " +
+                                std::to_string(e.traction_boundary_id) +
+                                ", so the surface traction would load nothing",
+                              "use one of the mesh's boundary ids: " + list +
+                                ".");
+          }
+      }
+
     // The active node.
     if (a.selection == "node id")
       {

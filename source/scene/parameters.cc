@@ -531,6 +531,25 @@ namespace palpate
                           "0, 0, -9.81",
                           point_pattern(),
                           "Gravitational acceleration vector g (m/s^2).");
+        prm.declare_entry("Surface traction",
+                          "false",
+                          Patterns::Bool(),
+                          "Whether a traction (a pressure or shear load, "
+                          "e.g. a neighbouring organ resting on this one) "
+                          "acts on the boundary faces with Traction boundary "
+                          "id. A dead load per reference area: it keeps its "
+                          "direction and size as the body deforms.");
+        prm.declare_entry("Traction boundary id",
+                          "1",
+                          Patterns::Integer(0, 255),
+                          "The boundary id of the loaded faces: a Gmsh "
+                          "physical surface tag, a VTK cell data "
+                          "'boundary id'; the generated beam numbers its "
+                          "faces 0 (x = 0), 1 (x = L), 2, 3 (y), 4, 5 (z).");
+        prm.declare_entry("Traction",
+                          "0, 0, 0",
+                          point_pattern(),
+                          "The traction vector t (Pa = N/m^2) on those faces.");
         prm.declare_entry("Shape output",
                           "false",
                           Patterns::Bool(),
@@ -571,10 +590,13 @@ namespace palpate
         gravity = prm.get_bool("Gravity");
         gravitational_acceleration =
           get_point(prm, "Gravitational acceleration");
-        shape_output      = prm.get_bool("Shape output");
-        shape_output_rate = prm.get_double("Shape output rate");
-        vtu_export        = prm.get_bool("VTU export");
-        force_log         = prm.get_bool("Force log");
+        surface_traction     = prm.get_bool("Surface traction");
+        traction_boundary_id = prm.get_integer("Traction boundary id");
+        traction             = get_point(prm, "Traction");
+        shape_output         = prm.get_bool("Shape output");
+        shape_output_rate    = prm.get_double("Shape output rate");
+        vtu_export           = prm.get_bool("VTU export");
+        force_log            = prm.get_bool("Force log");
       }
       prm.leave_subsection();
     }

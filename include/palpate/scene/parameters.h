@@ -162,6 +162,11 @@ namespace palpate
       /** Body force rho*g. */
       bool   gravity;
       Point3 gravitational_acceleration;
+      /** A dead-load traction (Pa, per reference area) on the boundary
+       * faces with one boundary id. */
+      bool         surface_traction;
+      unsigned int traction_boundary_id;
+      Point3       traction;
       /** Shape (whole displacement field) interpolation for rendering. */
       bool   shape_output;
       double shape_output_rate;
