@@ -5,6 +5,8 @@
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
@@ -20,6 +22,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -38,7 +43,28 @@ namespace palpate
       , stem(s)
       , clock(c)
       , system(i.mesh(), i.nodes(), i.scene().parameters)
-    {}
+    {
+      prepare_frames();
+    }
+
+    /**
+     * What every frame shares, written once: the reference mesh (points,
+     * tetrahedra) and the fixed/active flags as VTU text, and which DoFs
+     * hold each vertex's displacement. A frame then writes only the
+     * displacement: a fraction of a millisecond, where a full state's VTU
+     * (reactions by an assembly, DataOut's patches) took several.
+     */
+    void
+    prepare_frames();
+
+    /** Write the frame with displacement @p solution and force @p force. */
+    void
+    write_frame(const std::vector<double> &solution,
+                const Utilities::Point3   &force,
+                const std::string         &file) const;
+
+    std::vector<std::array<unsigned int, 3>> vertex_dofs;
+    std::string                              flags, geometry;
 
     void
     run();
@@ -57,6 +83,99 @@ namespace palpate
     std::vector<std::pair<double, std::string>> records;
     std::thread                                 thread;
   };
+
+
+
+  void
+  ShapeInterpolator::Impl::prepare_frames()
+  {
+    const Mesh &mesh      = interaction.mesh();
+    const auto &x         = mesh.vertices();
+    const auto &position  = system.dof_positions();
+    const auto &component = system.dof_components();
+    std::map<std::array<double, 3>, unsigned int> vertex_at;
+    for (unsigned int v = 0; v < x.size(); ++v)
+      vertex_at[{{x[v][0], x[v][1], x[v][2]}}] = v;
+    vertex_dofs.assign(x.size(), {{0, 0, 0}});
+    for (std::size_t d = 0; d < position.size(); ++d)
+      if (component[d] < 3)
+        if (const auto v = vertex_at.find(
+              {{position[d][0], position[d][1], position[d][2]}});
+            v != vertex_at.end())
+          vertex_dofs[v->second][component[d]] = d;
+
+    const auto       &nodes = interaction.nodes();
+    std::vector<char> fixed(x.size(), 0), active(x.size(), 0);
+    for (const unsigned int v : nodes.fixed_vertices)
+      fixed[v] = 1;
+    active[nodes.active_vertex] = 1;
+    for (const unsigned int v : nodes.tip_vertices)
+      active[v] = 1;
+    std::ostringstream f;
+    f << "<DataArray type=\"UInt8\" Name=\"fixed\" format=\"ascii\">\n";
+    for (const char c : fixed)
+      f << int(c) << " ";
+    f << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"active\" "
+         "format=\"ascii\">\n";
+    for (const char c : active)
+      f << int(c) << " ";
+    f << "\n</DataArray>\n";
+    flags = f.str();
+
+    std::ostringstream g;
+    g << std::setprecision(9)
+      << "<Points>\n<DataArray type=\"Float64\" "
+         "NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (const auto &p : x)
+      g << p[0] << " " << p[1] << " " << p[2] << "\n";
+    g << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int32\" "
+         "Name=\"connectivity\" format=\"ascii\">\n";
+    for (const auto &c : mesh.cells())
+      g << c[0] << " " << c[1] << " " << c[2] << " " << c[3] << "\n";
+    g << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" "
+         "format=\"ascii\">\n";
+    for (unsigned int c = 1; c <= mesh.n_cells(); ++c)
+      g << 4 * c << " ";
+    g << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" "
+         "format=\"ascii\">\n";
+    for (unsigned int c = 0; c < mesh.n_cells(); ++c)
+      g << "10 ";
+    g << "\n</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n"
+         "</VTKFile>\n";
+    geometry = g.str();
+  }
+
+
+
+  void
+  ShapeInterpolator::Impl::write_frame(const std::vector<double> &solution,
+                                       const Utilities::Point3   &force,
+                                       const std::string         &file) const
+  {
+    std::ofstream out(file);
+    if (!out)
+      throw std::runtime_error("cannot write the file '" + file + "'");
+    out << std::setprecision(7)
+        << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" "
+           "version=\"0.1\" byte_order=\"LittleEndian\">\n"
+           "<UnstructuredGrid>\n<FieldData>\n<DataArray type=\"Float64\" "
+           "Name=\"force\" NumberOfTuples=\"1\" NumberOfComponents=\"3\" "
+           "format=\"ascii\">"
+        << force[0] << " " << force[1] << " " << force[2]
+        << "</DataArray>\n</FieldData>\n<Piece NumberOfPoints=\""
+        << vertex_dofs.size() << "\" NumberOfCells=\""
+        << interaction.mesh().n_cells()
+        << "\">\n<PointData Vectors=\"displacement\">\n<DataArray "
+           "type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
+           "format=\"ascii\">\n";
+    for (const auto &d : vertex_dofs)
+      out << solution[d[0]] << " " << solution[d[1]] << " " << solution[d[2]]
+          << "\n";
+    out << "</DataArray>\n" << flags << "</PointData>\n" << geometry;
+    out.flush();
+    if (!out)
+      throw std::runtime_error("cannot write the file '" + file + "'");
+  }
 
 
 
@@ -158,7 +277,7 @@ namespace palpate
         char name[64];
         std::snprintf(name, sizeof(name), "-shape-%05u.vtu", written.load());
         const std::string file = stem + name;
-        system.write_vtu(blend, directory + "/" + file);
+        write_frame(blend.solution, blend.force, directory + "/" + file);
         records.emplace_back(t, file);
         ++written;
         last = x;

@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// benchmarks/run effects [--quick] [--repeats N]
+//
+// What each effect costs (issue 13): the liver-stvk interaction
+// (liver501, 2 solver threads, the 1 kHz loop, the 2.86 s stroke at
+// 28 mm/s after the initial cloud) with every effect off, then each effect
+// on alone: gravity, a surface traction (10 Pa on the whole surface),
+// shape output at 30 Hz, the force log, VTU export. For each: the median
+// time per state, the initial cloud's time, deadline misses and the
+// interpolation's p99.9. overhead_pct is against the runs with every
+// effect off; those runs, repeated, show the noise: an effect that is off
+// is not even constructed, so "none" is the floor.
+//
+// Target: shape output at 30 Hz costs the solvers <= 10 %.
+//
+// --quick: none and shape output, once each (about 30 s).
+
+#include <palpate/app/interaction_run.h>
+#include <palpate/base/environment.h>
+#include <palpate/haptics/run_summary.h>
+#include <palpate/scene/scene.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "machine.h"
+
+using namespace palpate;
+
+namespace
+{
+  struct Run
+  {
+    double state_ms = 0, cloud_s = 0, interp_p999_us = 0;
+    double deadline_misses = 0, missing = 0;
+  };
+
+  Run
+  run(const std::string &effect)
+  {
+    Scene scene        = Scene::read(std::string(PALPATE_SOURCE_DIR) +
+                              "/parameters/liver-stvk.prm");
+    auto &p            = scene.parameters;
+    p.output.directory = "effects-output";
+    p.output.summary_formats.clear();
+    p.output.print_timings = false;
+    auto &e                = p.effects;
+    e.gravity = e.surface_traction = e.shape_output = e.force_log =
+      e.vtu_export                                  = false;
+    if (effect == "gravity")
+      e.gravity = true;
+    else if (effect == "surface-traction")
+      {
+        e.surface_traction     = true;
+        e.traction_boundary_id = 1; // liver501: the whole surface
+        e.traction             = {{0, 0, -10}};
+      }
+    else if (effect == "shape-output")
+      {
+        e.shape_output      = true;
+        e.shape_output_rate = 30;
+      }
+    else if (effect == "force-log")
+      e.force_log = true;
+    else if (effect == "vtu-export")
+      e.vtu_export = true;
+    std::filesystem::remove_all("effects-output");
+    std::ostringstream quiet;
+    const RunSummary   s = run_interaction(quiet, scene);
+    std::filesystem::remove_all("effects-output");
+    Run r;
+    r.state_ms        = s.median_state_ms;
+    r.cloud_s         = s.motion_start;
+    r.interp_p999_us  = s.interpolation_p999_us;
+    r.deadline_misses = s.deadline_misses;
+    r.missing         = s.missing_events;
+    return r;
+  }
+
+  double
+  median(std::vector<double> v)
+  {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0 : v[v.size() / 2];
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Environment  env(argc, argv);
+  bool         quick   = false;
+  unsigned int repeats = 2;
+  for (int i = 1; i < argc; ++i)
+    {
+      const std::string a = argv[i];
+      if (a == "--quick")
+        quick = true;
+      else if (a == "--repeats" && i + 1 < argc)
+        repeats = std::max(1, std::stoi(argv[++i]));
+      else
+        {
+          std::cerr
+            << "usage: benchmarks/run effects [--quick] [--repeats N]\n";
+          return 2;
+        }
+    }
+  if (quick)
+    repeats = 1;
+  const std::vector<std::string> effects =
+    quick ? std::vector<std::string>{"none", "shape-output"} :
+            std::vector<std::string>{"none",
+                                     "gravity",
+                                     "surface-traction",
+                                     "shape-output",
+                                     "force-log",
+                                     "vtu-export"};
+  std::cout << "What each effect costs: liver-stvk interaction, " << machine()
+            << ", " << repeats << " run(s) each, interleaved"
+            << (quick ? " [--quick]" : "") << "\n\n";
+
+  // Interleaved rounds, so that a slow minute of the machine does not fall
+  // on one effect only.
+  std::vector<std::vector<Run>> runs(effects.size());
+  for (unsigned int round = 0; round < repeats; ++round)
+    for (unsigned int k = 0; k < effects.size(); ++k)
+      {
+        runs[k].push_back(run(effects[k]));
+        std::cout << "  " << std::left << std::setw(17) << effects[k]
+                  << " state " << std::fixed << std::setprecision(2)
+                  << runs[k].back().state_ms << " ms, initial cloud "
+                  << runs[k].back().cloud_s << " s, deadline misses "
+                  << std::setprecision(0) << runs[k].back().deadline_misses
+                  << ", interpolation p99.9 " << std::setprecision(2)
+                  << runs[k].back().interp_p999_us << " us\n"
+                  << std::flush;
+      }
+
+  const auto stat = [&](const unsigned int k, double Run::*field) {
+    std::vector<double> v;
+    for (const auto &r : runs[k])
+      v.push_back(r.*field);
+    return median(v);
+  };
+  const double none_ms = stat(0, &Run::state_ms);
+  double       noise   = 0;
+  for (const auto &r : runs[0])
+    noise = std::max(noise, 100 * std::abs(r.state_ms / none_ms - 1));
+
+  std::cout << "\n| effect | state (ms) | overhead | initial cloud (s) | "
+               "deadline misses | interpolation p99.9 (us) |\n"
+               "|---|---|---|---|---|---|\n";
+  std::ostringstream results;
+  results << std::fixed;
+  for (unsigned int k = 0; k < effects.size(); ++k)
+    {
+      const double ms       = stat(k, &Run::state_ms);
+      const double overhead = 100 * (ms / none_ms - 1);
+      std::cout << "| " << effects[k] << " | " << std::setprecision(2) << ms
+                << " | " << std::setprecision(1) << overhead << " % | "
+                << std::setprecision(2) << stat(k, &Run::cloud_s) << " | "
+                << std::setprecision(0) << stat(k, &Run::deadline_misses)
+                << " | " << std::setprecision(2)
+                << stat(k, &Run::interp_p999_us) << " |\n";
+      results << "RESULT effects effect=" << effects[k]
+              << " state_ms=" << std::setprecision(2) << ms
+              << " overhead_pct=" << std::setprecision(1) << overhead
+              << " cloud_s=" << std::setprecision(2) << stat(k, &Run::cloud_s)
+              << " deadline_misses=" << std::setprecision(0)
+              << stat(k, &Run::deadline_misses)
+              << (k == 0 ? " noise_pct=" + std::to_string(noise) : "")
+              << (effects[k] == "shape-output" ?
+                    std::string(" target_met=") +
+                      (overhead <= 10 ? "yes" : "no") :
+                    "")
+              << "\n";
+    }
+  std::cout << "\n" << results.str();
+}
