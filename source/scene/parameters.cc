@@ -556,7 +556,12 @@ namespace palpate
                           "Whether the whole displacement field is "
                           "interpolated for rendering during an interaction "
                           "(the shape interpolator) and written as VTU/PVD "
-                          "frames. Off: the shape interpolator does not run.");
+                          "frames: only while the probe moves, on the force "
+                          "log's clock (seconds since the motion started), "
+                          "at low priority (frames the machine has no time "
+                          "for are skipped and counted). Interactions only; "
+                          "palpate solve writes its state with VTU export. "
+                          "Off: the shape interpolator does not run.");
         prm.declare_entry("Shape output rate",
                           "30",
                           Patterns::Double(0.),
@@ -575,7 +580,10 @@ namespace palpate
                           "false",
                           Patterns::Bool(),
                           "Whether the force at the active node is logged to "
-                          "a CSV file (time s, position m, force N).");
+                          "a CSV file (time s, position m, force N): in an "
+                          "interaction one row per haptic tick from the "
+                          "motion's start (time 0) on; with palpate solve, "
+                          "the target and the force.");
       }
       prm.leave_subsection();
     }
