@@ -90,6 +90,49 @@ namespace palpate
         return;
       write_entry(e, force, stiffness, PointStatus::available, generation);
     }
+
+    /**
+     * The real-time read of a point behind its sequence lock: its force
+     * and, if @p stiffness is given, its stiffness; false if the point is
+     * not available in @p generation_read or a write raced with the read.
+     */
+    template <typename Entry>
+    bool
+    read_entry(const Entry           &e,
+               const std::uint64_t    generation_read,
+               Utilities::Point3     &force,
+               std::array<double, 9> *stiffness,
+               bool                  *has_stiffness) noexcept
+    {
+      const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
+      if (s1 & 1)
+        return false;
+      const auto status     = e.status.load(std::memory_order_relaxed);
+      const auto generation = e.generation.load(std::memory_order_relaxed);
+      Utilities::Point3     f;
+      std::array<double, 9> k;
+      bool                  has = false;
+      for (unsigned int d = 0; d < 3; ++d)
+        f[d] = e.force[d].load(std::memory_order_relaxed);
+      if (stiffness != nullptr)
+        {
+          has = e.has_stiffness.load(std::memory_order_relaxed);
+          for (unsigned int d = 0; d < 9; ++d)
+            k[d] = e.stiffness[d].load(std::memory_order_relaxed);
+        }
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (e.sequence.load(std::memory_order_relaxed) != s1 ||
+          generation != generation_read ||
+          status != static_cast<std::uint8_t>(PointStatus::available))
+        return false;
+      force = f;
+      if (stiffness != nullptr)
+        {
+          *stiffness     = k;
+          *has_stiffness = has;
+        }
+      return true;
+    }
   } // namespace
 
 
@@ -403,22 +446,7 @@ namespace palpate
                          const std::uint64_t generation_read,
                          Utilities::Point3  &force) const noexcept
   {
-    const Entry        &e  = entries[point];
-    const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
-    if (s1 & 1)
-      return false;
-    const auto        status     = e.status.load(std::memory_order_relaxed);
-    const auto        generation = e.generation.load(std::memory_order_relaxed);
-    Utilities::Point3 f;
-    for (unsigned int d = 0; d < 3; ++d)
-      f[d] = e.force[d].load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
-    if (e.sequence.load(std::memory_order_relaxed) != s1 ||
-        generation != generation_read ||
-        status != static_cast<std::uint8_t>(PointStatus::available))
-      return false;
-    force = f;
-    return true;
+    return read_entry(entries[point], generation_read, force, nullptr, nullptr);
   }
 
 
@@ -430,28 +458,8 @@ namespace palpate
                                        std::array<double, 9> &stiffness,
                                        bool &has_stiffness) const noexcept
   {
-    const Entry        &e  = entries[point];
-    const std::uint32_t s1 = e.sequence.load(std::memory_order_acquire);
-    if (s1 & 1)
-      return false;
-    const auto        status     = e.status.load(std::memory_order_relaxed);
-    const auto        generation = e.generation.load(std::memory_order_relaxed);
-    const bool        has = e.has_stiffness.load(std::memory_order_relaxed);
-    Utilities::Point3 f;
-    for (unsigned int d = 0; d < 3; ++d)
-      f[d] = e.force[d].load(std::memory_order_relaxed);
-    std::array<double, 9> k;
-    for (unsigned int d = 0; d < 9; ++d)
-      k[d] = e.stiffness[d].load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
-    if (e.sequence.load(std::memory_order_relaxed) != s1 ||
-        generation != generation_read ||
-        status != static_cast<std::uint8_t>(PointStatus::available))
-      return false;
-    force         = f;
-    stiffness     = k;
-    has_stiffness = has;
-    return true;
+    return read_entry(
+      entries[point], generation_read, force, &stiffness, &has_stiffness);
   }
 
 
