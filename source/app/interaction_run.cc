@@ -126,13 +126,13 @@ namespace palpate
     std::unique_ptr<ShapeInterpolator> shape;
     HapticLoop loop(interaction, device, p.haptics.loop_rate, max_seconds);
     if (p.effects.shape_output)
-      shape = std::make_unique<ShapeInterpolator>(interaction,
-                                                  p.effects.shape_output_rate,
-                                                  p.output.directory,
-                                                  stem,
-                                                  [&loop] {
-                                                    return loop.motion_time();
-                                                  });
+      shape = std::make_unique<ShapeInterpolator>(
+        interaction,
+        p.effects.shape_output_rate,
+        p.output.directory,
+        stem,
+        [&loop] { return loop.motion_time(); },
+        p.effects.shape_output_limit * 1048576.0);
 
     const auto t0 = Clock::now();
     interaction.attach();
@@ -293,8 +293,14 @@ namespace palpate
           << shape->frames().first << " frames while the probe moved, "
           << shape->frames().second << " skipped for missing states, "
           << shape->frames_skipped_busy()
-          << " skipped while the machine was "
-             "busy)\n";
+          << " skipped while the machine was busy"
+          << (shape->frames_over_limit() > 0 ?
+                ", " + std::to_string(shape->frames_over_limit()) +
+                  " left out beyond Shape output limit = " +
+                  Utilities::to_string(p.effects.shape_output_limit, 4) +
+                  " MiB" :
+                std::string())
+          << ")\n";
     if (!output_failures.empty())
       {
         std::string what;

@@ -36,12 +36,14 @@ namespace palpate
          const double                   r,
          const std::string             &d,
          const std::string             &s,
-         const std::function<double()> &c)
+         const std::function<double()> &c,
+         const double                   m)
       : interaction(i)
       , rate(r)
       , directory(d)
       , stem(s)
       , clock(c)
+      , max_bytes(m)
       , system(i.mesh(), i.nodes(), i.scene().parameters)
     {
       prepare_frames();
@@ -61,7 +63,7 @@ namespace palpate
     void
     write_frame(const std::vector<double> &solution,
                 const Utilities::Point3   &force,
-                const std::string         &file) const;
+                const std::string         &file);
 
     std::vector<std::array<unsigned int, 3>> vertex_dofs;
     std::string                              flags, geometry;
@@ -76,9 +78,11 @@ namespace palpate
     const double                  rate;
     const std::string             directory, stem;
     const std::function<double()> clock;
+    const double                  max_bytes;
+    double                        bytes = 0;
     HyperelasticSystem            system; // for the FE space and VTU output
     std::atomic<bool>             running{false};
-    std::atomic<unsigned int>     written{0}, skipped{0}, busy{0};
+    std::atomic<unsigned int>     written{0}, skipped{0}, busy{0}, over{0};
     std::string failure; // written by the thread before it ends
     std::vector<std::pair<double, std::string>> records;
     std::thread                                 thread;
@@ -150,7 +154,7 @@ namespace palpate
   void
   ShapeInterpolator::Impl::write_frame(const std::vector<double> &solution,
                                        const Utilities::Point3   &force,
-                                       const std::string         &file) const
+                                       const std::string         &file)
   {
     std::ofstream out(file);
     if (!out)
@@ -173,6 +177,7 @@ namespace palpate
           << "\n";
     out << "</DataArray>\n" << flags << "</PointData>\n" << geometry;
     out.flush();
+    bytes += static_cast<double>(out.tellp());
     if (!out)
       throw std::runtime_error("cannot write the file '" + file + "'");
   }
@@ -236,6 +241,13 @@ namespace palpate
         interaction.hip().read(x, v);
         if (any && Utilities::distance(x, last) <= 1e-6)
           continue; // not moving: the last frame still shows it
+        if (bytes >= max_bytes)
+          {
+            ++over; // the output limit: no more frames
+            last = x;
+            any  = true;
+            continue;
+          }
         GridIndex             lower;
         std::array<double, 3> local;
         if (!grid.locate(x, lower, local))
@@ -291,8 +303,14 @@ namespace palpate
                                        const double       rate,
                                        const std::string &directory,
                                        const std::string &stem,
-                                       const std::function<double()> &clock)
-    : impl(std::make_unique<Impl>(interaction, rate, directory, stem, clock))
+                                       const std::function<double()> &clock,
+                                       const double                   max_bytes)
+    : impl(std::make_unique<Impl>(interaction,
+                                  rate,
+                                  directory,
+                                  stem,
+                                  clock,
+                                  max_bytes))
   {}
 
 
@@ -351,5 +369,13 @@ namespace palpate
   ShapeInterpolator::frames_skipped_busy() const
   {
     return impl->busy.load();
+  }
+
+
+
+  unsigned int
+  ShapeInterpolator::frames_over_limit() const
+  {
+    return impl->over.load();
   }
 } // namespace palpate

@@ -566,6 +566,15 @@ namespace palpate
                           "30",
                           Patterns::Double(0.),
                           "Rate of the shape interpolator (Hz).");
+        prm.declare_entry("Shape output limit",
+                          "1000",
+                          Patterns::Double(0.),
+                          "The most the shape frames of one run may write "
+                          "(MiB), so that a long run cannot fill the disk: "
+                          "beyond it no frame is written, and the run says "
+                          "how many it left out. A frame of a 500-node liver "
+                          "is about 85 KiB (about 2.5 MiB per second at "
+                          "30 Hz).");
         prm.declare_entry("VTU export",
                           "false",
                           Patterns::Bool(),
@@ -603,6 +612,7 @@ namespace palpate
         traction             = get_point(prm, "Traction");
         shape_output         = prm.get_bool("Shape output");
         shape_output_rate    = prm.get_double("Shape output rate");
+        shape_output_limit   = prm.get_double("Shape output limit");
         vtu_export           = prm.get_bool("VTU export");
         force_log            = prm.get_bool("Force log");
       }

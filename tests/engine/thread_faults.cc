@@ -182,4 +182,33 @@ main(int argc, char **argv)
             << (all_finite(f) ? "finite" : "NOT FINITE") << std::endl;
     std::filesystem::remove("shapes");
   }
+
+  {
+    deallog << "--- the shape output reaches its limit (Effects / Shape "
+               "output limit)"
+            << std::endl;
+    std::filesystem::remove_all("limited");
+    palpate::Interaction interaction(scene);
+    interaction.attach();
+    const bool cloud =
+      wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
+    // One byte: the first frame is written, then none.
+    palpate::ShapeInterpolator shape(
+      interaction, 50, "limited", "beam", nullptr, 1);
+    shape.start();
+    unsigned int step     = 0;
+    const bool   left_out = wait_for(
+      [&] {
+        interaction.force({{1e-5 * (++step % 20), 0, 0}});
+        return shape.frames_over_limit() >= 3;
+      },
+      60);
+    shape.stop();
+    interaction.detach();
+    deallog << "initial cloud: " << (cloud ? "yes" : "NO")
+            << ", frames written: " << shape.frames().first
+            << ", later frames left out and counted: "
+            << (left_out ? "yes" : "NO") << std::endl;
+    std::filesystem::remove_all("limited");
+  }
 }

@@ -26,7 +26,9 @@ namespace palpate
    * thread runs at nice 19, and when writing falls behind (a busy
    * machine) the frames it missed are skipped and counted, not written in
    * a burst. With @p clock (the haptic loop's motion_time()) the frames'
-   * times are the force log's.
+   * times are the force log's. Once the frames written reach @p max_bytes
+   * no more are written (they are counted): a long run cannot fill the
+   * disk.
    */
   class ShapeInterpolator
   {
@@ -36,7 +38,8 @@ namespace palpate
                       const double                   rate,
                       const std::string             &directory,
                       const std::string             &stem,
-                      const std::function<double()> &clock = nullptr);
+                      const std::function<double()> &clock     = nullptr,
+                      const double                   max_bytes = 1e300);
 
     ~ShapeInterpolator();
 
@@ -55,6 +58,10 @@ namespace palpate
     /** Frames skipped because writing fell behind (a busy machine). */
     unsigned int
     frames_skipped_busy() const;
+
+    /** Frames left out because the frames reached @p max_bytes. */
+    unsigned int
+    frames_over_limit() const;
 
     /**
      * After stop(): why the shape output stopped early (a frame or the PVD

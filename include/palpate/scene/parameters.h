@@ -170,6 +170,9 @@ namespace palpate
       /** Shape (whole displacement field) interpolation for rendering. */
       bool   shape_output;
       double shape_output_rate;
+      /** The most the shape frames may write (MiB): a long run cannot
+       * fill the disk. */
+      double shape_output_limit;
       /** VTU export of computed states. */
       bool vtu_export;
       /** CSV log of the force at the active node. */
