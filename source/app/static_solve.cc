@@ -2,16 +2,22 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/app/static_solve.h>
+#include <palpate/base/exceptions.h>
+#include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 
+#include <deal.II/base/data_out_base.h>
+
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <memory>
 #include <ostream>
 
 namespace palpate
@@ -45,7 +51,33 @@ namespace palpate
         << "  active node:    from rest to (" << Utilities::to_string(target, 4)
         << ") m\n";
 
-    const State state = solver.solve(solver.rest_state(), target);
+    // Shape output: the path from rest, a frame per converged increment.
+    const std::string stem =
+      scene.file().empty() ?
+        "default" :
+        std::filesystem::path(scene.file()).stem().string();
+    std::vector<std::pair<double, std::string>> frames;
+    std::unique_ptr<ShapeFrames>                writer;
+    const State                                 rest = solver.rest_state();
+    if (p.effects.shape_output)
+      {
+        std::filesystem::create_directories(p.output.directory);
+        writer           = std::make_unique<ShapeFrames>(mesh, nodes, system);
+        const auto frame = [&](const State &s, const double t) {
+          char name[64];
+          std::snprintf(name,
+                        sizeof(name),
+                        "-shape-%05u.vtu",
+                        static_cast<unsigned int>(frames.size()));
+          const std::string file = stem + name;
+          writer->write(s.solution, s.force, p.output.directory + "/" + file);
+          frames.emplace_back(t, file);
+        };
+        frame(rest, 0);
+        solver.set_increment_observer(frame);
+      }
+    const State state = solver.solve(rest, target);
+    solver.set_increment_observer(nullptr);
 
     out
       << "  Newton history (force residual relative to the force scale, after\n"
@@ -102,10 +134,18 @@ namespace palpate
     // Effects: only when the scene asks for them.
     if (p.effects.vtu_export || p.effects.force_log)
       std::filesystem::create_directories(p.output.directory);
-    const std::string stem =
-      scene.file().empty() ?
-        "default" :
-        std::filesystem::path(scene.file()).stem().string();
+    if (writer)
+      {
+        const std::string file = p.output.directory + "/" + stem + "-shape.pvd";
+        std::ofstream     pvd(file);
+        dealii::DataOutBase::write_pvd_record(pvd, frames);
+        pvd.flush();
+        if (!pvd)
+          throw OutputError("cannot write the file '" + file + "'");
+        out << "  wrote " << file << " (" << frames.size()
+            << " frames: rest, then the end of every increment; time = the "
+               "fraction of the path)\n";
+      }
     if (p.effects.vtu_export)
       {
         const std::string file = p.output.directory + "/" + stem + "-state.vtu";

@@ -45,28 +45,8 @@ namespace palpate
       , clock(c)
       , max_bytes(m)
       , system(i.mesh(), i.nodes(), i.scene().parameters)
-    {
-      prepare_frames();
-    }
-
-    /**
-     * What every frame shares, written once: the reference mesh (points,
-     * tetrahedra) and the fixed/active flags as VTU text, and which DoFs
-     * hold each vertex's displacement. A frame then writes only the
-     * displacement: a fraction of a millisecond, where a full state's VTU
-     * (reactions by an assembly, DataOut's patches) took several.
-     */
-    void
-    prepare_frames();
-
-    /** Write the frame with displacement @p solution and force @p force. */
-    void
-    write_frame(const std::vector<double> &solution,
-                const Utilities::Point3   &force,
-                const std::string         &file);
-
-    std::vector<std::array<unsigned int, 3>> vertex_dofs;
-    std::string                              flags, geometry;
+      , frames(i.mesh(), i.nodes(), system)
+    {}
 
     void
     run();
@@ -80,7 +60,8 @@ namespace palpate
     const std::function<double()> clock;
     const double                  max_bytes;
     double                        bytes = 0;
-    HyperelasticSystem            system; // for the FE space and VTU output
+    HyperelasticSystem            system; // for the FE space
+    ShapeFrames                   frames;
     std::atomic<bool>             running{false};
     std::atomic<unsigned int>     written{0}, skipped{0}, busy{0}, over{0};
     std::string failure; // written by the thread before it ends
@@ -90,10 +71,11 @@ namespace palpate
 
 
 
-  void
-  ShapeInterpolator::Impl::prepare_frames()
+  ShapeFrames::ShapeFrames(const Mesh               &mesh,
+                           const NodeSelection      &nodes,
+                           const HyperelasticSystem &system)
+    : n_cells(mesh.n_cells())
   {
-    const Mesh &mesh      = interaction.mesh();
     const auto &x         = mesh.vertices();
     const auto &position  = system.dof_positions();
     const auto &component = system.dof_components();
@@ -108,7 +90,6 @@ namespace palpate
             v != vertex_at.end())
           vertex_dofs[v->second][component[d]] = d;
 
-    const auto       &nodes = interaction.nodes();
     std::vector<char> fixed(x.size(), 0), active(x.size(), 0);
     for (const unsigned int v : nodes.fixed_vertices)
       fixed[v] = 1;
@@ -151,10 +132,10 @@ namespace palpate
 
 
 
-  void
-  ShapeInterpolator::Impl::write_frame(const std::vector<double> &solution,
-                                       const Utilities::Point3   &force,
-                                       const std::string         &file)
+  double
+  ShapeFrames::write(const std::vector<double> &solution,
+                     const Utilities::Point3   &force,
+                     const std::string         &file) const
   {
     std::ofstream out(file);
     if (!out)
@@ -167,8 +148,7 @@ namespace palpate
            "format=\"ascii\">"
         << force[0] << " " << force[1] << " " << force[2]
         << "</DataArray>\n</FieldData>\n<Piece NumberOfPoints=\""
-        << vertex_dofs.size() << "\" NumberOfCells=\""
-        << interaction.mesh().n_cells()
+        << vertex_dofs.size() << "\" NumberOfCells=\"" << n_cells
         << "\">\n<PointData Vectors=\"displacement\">\n<DataArray "
            "type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
            "format=\"ascii\">\n";
@@ -177,7 +157,7 @@ namespace palpate
           << "\n";
     out << "</DataArray>\n" << flags << "</PointData>\n" << geometry;
     out.flush();
-    bytes += static_cast<double>(out.tellp());
+    return static_cast<double>(out.tellp());
     if (!out)
       throw std::runtime_error("cannot write the file '" + file + "'");
   }
@@ -289,7 +269,8 @@ namespace palpate
         char name[64];
         std::snprintf(name, sizeof(name), "-shape-%05u.vtu", written.load());
         const std::string file = stem + name;
-        write_frame(blend.solution, blend.force, directory + "/" + file);
+        bytes +=
+          frames.write(blend.solution, blend.force, directory + "/" + file);
         records.emplace_back(t, file);
         ++written;
         last = x;

@@ -246,10 +246,11 @@ namespace palpate
              r <= 1e3 * settings.residual_tolerance * force_scale;
     }
 
-    std::unique_ptr<HyperelasticSystem> system;
-    std::unique_ptr<LinearSolver>       linear_solver;
-    Parameters::NonlinearSolver         settings;
-    double                              setup_time = 0;
+    std::unique_ptr<HyperelasticSystem>        system;
+    std::unique_ptr<LinearSolver>              linear_solver;
+    Parameters::NonlinearSolver                settings;
+    double                                     setup_time = 0;
+    std::function<void(const State &, double)> observer;
 
     // Work vectors, reused from solve to solve.
     std::vector<double> residual, trial_residual, best_residual, matrix, step,
@@ -821,6 +822,13 @@ namespace palpate
           std::max(state.max_increment_iterations, o.iterations);
         if (o.status == SolveStatus::converged)
           {
+            if (impl->observer)
+              {
+                State at;
+                impl->system->to_state(x, at);
+                at.active_displacement = point(t1);
+                impl->observer(at, t1);
+              }
             previous   = saved;
             previous_t = t0;
             current_t  = t1;
@@ -871,6 +879,15 @@ namespace palpate
       }
     state.wall_time = seconds_since(start);
     return state;
+  }
+
+
+
+  void
+  StateSolver::set_increment_observer(
+    std::function<void(const State &, double)> observer)
+  {
+    impl->observer = std::move(observer);
   }
 
 

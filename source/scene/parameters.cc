@@ -559,8 +559,9 @@ namespace palpate
                           "frames: only while the probe moves, on the force "
                           "log's clock (seconds since the motion started), "
                           "at low priority (frames the machine has no time "
-                          "for are skipped and counted). Interactions only; "
-                          "palpate solve writes its state with VTU export. "
+                          "for are skipped and counted). With palpate solve: "
+                          "the path from rest, a frame per staging "
+                          "increment. "
                           "Off: the shape interpolator does not run.");
         prm.declare_entry("Shape output rate",
                           "30",

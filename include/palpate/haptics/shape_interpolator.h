@@ -4,13 +4,48 @@
 #ifndef palpate_haptics_shape_interpolator_h
 #define palpate_haptics_shape_interpolator_h
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace palpate
 {
   class Interaction;
+  class Mesh;
+  class HyperelasticSystem;
+  struct NodeSelection;
+
+  /**
+   * Writes shape frames: the body's displacement as a VTU file for
+   * ParaView (warp by 'displacement'), with the fixed and active nodes
+   * flagged and the force on the probe as field data. What every frame
+   * shares - the reference mesh (points, tetrahedra), the flags, which
+   * DoFs hold each vertex's displacement - is written to text once, so a
+   * frame writes only the displacement: a fraction of a millisecond, where
+   * a full state's VTU (reactions by an assembly, DataOut's patches) takes
+   * several.
+   */
+  class ShapeFrames
+  {
+  public:
+    ShapeFrames(const Mesh               &mesh,
+                const NodeSelection      &nodes,
+                const HyperelasticSystem &system);
+
+    /** Write the frame of @p solution (a state's) and @p force (N) to
+     * @p file; returns its size (bytes). Throws if it cannot be written. */
+    double
+    write(const std::vector<double>   &solution,
+          const std::array<double, 3> &force,
+          const std::string           &file) const;
+
+  private:
+    std::vector<std::array<unsigned int, 3>> vertex_dofs;
+    std::string                              flags, geometry;
+    unsigned int                             n_cells;
+  };
 
   /**
    * The shape interpolator: at Effects / Shape output rate (about 30 Hz),

@@ -8,6 +8,7 @@
 #include <palpate/hyperelastic/state.h>
 #include <palpate/scene/parameters.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -78,6 +79,15 @@ namespace palpate
           const State             *behind2 = nullptr);
 
     /** The discrete system. */
+    /**
+     * Call @p observer with the state at the end of every converged
+     * increment of the staging and its path parameter t in (0, 1] (1: the
+     * target). Null: none (the default). For output that shows the path,
+     * e.g. `palpate solve` with shape output.
+     */
+    void
+    set_increment_observer(std::function<void(const State &, double)> observer);
+
     const HyperelasticSystem &
     system() const;
 
