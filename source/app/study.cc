@@ -376,17 +376,8 @@ namespace palpate
     {
       std::set<unsigned int> r;
       for (const unsigned int q : points)
-        {
-          const GridIndex g = grid.index(q);
-          for (int i = -1; i <= 1; ++i)
-            for (int j = -1; j <= 1; ++j)
-              for (int k = -1; k <= 1; ++k)
-                {
-                  const GridIndex n = {{g[0] + i, g[1] + j, g[2] + k}};
-                  if (grid.contains(n))
-                    r.insert(grid.linear(n));
-                }
-        }
+        for (const unsigned int n : grid.neighbourhood(q))
+          r.insert(n);
       return r;
     }
 

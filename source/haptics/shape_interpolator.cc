@@ -44,8 +44,9 @@ namespace palpate
       , stem(s)
       , clock(c)
       , max_bytes(m)
-      , system(i.mesh(), i.nodes(), i.scene().parameters)
-      , frames(i.mesh(), i.nodes(), system)
+      , frames(i.mesh(),
+               i.nodes(),
+               HyperelasticSystem(i.mesh(), i.nodes(), i.scene().parameters))
     {}
 
     void
@@ -60,7 +61,6 @@ namespace palpate
     const std::function<double()> clock;
     const double                  max_bytes;
     double                        bytes = 0;
-    HyperelasticSystem            system; // for the FE space
     ShapeFrames                   frames;
     std::atomic<bool>             running{false};
     std::atomic<unsigned int>     written{0}, skipped{0}, busy{0}, over{0};

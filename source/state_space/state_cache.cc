@@ -374,15 +374,8 @@ namespace palpate
   void
   StateCache::update_cross_around(const unsigned int point)
   {
-    const GridIndex g = grid.index(point);
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k)
-          {
-            const GridIndex q = {{g[0] + i, g[1] + j, g[2] + k}};
-            if (grid.contains(q))
-              update_cross(grid.linear(q));
-          }
+    for (const unsigned int q : grid.neighbourhood(point))
+      update_cross(q);
   }
 
 

@@ -139,4 +139,19 @@ namespace palpate
              (((k >> 2) & 1) ? s[2] : 1 - s[2]);
     return w;
   }
+  std::vector<unsigned int>
+  StateGrid::neighbourhood(const unsigned int point) const
+  {
+    const GridIndex           g = index(point);
+    std::vector<unsigned int> points;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k)
+          {
+            const GridIndex n = {{g[0] + i, g[1] + j, g[2] + k}};
+            if (contains(n))
+              points.push_back(linear(n));
+          }
+    return points;
+  }
 } // namespace palpate

@@ -7,6 +7,7 @@
 #include <palpate/base/utilities.h>
 
 #include <array>
+#include <vector>
 
 namespace palpate
 {
@@ -99,6 +100,12 @@ namespace palpate
      */
     std::array<unsigned int, 8>
     corners(const GridIndex &lower) const noexcept;
+
+    /** @p point and its (up to 26) neighbours inside the grid: the
+     * points whose cross derivatives depend on it, and those its own
+     * depend on. Not for the real-time side. */
+    std::vector<unsigned int>
+    neighbourhood(const unsigned int point) const;
 
   private:
     double       h;
