@@ -82,7 +82,9 @@ main(int argc, char **argv)
 
       const auto element = [&]() -> std::string {
         return m == "mr" ?
-                 " element=" + scene.parameters.material_model.mr_element :
+                 " element=" +
+                   scene.parameters.material_model.get("Mooney-Rivlin",
+                                                       "Element") :
                  "";
       };
       double hermite10 = -1, trilinear5 = -1;

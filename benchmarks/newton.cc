@@ -175,8 +175,11 @@ namespace
           file.replace(file.rfind("liver501"), 8, o.mesh);
         }
       if (o.material == "mr")
-        scene.parameters.material_model.mr_element =
-          o.element == "taylor-hood" ? "Taylor-Hood" : "P1-P1";
+        scene.parameters.material_model.set("Mooney-Rivlin",
+                                            "Element",
+                                            o.element == "taylor-hood" ?
+                                              "Taylor-Hood" :
+                                              "P1-P1");
       // Each transition is one grid step or less: one increment.
       scene.parameters.nonlinear_solver.max_increment_length = o.spacing;
       return scene;

@@ -2,6 +2,8 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/app/scene_report.h>
+#include <palpate/hyperelastic/effect.h>
+#include <palpate/hyperelastic/material.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
@@ -80,33 +82,17 @@ namespace palpate
               std::string());
     s << "\n";
 
-    const auto &m = p.material_model;
-    s << "Material\n  model:         " << m.model_name << std::setprecision(6);
-    if (m.model_name == "St.Venant-Kirchhoff")
-      s << ", E = " << m.stvk_youngs_modulus
-        << " Pa, nu = " << m.stvk_poissons_ratio;
-    else if (m.model_name == "Neo-Hookean")
-      s << ", E = " << m.nh_youngs_modulus
-        << " Pa, nu = " << m.nh_poissons_ratio;
-    else
-      {
-        s << ", C10 = " << m.mr_c10 << " Pa, C01 = " << m.mr_c01 << " Pa, ";
-        if (m.incompressible())
-          s << "exactly incompressible, " << m.mr_element << " elements";
-        else
-          s << "nearly incompressible, bulk modulus " << m.mr_bulk_modulus
-            << " Pa";
-      }
-    s << "\n";
+    const auto &m        = p.material_model;
+    const auto  material = Material::create(m);
+    s << "Material\n  model:         " << m.model_name << ", "
+      << material->description() << "\n";
     {
       // Volumetric locking: a compressible law on linear tetrahedra near
       // nu = 0.5 is far too stiff (the divergence-free displacements of P1
       // tetrahedra are almost only rigid motions).
-      const double nu = m.model_name == "St.Venant-Kirchhoff" ?
-                          m.stvk_poissons_ratio :
-                        m.model_name == "Neo-Hookean" ? m.nh_poissons_ratio :
-                                                        0;
-      if (nu >= 0.495 && p.discretization.polynomial_degree == 1)
+      const double nu = material->poissons_ratio();
+      if (material->formulation().pressure == Formulation::Pressure::none &&
+          nu >= 0.495 && p.discretization.polynomial_degree == 1)
         s << "  warning:       nu = " << nu
           << " on linear tetrahedra locks (volumetric locking): the body "
              "is too stiff and Newton may stagnate. For a nearly "
@@ -117,16 +103,15 @@ namespace palpate
     // Effects are what a scene switches on; incompressibility is the
     // material's (see Material above), not an effect.
     std::vector<std::string> on, off;
-    (p.effects.gravity ? on : off).push_back("gravity");
-    if (p.effects.surface_traction)
-      on.push_back("surface traction (" +
-                   Utilities::to_string(p.effects.traction, 4) + " Pa on " +
-                   std::to_string(nodes.traction_faces) +
-                   " faces with boundary id " +
-                   std::to_string(p.effects.traction_boundary_id) + ", " +
-                   Utilities::to_string(nodes.traction_area, 4) + " m^2)");
-    else
-      off.push_back("surface traction");
+    for (const auto &plugin : EffectRegistry::plugins())
+      if (!p.effects.on(plugin.name))
+        {
+          std::string name = plugin.name;
+          name[0]          = std::tolower(name[0]);
+          off.push_back(name);
+        }
+    for (const auto &effect : Effect::create_enabled(p.effects))
+      on.push_back(effect->description(mesh, p));
     if (p.boundary_conditions.active_node.tip_radius > 0)
       on.push_back("probe tip (" +
                    std::to_string(1 + nodes.tip_vertices.size()) + " nodes)");

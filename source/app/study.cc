@@ -5,6 +5,7 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/material.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
@@ -489,9 +490,15 @@ namespace palpate
     std::string
     material_key(const Parameters::MaterialModel &m)
     {
-      return m.model_name == "St.Venant-Kirchhoff" ? "stvk" :
-             m.model_name == "Neo-Hookean"         ? "nh" :
-                                                     "mooney-rivlin";
+      if (m.model_name == "St.Venant-Kirchhoff")
+        return "stvk";
+      if (m.model_name == "Neo-Hookean")
+        return "nh";
+      // Any other plug-in: its name, lower case, spaces as dashes.
+      std::string key = m.model_name;
+      for (char &c : key)
+        c = c == ' ' ? '-' : static_cast<char>(std::tolower(c));
+      return key;
     }
 
     std::string
@@ -905,22 +912,22 @@ namespace palpate
                      {1, finer_cost});
     if (p2_knob)
       {
-        Scene p2 = scene;
-        auto &m  = p2.parameters.material_model;
-        if (m.model_name == "Mooney-Rivlin" && m.incompressible())
-          m.mr_element = "Taylor-Hood";
+        // An incompressible plug-in's element pair fixes the degree: the
+        // knob is its Element entry (P1-P1 -> Taylor-Hood).
+        Scene      p2   = scene;
+        auto      &m    = p2.parameters.material_model;
+        const auto f    = Material::create(m)->formulation();
+        const bool pair = f.displacement_degree > 0;
+        if (pair)
+          m.set(m.model_name, "Element", "Taylor-Hood");
         else
           p2.parameters.discretization.polynomial_degree = 2;
-        const std::string low =
-          m.model_name == "Mooney-Rivlin" && m.incompressible() ? "P1-P1" :
-                                                                  "P1";
-        const std::string high =
-          m.model_name == "Mooney-Rivlin" && m.incompressible() ?
-            "Taylor-Hood P2-P1" :
-            "P2";
-        if (p0.discretization.polynomial_degree == 1 &&
-            !(m.model_name == "Mooney-Rivlin" &&
-              p0.material_model.mr_element == "Taylor-Hood"))
+        const std::string  low    = pair ? "P1-P1" : "P1";
+        const std::string  high   = pair ? "Taylor-Hood P2-P1" : "P2";
+        const unsigned int degree = f.displacement_degree > 0 ?
+                                      f.displacement_degree :
+                                      p0.discretization.polynomial_degree;
+        if (degree == 1)
           discretisation("element", {scene, p2}, {low, high}, {1, p2_cost});
       }
     progress.finish();

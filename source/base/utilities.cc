@@ -153,5 +153,36 @@ namespace palpate
         }
       return p;
     }
+    Point3
+    minus(const Point3 &a, const Point3 &b)
+    {
+      return {{a[0] - b[0], a[1] - b[1], a[2] - b[2]}};
+    }
+
+
+
+    double
+    dot(const Point3 &a, const Point3 &b)
+    {
+      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    }
+
+
+
+    Point3
+    cross(const Point3 &a, const Point3 &b)
+    {
+      return {{a[1] * b[2] - a[2] * b[1],
+               a[2] * b[0] - a[0] * b[2],
+               a[0] * b[1] - a[1] * b[0]}};
+    }
+
+
+
+    Point3
+    scaled(const Point3 &a, const double s)
+    {
+      return {{s * a[0], s * a[1], s * a[2]}};
+    }
   } // namespace Utilities
 } // namespace palpate

@@ -103,6 +103,7 @@ namespace palpate
     const Mesh                  &mesh;
     NodeSelection                nodes;
     std::unique_ptr<Material>    material;
+    const Formulation            formulation;
     const bool                   mixed; // pressure field present
     const bool                   taylor_hood;
     const double                 kappa_inverse; // 0: exact incompressibility
@@ -138,8 +139,7 @@ namespace palpate
     SparsityCSR                    pattern;
 
     double              beta, L, pressure_scale = 1;
-    bool                gravity;
-    std::vector<double> f_gravity, f_surface;
+    std::vector<double> f_body, f_surface;
     double              load_factor = 1;
 
     unsigned int                     n_threads;
@@ -155,16 +155,17 @@ namespace palpate
     : mesh(mesh)
     , nodes(nodes)
     , material(Material::create(p.material_model))
-    , mixed(material->isochoric())
-    , taylor_hood(mixed && p.material_model.mr_element == "Taylor-Hood")
-    , kappa_inverse(mixed &&
-                        p.material_model.mr_incompressibility == "penalty" ?
-                      1.0 / p.material_model.mr_bulk_modulus :
+    , formulation(material->formulation())
+    , mixed(formulation.pressure != Formulation::Pressure::none)
+    , taylor_hood(mixed && formulation.displacement_degree == 2)
+    , kappa_inverse(formulation.pressure == Formulation::Pressure::penalty ?
+                      1.0 / formulation.bulk_modulus :
                       0.0)
-    , stabilize(mixed && !taylor_hood &&
-                p.material_model.mr_stabilization == "Brezzi-Pitkaranta")
-    , alpha(p.material_model.mr_stabilization_factor)
-    , degree(mixed ? (taylor_hood ? 2 : 1) : p.discretization.polynomial_degree)
+    , stabilize(mixed && !taylor_hood && formulation.stabilization)
+    , alpha(formulation.stabilization_factor)
+    , degree(formulation.displacement_degree > 0 ?
+               formulation.displacement_degree :
+               p.discretization.polynomial_degree)
     , fe(make_fe(degree, mixed))
     , mapping(FE_SimplexP<3>(1))
     , quadrature(p.discretization.quadrature_order > 0 ?
@@ -173,7 +174,6 @@ namespace palpate
                    // mass matrix needs the 4-point rule on P1.
                    (degree == 1 ? (kappa_inverse > 0 ? 2 : 1) : 3))
     , dof_handler(mesh.triangulation())
-    , gravity(p.effects.gravity)
     , n_threads(p.nonlinear_solver.assembly_threads)
   {
     dof_handler.distribute_dofs(*fe);
@@ -300,11 +300,7 @@ namespace palpate
         pressure_gradients.resize(std::size_t(n_cells) * n_pressure * 3);
         stabilization_tau.resize(n_cells);
       }
-    if (gravity)
-      f_gravity.assign(n_dofs, 0.0);
-    const auto  &g_accel = p.effects.gravitational_acceleration;
-    const double rho     = p.material_model.density;
-    const double mu      = material->shear_modulus();
+    const double mu = material->shear_modulus();
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         const unsigned int c = cell->active_cell_index();
@@ -328,12 +324,6 @@ namespace palpate
                              k) *
                               3 +
                             d] = g[d];
-                // Gravity is a dead load: integrate it once, here.
-                if (gravity)
-                  for (unsigned int comp = 0; comp < 3; ++comp)
-                    f_gravity[dofs[local_dof[3 * k + comp]]] +=
-                      rho * g_accel[comp] * fe_values.shape_value(k, q) *
-                      fe_values.JxW(q);
               }
           }
         if (mixed)
@@ -458,10 +448,9 @@ namespace palpate
   HyperelasticSystem::Impl::subtract_dead_loads(double     *f,
                                                 const Keep &keep) const
   {
-    if (gravity)
-      for (unsigned int d = 0; d < f_gravity.size(); ++d)
-        if (keep(d))
-          f[d] -= f_gravity[d];
+    for (unsigned int d = 0; d < f_body.size(); ++d)
+      if (keep(d))
+        f[d] -= f_body[d];
     if (!f_surface.empty())
       for (unsigned int d = 0; d < f_surface.size(); ++d)
         if (keep(d))
@@ -853,6 +842,32 @@ namespace palpate
 
 
   void
+  HyperelasticSystem::add_body_force(const Utilities::Point3 &b)
+  {
+    // A dead load: integrated once, here, not at every residual.
+    Impl &s = *impl;
+    if (s.f_body.empty())
+      s.f_body.assign(n_dofs(), 0.0);
+    FEValues<3>                          fe_values(s.mapping,
+                          s.fe->base_element(0),
+                          s.quadrature,
+                          update_values | update_JxW_values);
+    std::vector<types::global_dof_index> dofs(s.dofs_per_cell);
+    for (const auto &cell : s.dof_handler.active_cell_iterators())
+      {
+        fe_values.reinit(typename Triangulation<3>::cell_iterator(cell));
+        cell->get_dof_indices(dofs);
+        for (unsigned int q = 0; q < s.quadrature.size(); ++q)
+          for (unsigned int k = 0; k < s.n_nodes_per_cell; ++k)
+            for (unsigned int c = 0; c < 3; ++c)
+              s.f_body[dofs[s.local_dof[3 * k + c]]] +=
+                b[c] * fe_values.shape_value(k, q) * fe_values.JxW(q);
+      }
+  }
+
+
+
+  void
   HyperelasticSystem::set_load_factor(const double factor)
   {
     impl->load_factor = factor;
@@ -927,7 +942,7 @@ namespace palpate
 
     // Dead loads, only when there are any (gravity switched on, tractions
     // added): no work at all otherwise.
-    if (s.gravity || !s.f_surface.empty())
+    if (!s.f_body.empty() || !s.f_surface.empty())
       {
         for (unsigned int d = 0; d < s.eq_of_dof.size(); ++d)
           s.f_work[d] = 0;

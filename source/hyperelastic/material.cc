@@ -2,8 +2,12 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/base/exceptions.h>
+#include <palpate/base/plugins.templates.h>
 #include <palpate/base/utilities.h>
 #include <palpate/hyperelastic/material.h>
+#include <palpate/scene/scene.h>
+
+#include <deal.II/base/parameter_handler.h>
 
 #include <cmath>
 
@@ -20,15 +24,114 @@ namespace palpate
   std::unique_ptr<Material>
   Material::create(const Parameters::MaterialModel &p)
   {
-    if (p.model_name == "St.Venant-Kirchhoff")
-      return std::make_unique<StVenantKirchhoff>(p.stvk_youngs_modulus,
-                                                 p.stvk_poissons_ratio);
-    if (p.model_name == "Neo-Hookean")
-      return std::make_unique<NeoHookean>(p.nh_youngs_modulus,
-                                          p.nh_poissons_ratio);
-    if (p.model_name == "Mooney-Rivlin")
-      return std::make_unique<MooneyRivlin>(p.mr_c10, p.mr_c01);
-    throw std::invalid_argument("unknown material " + p.model_name);
+    const auto entries = p.models.find(p.model_name);
+    return MaterialRegistry::create(p.model_name,
+                                    entries == p.models.end() ?
+                                      Plugins::Entries() :
+                                      entries->second);
+  }
+
+
+
+  void
+  check_modulus(const std::string &entry, const double value)
+  {
+    if (!(value > 0))
+      throw Plugins::EntryError(entry,
+                                "must be positive",
+                                "set it in Pa, e.g. 15465 for liver.");
+  }
+
+
+
+  std::vector<std::pair<std::string, double>>
+  Material::moduli() const
+  {
+    return {{"", youngs_modulus()}};
+  }
+
+
+
+  void
+  check_poissons_ratio(const std::string &entry, const double nu)
+  {
+    if (nu >= 0.5)
+      throw Plugins::EntryError(
+        entry,
+        "nu = 0.5 makes the Lame parameter lambda infinite",
+        "use nu < 0.5 (e.g. 0.49, the paper's value), or the "
+        "incompressible Mooney-Rivlin model.");
+    if (nu <= -1)
+      throw Plugins::EntryError(
+        entry,
+        "nu = -1 makes the shear modulus E/(2(1+nu)) infinite",
+        "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
+  }
+
+
+
+  void
+  declare_incompressibility(dealii::ParameterHandler &prm)
+  {
+    using dealii::Patterns::Double;
+    using dealii::Patterns::Selection;
+    prm.declare_entry("Incompressibility",
+                      "exact",
+                      Selection("exact|penalty"),
+                      "exact: J = 1 is imposed by a pressure field that "
+                      "acts as a Lagrange multiplier (mixed u-p "
+                      "elements, as in the paper); penalty: nearly "
+                      "incompressible with the bulk modulus below.");
+    prm.declare_entry("Bulk modulus",
+                      "1e6",
+                      Double(0.),
+                      "Bulk modulus kappa of the volumetric energy "
+                      "kappa/2 (J - 1)^2 for Incompressibility = "
+                      "penalty (Pa).");
+    prm.declare_entry("Element",
+                      "P1-P1",
+                      Selection("P1-P1|Taylor-Hood"),
+                      "Displacement-pressure element pair for exact "
+                      "incompressibility: P1-P1 (the paper's, one "
+                      "pressure per node, not inf-sup stable) or "
+                      "Taylor-Hood P2-P1 (stable).");
+    prm.declare_entry("Stabilization",
+                      "Brezzi-Pitkaranta",
+                      Selection("none|Brezzi-Pitkaranta"),
+                      "Pressure stabilisation for P1-P1: none, or the "
+                      "Brezzi-Pitkaranta term -alpha h^2/mu (grad p, "
+                      "grad q) that suppresses checkerboard pressure.");
+    prm.declare_entry("Stabilization factor",
+                      "0.05",
+                      Double(0.),
+                      "alpha of the Brezzi-Pitkaranta term "
+                      "(dimensionless).");
+  }
+
+
+
+  Formulation
+  parse_incompressibility(const dealii::ParameterHandler &prm)
+  {
+    Formulation f;
+    f.pressure     = prm.get("Incompressibility") == "penalty" ?
+                       Formulation::Pressure::penalty :
+                       Formulation::Pressure::exact;
+    f.bulk_modulus = prm.get_double("Bulk modulus");
+    if (f.pressure == Formulation::Pressure::penalty)
+      {
+        if (!(f.bulk_modulus > 0))
+          throw Plugins::EntryError(
+            "Bulk modulus",
+            "the bulk modulus must be positive",
+            "set it in Pa, typically 1000 times C10 + C01 for soft tissue.");
+      }
+    f.element             = prm.get("Element");
+    f.displacement_degree = f.element == "Taylor-Hood" ? 2 : 1;
+    f.stabilization =
+      f.element == "P1-P1" && prm.get("Stabilization") == "Brezzi-Pitkaranta";
+    f.stabilization_factor = prm.get_double("Stabilization factor");
+    return f;
   }
 
 
@@ -117,8 +220,53 @@ namespace palpate
   std::string
   StVenantKirchhoff::description() const
   {
-    return "St.Venant-Kirchhoff, E = " + Utilities::to_string(E) +
+    return "E = " + Utilities::to_string(E) +
            " Pa, nu = " + Utilities::to_string(nu);
+  }
+
+
+
+  std::vector<std::pair<std::string, double>>
+  StVenantKirchhoff::moduli() const
+  {
+    return {{"Young's modulus", E}};
+  }
+
+
+
+  double
+  StVenantKirchhoff::poissons_ratio() const
+  {
+    return nu;
+  }
+
+
+
+  void
+  StVenantKirchhoff::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("Young's modulus",
+                      "15465",
+                      dealii::Patterns::Double(0.),
+                      "Young's modulus E (Pa). The Lame parameters are "
+                      "lambda = E nu/((1+nu)(1-2nu)), mu = E/(2(1+nu)).");
+    prm.declare_entry("Poisson's ratio",
+                      "0.49",
+                      dealii::Patterns::Double(-1., 0.5),
+                      "Poisson's ratio nu (dimensionless), -1 < nu < "
+                      "0.5.");
+  }
+
+
+
+  std::unique_ptr<Material>
+  StVenantKirchhoff::create(const dealii::ParameterHandler &prm)
+  {
+    const double E  = prm.get_double("Young's modulus");
+    const double nu = prm.get_double("Poisson's ratio");
+    check_poissons_ratio("Poisson's ratio", nu);
+    check_modulus("Young's modulus", E);
+    return std::make_unique<StVenantKirchhoff>(E, nu);
   }
 
 
@@ -192,8 +340,54 @@ namespace palpate
   std::string
   NeoHookean::description() const
   {
-    return "compressible neo-Hookean, E = " + Utilities::to_string(E) +
+    return "E = " + Utilities::to_string(E) +
            " Pa, nu = " + Utilities::to_string(nu);
+  }
+
+
+
+  std::vector<std::pair<std::string, double>>
+  NeoHookean::moduli() const
+  {
+    return {{"Young's modulus", E}};
+  }
+
+
+
+  double
+  NeoHookean::poissons_ratio() const
+  {
+    return nu;
+  }
+
+
+
+  void
+  NeoHookean::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("Young's modulus",
+                      "15465",
+                      dealii::Patterns::Double(0.),
+                      "Young's modulus E of the small-strain limit (Pa). "
+                      "W = mu/2 (tr C - 3) - mu ln J + lambda/2 (ln J)^2 "
+                      "with the Lame parameters of E and nu.");
+    prm.declare_entry("Poisson's ratio",
+                      "0.49",
+                      dealii::Patterns::Double(-1., 0.5),
+                      "Poisson's ratio nu of the small-strain limit "
+                      "(dimensionless), -1 < nu < 0.5.");
+  }
+
+
+
+  std::unique_ptr<Material>
+  NeoHookean::create(const dealii::ParameterHandler &prm)
+  {
+    const double E  = prm.get_double("Young's modulus");
+    const double nu = prm.get_double("Poisson's ratio");
+    check_poissons_ratio("Poisson's ratio", nu);
+    check_modulus("Young's modulus", E);
+    return std::make_unique<NeoHookean>(E, nu);
   }
 
 
@@ -253,10 +447,139 @@ namespace palpate
 
 
 
-  MooneyRivlin::MooneyRivlin(const double c10, const double c01)
+  void
+  isochoric_invariants(const Tensor<2, 3>  &F,
+                       IsochoricInvariants &inv,
+                       const bool           second_derivatives)
+  {
+    double       J;
+    Tensor<2, 3> dJ;
+    Tensor<4, 3> d2J;
+    volume_derivatives(F, J, dJ, second_derivatives ? &d2J : nullptr);
+
+    // I1 = F:F, dI1 = 2F, d2I1 = 2 d_ik d_AB.
+    const double I1  = dealii::scalar_product(F, F);
+    Tensor<2, 3> dI1 = 2.0 * F;
+    // I2 = (I1^2 - C:C)/2, dI2 = 2 (I1 F - F C),
+    // d2I2 = 2 (2 F_iA F_kB + I1 d_ik d_AB - d_ik C_AB - F_iB F_kA - b_ik
+    // d_AB).
+    const Tensor<2, 3> C   = dealii::transpose(F) * F;
+    const Tensor<2, 3> b   = F * dealii::transpose(F);
+    const double       I2  = 0.5 * (I1 * I1 - dealii::scalar_product(C, C));
+    const Tensor<2, 3> dI2 = 2.0 * (I1 * F - F * C);
+    Tensor<4, 3>       d2I1, d2I2;
+    if (second_derivatives)
+      for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int A = 0; A < 3; ++A)
+          for (unsigned int k = 0; k < 3; ++k)
+            for (unsigned int B = 0; B < 3; ++B)
+              {
+                const double dik = (i == k), dAB = (A == B);
+                d2I1[i][A][k][B] = 2.0 * dik * dAB;
+                d2I2[i][A][k][B] =
+                  2.0 * (2.0 * F[i][A] * F[k][B] + I1 * dik * dAB -
+                         dik * C[A][B] - F[i][B] * F[k][A] - b[i][k] * dAB);
+              }
+
+    inv.I1bar = scaled_invariant(-2.0 / 3.0,
+                                 J,
+                                 dJ,
+                                 d2J,
+                                 I1,
+                                 dI1,
+                                 d2I1,
+                                 inv.dI1bar,
+                                 second_derivatives ? &inv.d2I1bar : nullptr);
+    inv.I2bar = scaled_invariant(-4.0 / 3.0,
+                                 J,
+                                 dJ,
+                                 d2J,
+                                 I2,
+                                 dI2,
+                                 d2I2,
+                                 inv.dI2bar,
+                                 second_derivatives ? &inv.d2I2bar : nullptr);
+  }
+
+
+
+  MooneyRivlin::MooneyRivlin(const double       c10,
+                             const double       c01,
+                             const Formulation &formulation)
     : c10(c10)
     , c01(c01)
-  {}
+    , mixed(formulation)
+  {
+    // The isochoric energy alone is not a solid: without a pressure field
+    // it has no volumetric stiffness. Default to the paper's formulation.
+    if (mixed.pressure == Formulation::Pressure::none)
+      {
+        mixed.pressure            = Formulation::Pressure::exact;
+        mixed.element             = "P1-P1";
+        mixed.displacement_degree = 1;
+      }
+  }
+
+
+
+  Formulation
+  MooneyRivlin::formulation() const
+  {
+    return mixed;
+  }
+
+
+
+  std::vector<std::pair<std::string, double>>
+  MooneyRivlin::moduli() const
+  {
+    return {{"C10", c10}, {"C01", c01}, {"Bulk modulus", mixed.bulk_modulus}};
+  }
+
+
+
+  double
+  MooneyRivlin::poissons_ratio() const
+  {
+    return 0.5;
+  }
+
+
+
+  void
+  MooneyRivlin::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("C10",
+                      "2148",
+                      dealii::Patterns::Double(0.),
+                      "Coefficient of (I1 - 3) in the strain energy "
+                      "(Pa). The shear modulus is mu = 2 (C10 + C01); "
+                      "the defaults give mu = E/3 for the paper's "
+                      "E = 15465 Pa with C01/C10 = 0.2.");
+    prm.declare_entry("C01",
+                      "429.6",
+                      dealii::Patterns::Double(0.),
+                      "Coefficient of (I2 - 3) in the strain energy "
+                      "(Pa).");
+    declare_incompressibility(prm);
+  }
+
+
+
+  std::unique_ptr<Material>
+  MooneyRivlin::create(const dealii::ParameterHandler &prm)
+  {
+    const double c10 = prm.get_double("C10"), c01 = prm.get_double("C01");
+    if (!(c10 + c01 > 0))
+      throw Plugins::EntryError(
+        "C10",
+        "the shear modulus 2 (C10 + C01) must be positive",
+        "set C10 (and C01) in Pa; for Young's modulus E of an "
+        "incompressible solid, C10 + C01 = E/6.");
+    return std::make_unique<MooneyRivlin>(c10,
+                                          c01,
+                                          parse_incompressibility(prm));
+  }
 
 
 
@@ -274,60 +597,12 @@ namespace palpate
                          Tensor<2, 3>       &P,
                          Tensor<4, 3>       *tangent) const
   {
-    double       J;
-    Tensor<2, 3> dJ;
-    Tensor<4, 3> d2J;
-    volume_derivatives(F, J, dJ, tangent ? &d2J : nullptr);
-
-    // I1 = F:F, dI1 = 2F, d2I1 = 2 d_ik d_AB.
-    const double I1  = dealii::scalar_product(F, F);
-    Tensor<2, 3> dI1 = 2.0 * F;
-    // I2 = (I1^2 - C:C)/2, dI2 = 2 (I1 F - F C),
-    // d2I2 = 2 (2 F_iA F_kB + I1 d_ik d_AB - d_ik C_AB - F_iB F_kA - b_ik
-    // d_AB).
-    const Tensor<2, 3> C   = dealii::transpose(F) * F;
-    const Tensor<2, 3> b   = F * dealii::transpose(F);
-    const double       I2  = 0.5 * (I1 * I1 - dealii::scalar_product(C, C));
-    const Tensor<2, 3> dI2 = 2.0 * (I1 * F - F * C);
-    Tensor<4, 3>       d2I1, d2I2;
+    IsochoricInvariants inv;
+    isochoric_invariants(F, inv, tangent != nullptr);
+    P = c10 * inv.dI1bar + c01 * inv.dI2bar;
     if (tangent != nullptr)
-      for (unsigned int i = 0; i < 3; ++i)
-        for (unsigned int A = 0; A < 3; ++A)
-          for (unsigned int k = 0; k < 3; ++k)
-            for (unsigned int B = 0; B < 3; ++B)
-              {
-                const double dik = (i == k), dAB = (A == B);
-                d2I1[i][A][k][B] = 2.0 * dik * dAB;
-                d2I2[i][A][k][B] =
-                  2.0 * (2.0 * F[i][A] * F[k][B] + I1 * dik * dAB -
-                         dik * C[A][B] - F[i][B] * F[k][A] - b[i][k] * dAB);
-              }
-
-    Tensor<2, 3> dI1bar, dI2bar;
-    Tensor<4, 3> d2I1bar, d2I2bar;
-    const double I1bar = scaled_invariant(-2.0 / 3.0,
-                                          J,
-                                          dJ,
-                                          d2J,
-                                          I1,
-                                          dI1,
-                                          d2I1,
-                                          dI1bar,
-                                          tangent ? &d2I1bar : nullptr);
-    const double I2bar = scaled_invariant(-4.0 / 3.0,
-                                          J,
-                                          dJ,
-                                          d2J,
-                                          I2,
-                                          dI2,
-                                          d2I2,
-                                          dI2bar,
-                                          tangent ? &d2I2bar : nullptr);
-
-    P = c10 * dI1bar + c01 * dI2bar;
-    if (tangent != nullptr)
-      *tangent = c10 * d2I1bar + c01 * d2I2bar;
-    return c10 * (I1bar - 3.0) + c01 * (I2bar - 3.0);
+      *tangent = c10 * inv.d2I1bar + c01 * inv.d2I2bar;
+    return c10 * (inv.I1bar - 3.0) + c01 * (inv.I2bar - 3.0);
   }
 
 
@@ -351,7 +626,31 @@ namespace palpate
   std::string
   MooneyRivlin::description() const
   {
-    return "Mooney-Rivlin (isochoric), C10 = " + Utilities::to_string(c10) +
-           " Pa, C01 = " + Utilities::to_string(c01) + " Pa";
+    return "C10 = " + Utilities::to_string(c10) +
+           " Pa, C01 = " + Utilities::to_string(c01) + " Pa, " +
+           (mixed.pressure == Formulation::Pressure::exact ?
+              "exactly incompressible, " + mixed.element + " elements" :
+              "nearly incompressible, bulk modulus " +
+                Utilities::to_string(mixed.bulk_modulus) + " Pa");
   }
+
+
+
+  template class Plugins::Registry<Material>;
+
+
+  PALPATE_REGISTER_MATERIAL(
+    StVenantKirchhoff,
+    "St.Venant-Kirchhoff",
+    "the paper's first model, linear in the Green strain; softens and may "
+    "invert under strong compression")
+  PALPATE_REGISTER_MATERIAL(
+    NeoHookean,
+    "Neo-Hookean",
+    "compressible neo-Hookean, never softens under compression")
+  PALPATE_REGISTER_MATERIAL(
+    MooneyRivlin,
+    "Mooney-Rivlin",
+    "the paper's second model, incompressible, with a pressure multiplier "
+    "field")
 } // namespace palpate

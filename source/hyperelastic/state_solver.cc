@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/linear_solver.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -182,9 +183,9 @@ namespace palpate
         p.state_space.interpolation == "tricubic Hermite";
       const auto start = Clock::now();
       system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
-      if (p.effects.surface_traction)
-        system->add_surface_traction(p.effects.traction_boundary_id,
-                                     p.effects.traction);
+      // The load effects the scene switches on, and only those.
+      for (const auto &effect : Effect::create_enabled(p.effects))
+        effect->apply(*system, p);
       linear_solver =
         LinearSolver::create(p.linear_solver.solver, p.linear_solver.ordering);
       linear_solver->analyze(system->sparsity());

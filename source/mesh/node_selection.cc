@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/hyperelastic/effect.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
@@ -17,25 +18,9 @@ namespace palpate
   {
     using Utilities::Point3;
 
-    Point3
-    minus(const Point3 &a, const Point3 &b)
-    {
-      return {{a[0] - b[0], a[1] - b[1], a[2] - b[2]}};
-    }
-
-    double
-    dot(const Point3 &a, const Point3 &b)
-    {
-      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    }
-
-    Point3
-    cross(const Point3 &a, const Point3 &b)
-    {
-      return {{a[1] * b[2] - a[2] * b[1],
-               a[2] * b[0] - a[0] * b[2],
-               a[0] * b[1] - a[1] * b[0]}};
-    }
+    using Utilities::cross;
+    using Utilities::dot;
+    using Utilities::minus;
 
     /**
      * Whether the points span at least a plane. Points on one line (or a
@@ -194,36 +179,17 @@ namespace palpate
     }
     selection.fixed_description = description.str();
 
-    // The surface traction's faces: they must exist.
-    if (const auto &e = scene.parameters.effects; e.surface_traction)
-      {
-        std::set<unsigned int> ids;
-        for (const auto &face : mesh.surface_faces())
-          {
-            ids.insert(face.boundary_id);
-            if (face.boundary_id != e.traction_boundary_id)
-              continue;
-            const Point3 a = minus(x[face.vertices[1]], x[face.vertices[0]]);
-            const Point3 b = minus(x[face.vertices[2]], x[face.vertices[0]]);
-            const Point3 n = {{a[1] * b[2] - a[2] * b[1],
-                               a[2] * b[0] - a[0] * b[2],
-                               a[0] * b[1] - a[1] * b[0]}};
-            ++selection.traction_faces;
-            selection.traction_area += 0.5 * Utilities::norm(n);
-          }
-        if (selection.traction_faces == 0)
-          {
-            std::string list;
-            for (const unsigned int id : ids)
-              list += (list.empty() ? "" : ", ") + std::to_string(id);
-            throw scene.error("Effects/Traction boundary id",
-                              "no boundary face of the mesh has id " +
-                                std::to_string(e.traction_boundary_id) +
-                                ", so the surface traction would load nothing",
-                              "use one of the mesh's boundary ids: " + list +
-                                ".");
-          }
-      }
+    // The effects that depend on the mesh (a traction's faces) check it
+    // now, before anything is computed.
+    for (const auto &effect : Effect::create_enabled(scene.parameters.effects))
+      try
+        {
+          effect->check(mesh);
+        }
+      catch (const Plugins::EntryError &e)
+        {
+          throw scene.error("Effects/" + e.entry, e.problem, e.fix);
+        }
 
     // The active node.
     if (a.selection == "node id")

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/hyperelastic/effect.h>
+#include <palpate/hyperelastic/material.h>
 #include <palpate/scene/parameters.h>
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <iomanip>
 #include <sstream>
 
 namespace palpate
@@ -327,10 +330,61 @@ namespace palpate
 
 
 
-    bool
-    MaterialModel::incompressible() const
+    void
+    MaterialModel::set(const std::string &model,
+                       const std::string &entry,
+                       const std::string &value)
     {
-      return model_name == "Mooney-Rivlin" && mr_incompressibility == "exact";
+      const auto *plugin = MaterialRegistry::find(model);
+      AssertThrow(plugin != nullptr,
+                  ExcMessage("no material model called " + model));
+      auto &entries = models[model];
+      if (entries.empty())
+        entries = Plugins::declared_entries(plugin->declare_parameters);
+      AssertThrow(entries.count(entry) == 1,
+                  ExcMessage("material model " + model + " has no entry " +
+                             entry));
+      entries[entry] = value;
+    }
+
+
+
+    void
+    MaterialModel::set(const std::string &model,
+                       const std::string &entry,
+                       const double       value)
+    {
+      std::ostringstream s;
+      s << std::setprecision(17) << value;
+      set(model, entry, s.str());
+    }
+
+
+
+    std::string
+    MaterialModel::get(const std::string &model, const std::string &entry) const
+    {
+      const auto m = models.find(model);
+      if (m != models.end() && m->second.count(entry) == 1)
+        return m->second.at(entry);
+      const auto *plugin = MaterialRegistry::find(model);
+      AssertThrow(plugin != nullptr,
+                  ExcMessage("no material model called " + model));
+      const auto defaults =
+        Plugins::declared_entries(plugin->declare_parameters);
+      AssertThrow(defaults.count(entry) == 1,
+                  ExcMessage("material model " + model + " has no entry " +
+                             entry));
+      return defaults.at(entry);
+    }
+
+
+
+    double
+    MaterialModel::get_double(const std::string &model,
+                              const std::string &entry) const
+    {
+      return std::stod(get(model, entry));
     }
 
 
@@ -340,99 +394,28 @@ namespace palpate
     {
       prm.enter_subsection("Material model");
       {
-        prm.declare_entry(
-          "Model name",
-          "St.Venant-Kirchhoff",
-          Patterns::Selection("St.Venant-Kirchhoff|Neo-Hookean|Mooney-Rivlin"),
-          "The hyperelastic constitutive law: St.Venant-Kirchhoff (linear "
-          "in the Green strain; softens and may invert under strong "
-          "compression), compressible Neo-Hookean, or incompressible "
-          "Mooney-Rivlin (pressure multiplier field).");
+        // The models are plug-ins: the choice and each model's subsection
+        // come from the registry (doc/extending.md).
+        std::string doc = "The hyperelastic constitutive law:";
+        for (const auto &plugin : MaterialRegistry::plugins())
+          doc += " " + plugin.name + ": " + plugin.description + ";";
+        doc.back() = '.';
+        prm.declare_entry("Model name",
+                          "St.Venant-Kirchhoff",
+                          Patterns::Selection(MaterialRegistry::selection()),
+                          doc);
         prm.declare_entry("Density",
                           "1060",
                           Patterns::Double(0.),
                           "Mass density of the tissue in the reference "
                           "configuration (kg/m^3); used only when the "
                           "gravity effect is on. 1060 is liver tissue.");
-
-        prm.enter_subsection("St.Venant-Kirchhoff");
-        {
-          prm.declare_entry("Young's modulus",
-                            "15465",
-                            Patterns::Double(0.),
-                            "Young's modulus E (Pa). The Lame parameters are "
-                            "lambda = E nu/((1+nu)(1-2nu)), mu = E/(2(1+nu)).");
-          prm.declare_entry("Poisson's ratio",
-                            "0.49",
-                            Patterns::Double(-1., 0.5),
-                            "Poisson's ratio nu (dimensionless), -1 < nu < "
-                            "0.5.");
-        }
-        prm.leave_subsection();
-
-        prm.enter_subsection("Neo-Hookean");
-        {
-          prm.declare_entry("Young's modulus",
-                            "15465",
-                            Patterns::Double(0.),
-                            "Young's modulus E of the small-strain limit (Pa). "
-                            "W = mu/2 (tr C - 3) - mu ln J + lambda/2 (ln J)^2 "
-                            "with the Lame parameters of E and nu.");
-          prm.declare_entry("Poisson's ratio",
-                            "0.49",
-                            Patterns::Double(-1., 0.5),
-                            "Poisson's ratio nu of the small-strain limit "
-                            "(dimensionless), -1 < nu < 0.5.");
-        }
-        prm.leave_subsection();
-
-        prm.enter_subsection("Mooney-Rivlin");
-        {
-          prm.declare_entry("C10",
-                            "2148",
-                            Patterns::Double(0.),
-                            "Coefficient of (I1 - 3) in the strain energy "
-                            "(Pa). The shear modulus is mu = 2 (C10 + C01); "
-                            "the defaults give mu = E/3 for the paper's "
-                            "E = 15465 Pa with C01/C10 = 0.2.");
-          prm.declare_entry("C01",
-                            "429.6",
-                            Patterns::Double(0.),
-                            "Coefficient of (I2 - 3) in the strain energy "
-                            "(Pa).");
-          prm.declare_entry("Incompressibility",
-                            "exact",
-                            Patterns::Selection("exact|penalty"),
-                            "exact: J = 1 is imposed by a pressure field that "
-                            "acts as a Lagrange multiplier (mixed u-p "
-                            "elements, as in the paper); penalty: nearly "
-                            "incompressible with the bulk modulus below.");
-          prm.declare_entry("Bulk modulus",
-                            "1e6",
-                            Patterns::Double(0.),
-                            "Bulk modulus kappa of the volumetric energy "
-                            "kappa/2 (J - 1)^2 for Incompressibility = "
-                            "penalty (Pa).");
-          prm.declare_entry("Element",
-                            "P1-P1",
-                            Patterns::Selection("P1-P1|Taylor-Hood"),
-                            "Displacement-pressure element pair for exact "
-                            "incompressibility: P1-P1 (the paper's, one "
-                            "pressure per node, not inf-sup stable) or "
-                            "Taylor-Hood P2-P1 (stable).");
-          prm.declare_entry("Stabilization",
-                            "Brezzi-Pitkaranta",
-                            Patterns::Selection("none|Brezzi-Pitkaranta"),
-                            "Pressure stabilisation for P1-P1: none, or the "
-                            "Brezzi-Pitkaranta term -alpha h^2/mu (grad p, "
-                            "grad q) that suppresses checkerboard pressure.");
-          prm.declare_entry("Stabilization factor",
-                            "0.05",
-                            Patterns::Double(0.),
-                            "alpha of the Brezzi-Pitkaranta term "
-                            "(dimensionless).");
-        }
-        prm.leave_subsection();
+        for (const auto &plugin : MaterialRegistry::plugins())
+          {
+            prm.enter_subsection(plugin.name);
+            plugin.declare_parameters(prm);
+            prm.leave_subsection();
+          }
       }
       prm.leave_subsection();
     }
@@ -446,33 +429,27 @@ namespace palpate
       {
         model_name = prm.get("Model name");
         density    = prm.get_double("Density");
-
-        prm.enter_subsection("St.Venant-Kirchhoff");
-        {
-          stvk_youngs_modulus = prm.get_double("Young's modulus");
-          stvk_poissons_ratio = prm.get_double("Poisson's ratio");
-        }
-        prm.leave_subsection();
-
-        prm.enter_subsection("Neo-Hookean");
-        {
-          nh_youngs_modulus = prm.get_double("Young's modulus");
-          nh_poissons_ratio = prm.get_double("Poisson's ratio");
-        }
-        prm.leave_subsection();
-
-        prm.enter_subsection("Mooney-Rivlin");
-        {
-          mr_c10                  = prm.get_double("C10");
-          mr_c01                  = prm.get_double("C01");
-          mr_incompressibility    = prm.get("Incompressibility");
-          mr_bulk_modulus         = prm.get_double("Bulk modulus");
-          mr_element              = prm.get("Element");
-          mr_stabilization        = prm.get("Stabilization");
-          mr_stabilization_factor = prm.get_double("Stabilization factor");
-        }
-        prm.leave_subsection();
+        models.clear();
+        for (const auto &plugin : MaterialRegistry::plugins())
+          {
+            auto &entries = models[plugin.name];
+            prm.enter_subsection(plugin.name);
+            for (const auto &entry :
+                 Plugins::declared_entries(plugin.declare_parameters))
+              entries[entry.first] = prm.get(entry.first);
+            prm.leave_subsection();
+          }
       }
+      // Build the chosen model once: values its patterns accept but
+      // deal.II cannot convert (1e-320) fail here, where Scene::read()
+      // names them. What makes no physical sense (nu = 0.5) is
+      // Scene::validate()'s, with the entry's line.
+      try
+        {
+          Material::create(*this);
+        }
+      catch (const Plugins::EntryError &)
+        {}
       prm.leave_subsection();
     }
 
@@ -516,40 +493,59 @@ namespace palpate
 
 
 
+    bool
+    Effects::on(const std::string &name) const
+    {
+      const auto s = switches.find(name);
+      return s != switches.end() && s->second;
+    }
+
+
+
+    void
+    Effects::turn_on(const std::string &name, const bool on)
+    {
+      AssertThrow(EffectRegistry::find(name) != nullptr,
+                  ExcMessage("no effect called " + name));
+      switches[name] = on;
+    }
+
+
+
+    void
+    Effects::set(const std::string &effect,
+                 const std::string &entry,
+                 const std::string &value)
+    {
+      const auto *plugin = EffectRegistry::find(effect);
+      AssertThrow(plugin != nullptr, ExcMessage("no effect called " + effect));
+      auto &entries = loads[effect];
+      if (entries.empty())
+        entries = Plugins::declared_entries(plugin->declare_parameters);
+      AssertThrow(entries.count(entry) == 1,
+                  ExcMessage("effect " + effect + " has no entry " + entry));
+      entries[entry] = value;
+    }
+
+
+
     void
     Effects::declare_parameters(ParameterHandler &prm)
     {
       prm.enter_subsection("Effects");
       {
-        prm.declare_entry("Gravity",
-                          "false",
-                          Patterns::Bool(),
-                          "Whether the body carries its weight, the body "
-                          "force rho g (rho from Material model / Density). "
-                          "Off: no body-force term is assembled at all.");
-        prm.declare_entry("Gravitational acceleration",
-                          "0, 0, -9.81",
-                          point_pattern(),
-                          "Gravitational acceleration vector g (m/s^2).");
-        prm.declare_entry("Surface traction",
-                          "false",
-                          Patterns::Bool(),
-                          "Whether a traction (a pressure or shear load, "
-                          "e.g. a neighbouring organ resting on this one) "
-                          "acts on the boundary faces with Traction boundary "
-                          "id. A dead load per reference area: it keeps its "
-                          "direction and size as the body deforms.");
-        prm.declare_entry("Traction boundary id",
-                          "1",
-                          Patterns::Integer(0, 255),
-                          "The boundary id of the loaded faces: a Gmsh "
-                          "physical surface tag, a VTK cell data "
-                          "'boundary id'; the generated beam numbers its "
-                          "faces 0 (x = 0), 1 (x = L), 2, 3 (y), 4, 5 (z).");
-        prm.declare_entry("Traction",
-                          "0, 0, 0",
-                          point_pattern(),
-                          "The traction vector t (Pa = N/m^2) on those faces.");
+        // The load effects are plug-ins: each one's switch and entries
+        // come from the registry (doc/extending.md).
+        for (const auto &plugin : EffectRegistry::plugins())
+          {
+            prm.declare_entry(plugin.name,
+                              "false",
+                              Patterns::Bool(),
+                              "Whether to switch on " + plugin.description +
+                                ". Off: nothing of it is built, assembled "
+                                "or written.");
+            plugin.declare_parameters(prm);
+          }
         prm.declare_entry("Shape output",
                           "false",
                           Patterns::Bool(),
@@ -605,17 +601,27 @@ namespace palpate
     {
       prm.enter_subsection("Effects");
       {
-        gravity = prm.get_bool("Gravity");
-        gravitational_acceleration =
-          get_point(prm, "Gravitational acceleration");
-        surface_traction     = prm.get_bool("Surface traction");
-        traction_boundary_id = prm.get_integer("Traction boundary id");
-        traction             = get_point(prm, "Traction");
-        shape_output         = prm.get_bool("Shape output");
-        shape_output_rate    = prm.get_double("Shape output rate");
-        shape_output_limit   = prm.get_double("Shape output limit");
-        vtu_export           = prm.get_bool("VTU export");
-        force_log            = prm.get_bool("Force log");
+        switches.clear();
+        loads.clear();
+        for (const auto &plugin : EffectRegistry::plugins())
+          {
+            switches[plugin.name] = prm.get_bool(plugin.name);
+            auto &entries         = loads[plugin.name];
+            for (const auto &entry :
+                 Plugins::declared_entries(plugin.declare_parameters))
+              entries[entry.first] = prm.get(entry.first);
+          }
+        try
+          {
+            Effect::create_enabled(*this);
+          }
+        catch (const Plugins::EntryError &)
+          {}
+        shape_output       = prm.get_bool("Shape output");
+        shape_output_rate  = prm.get_double("Shape output rate");
+        shape_output_limit = prm.get_double("Shape output limit");
+        vtu_export         = prm.get_bool("VTU export");
+        force_log          = prm.get_bool("Force log");
       }
       prm.leave_subsection();
     }

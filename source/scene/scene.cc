@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/hyperelastic/effect.h>
+#include <palpate/hyperelastic/material.h>
 #include <palpate/scene/scene.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -797,82 +799,54 @@ namespace palpate
     using namespace Limits;
     const auto &p = parameters;
 
-    // Material: the moduli of the model in use must describe a solid.
-    const auto &m = p.material_model;
-    if (m.model_name == "St.Venant-Kirchhoff" && m.stvk_poissons_ratio >= 0.5)
-      throw error("Material model/St.Venant-Kirchhoff/Poisson's ratio",
-                  "nu = 0.5 makes the Lame parameter lambda infinite",
-                  "use nu < 0.5 (e.g. 0.49, the paper's value), or the "
-                  "incompressible Mooney-Rivlin model.");
-    if (m.model_name == "Neo-Hookean" && m.nh_poissons_ratio >= 0.5)
-      throw error("Material model/Neo-Hookean/Poisson's ratio",
-                  "nu = 0.5 makes the Lame parameter lambda infinite",
-                  "use nu < 0.5, or the incompressible Mooney-Rivlin model.");
-    if ((m.model_name == "St.Venant-Kirchhoff" &&
-         m.stvk_poissons_ratio <= -1) ||
-        (m.model_name == "Neo-Hookean" && m.nh_poissons_ratio <= -1))
-      throw error(m.model_name == "Neo-Hookean" ?
-                    "Material model/Neo-Hookean/Poisson's ratio" :
-                    "Material model/St.Venant-Kirchhoff/Poisson's ratio",
-                  "nu = -1 makes the shear modulus E/(2(1+nu)) infinite",
-                  "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
-    if (m.model_name == "St.Venant-Kirchhoff" && m.stvk_youngs_modulus <= 0)
-      throw error("Material model/St.Venant-Kirchhoff/Young's modulus",
-                  "Young's modulus must be positive",
-                  "set it in Pa, e.g. 15465 for liver.");
-    if (m.model_name == "Neo-Hookean" && m.nh_youngs_modulus <= 0)
-      throw error("Material model/Neo-Hookean/Young's modulus",
-                  "Young's modulus must be positive",
-                  "set it in Pa, e.g. 15465 for liver.");
-    if (m.model_name == "Mooney-Rivlin" && m.mr_c10 + m.mr_c01 <= 0)
-      throw error("Material model/Mooney-Rivlin/C10",
-                  "the shear modulus 2 (C10 + C01) must be positive",
-                  "set C10 (and C01) in Pa; for Young's modulus E of an "
-                  "incompressible solid, C10 + C01 = E/6.");
+    // Material: the plug-in checks that its constants describe a solid.
+    const auto               &m = p.material_model;
+    std::unique_ptr<Material> material;
+    try
+      {
+        material = Material::create(m);
+      }
+    catch (const Plugins::EntryError &e)
+      {
+        throw error("Material model/" + m.model_name + "/" + e.entry,
+                    e.problem,
+                    e.fix);
+      }
 
     // Moduli beyond any solid's (diamond: E = 1.2e12 Pa) only overflow the
     // force scale; soft tissue is 1e2 - 1e7 Pa.
-    {
-      const std::pair<const char *, double> moduli[] = {
-        {"Material model/St.Venant-Kirchhoff/Young's modulus",
-         m.model_name == "St.Venant-Kirchhoff" ? m.stvk_youngs_modulus : 0},
-        {"Material model/Neo-Hookean/Young's modulus",
-         m.model_name == "Neo-Hookean" ? m.nh_youngs_modulus : 0},
-        {"Material model/Mooney-Rivlin/C10",
-         m.model_name == "Mooney-Rivlin" ? m.mr_c10 : 0},
-        {"Material model/Mooney-Rivlin/C01",
-         m.model_name == "Mooney-Rivlin" ? m.mr_c01 : 0},
-        {"Material model/Mooney-Rivlin/Bulk modulus",
-         m.model_name == "Mooney-Rivlin" ? m.mr_bulk_modulus : 0}};
-      for (const auto &[entry, value] : moduli)
-        if (std::abs(value) > max_modulus)
-          throw error(entry,
-                      "at most " + Utilities::to_string(max_modulus, 3) +
-                        " Pa: stiffer than any solid (diamond is 1.2e12 Pa); "
-                        "such moduli only overflow the solver's force scale",
-                      "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
-                      "(liver: E = 15465 Pa).");
-    }
+    for (const auto &[entry, value] : material->moduli())
+      if (std::abs(value) > max_modulus)
+        throw error("Material model/" + m.model_name +
+                      (entry.empty() ? "" : "/" + entry),
+                    "at most " + Utilities::to_string(max_modulus, 3) +
+                      " Pa: stiffer than any solid (diamond is 1.2e12 Pa); "
+                      "such moduli only overflow the solver's force scale",
+                    "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
+                    "(liver: E = 15465 Pa).");
 
-    // Mooney-Rivlin: the element pair fixes the displacement degree.
-    if (m.model_name == "Mooney-Rivlin" &&
-        line_of("Discretization/Polynomial degree") > 0)
+    // Effects: each plug-in checks its entries.
+    try
       {
-        const unsigned int pair_degree = m.mr_element == "Taylor-Hood" ? 2 : 1;
-        if (p.discretization.polynomial_degree != pair_degree)
-          throw error(
-            "Discretization/Polynomial degree",
-            "Mooney-Rivlin's element pair " + m.mr_element +
-              " has displacements of degree " + std::to_string(pair_degree),
-            "remove this entry (Material model / Mooney-Rivlin / Element chooses the "
-            "degree), or choose the element pair with the degree you want.");
+        Effect::create_enabled(p.effects);
       }
-    if (m.model_name == "Mooney-Rivlin" &&
-        m.mr_incompressibility == "penalty" && m.mr_bulk_modulus <= 0)
-      throw error(
-        "Material model/Mooney-Rivlin/Bulk modulus",
-        "the bulk modulus must be positive",
-        "set it in Pa, typically 1000 times C10 + C01 for soft tissue.");
+    catch (const Plugins::EntryError &e)
+      {
+        throw error("Effects/" + e.entry, e.problem, e.fix);
+      }
+
+    // An element pair (Taylor-Hood, P1-P1) fixes the displacement degree.
+    if (const Formulation f = material->formulation();
+        f.displacement_degree > 0 &&
+        line_of("Discretization/Polynomial degree") > 0 &&
+        p.discretization.polynomial_degree != f.displacement_degree)
+      throw error("Discretization/Polynomial degree",
+                  m.model_name + "'s element pair " + f.element +
+                    " has displacements of degree " +
+                    std::to_string(f.displacement_degree),
+                  "remove this entry (Material model / " + m.model_name +
+                    " / Element chooses the degree), or choose the "
+                    "element pair with the degree you want.");
 
     // Mesh.
     if (p.mesh.source == "file" && p.mesh.file_name.empty())

@@ -67,14 +67,14 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
 
-  palpate::Scene scene                 = shipped_scene("beam.prm");
-  auto          &p                     = scene.parameters;
-  p.state_space.grid_spacing           = 0.002;
-  p.state_space.extent                 = 0.006;
-  p.scheduler.cloud_radius             = 0.0045;
-  p.engine.type                        = "mpi";
-  p.engine.workers                     = 2;
-  p.material_model.stvk_youngs_modulus = 1e6;
+  palpate::Scene scene       = shipped_scene("beam.prm");
+  auto          &p           = scene.parameters;
+  p.state_space.grid_spacing = 0.002;
+  p.state_space.extent       = 0.006;
+  p.scheduler.cloud_radius   = 0.0045;
+  p.engine.type              = "mpi";
+  p.engine.workers           = 2;
+  p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e6);
   const Body body(scene);
   if (palpate::mpi_rank() > 0)
     return palpate::run_solver_server(scene, body.mesh, body.nodes);

@@ -35,10 +35,10 @@ main(int argc, char **argv)
   using palpate::Utilities::Point3;
   const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
-  palpate::Scene scene                 = small_beam_scene();
-  auto          &p                     = scene.parameters;
-  p.state_space.interpolation          = "tricubic Hermite";
-  p.material_model.stvk_youngs_modulus = 1e6;
+  palpate::Scene scene        = small_beam_scene();
+  auto          &p            = scene.parameters;
+  p.state_space.interpolation = "tricubic Hermite";
+  p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e6);
   palpate::Interaction interaction(scene);
   const Point3         inside{{0.0007, -0.0003, -0.0011}};
   interaction.force(inside);

@@ -26,9 +26,9 @@ main(int argc, char **argv)
   initlog();
   using palpate::Utilities::Point3;
 
-  palpate::Scene scene                 = small_beam_scene();
-  auto          &p                     = scene.parameters;
-  p.material_model.stvk_youngs_modulus = 1e6;
+  palpate::Scene scene = small_beam_scene();
+  auto          &p     = scene.parameters;
+  p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e6);
   palpate::Interaction interaction(scene);
   const Point3         inside{{0.0005, -0.0003, -0.0015}};
   interaction.force(inside);

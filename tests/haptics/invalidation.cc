@@ -104,11 +104,11 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene                 = small_beam_scene();
-  auto          &p                     = scene.parameters;
-  p.haptics.force_limit                = 10;
-  p.haptics.max_force_change           = 1e-3;
-  p.material_model.stvk_youngs_modulus = 1e6;
+  palpate::Scene scene       = small_beam_scene();
+  auto          &p           = scene.parameters;
+  p.haptics.force_limit      = 10;
+  p.haptics.max_force_change = 1e-3;
+  p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e6);
   palpate::Interaction interaction(scene);
   const Point3         x{{0.0012, -0.0007, -0.0015}};
   deallog << "grid of " << interaction.grid().size() << " points; HIP at ("
@@ -146,7 +146,10 @@ main(int argc, char **argv)
 
   // No change while in contact.
   palpate::Parameters::AllParameters changed = p;
-  changed.material_model.stvk_youngs_modulus *= 2;
+  changed.material_model.set(
+    "St.Venant-Kirchhoff",
+    "Young's modulus",
+    2 * p.material_model.get_double("St.Venant-Kirchhoff", "Young's modulus"));
   try
     {
       interaction.change_parameters(changed);

@@ -35,11 +35,11 @@ namespace
     auto          &p     = scene.parameters;
     const double   E = 240.565e6, nu = 0.499;
     const double   mu = E / (2 * (1 + nu)), kappa = E / (3 * (1 - 2 * nu));
-    p.material_model.mr_c10               = mu / 2;
-    p.material_model.mr_c01               = 0;
-    p.material_model.mr_incompressibility = "penalty";
-    p.material_model.mr_bulk_modulus      = kappa;
-    p.material_model.mr_element           = element;
+    p.material_model.set("Mooney-Rivlin", "C10", mu / 2);
+    p.material_model.set("Mooney-Rivlin", "C01", 0.0);
+    p.material_model.set("Mooney-Rivlin", "Incompressibility", "penalty");
+    p.material_model.set("Mooney-Rivlin", "Bulk modulus", kappa);
+    p.material_model.set("Mooney-Rivlin", "Element", element);
     p.nonlinear_solver.residual_tolerance = 1e-9;
 
     // The beam generator's block, mapped onto the trapezoid (in mm, then

@@ -78,8 +78,10 @@ main(int argc, char **argv)
     const palpate::State reference = run("E = 15465 Pa", mesh, blob, push);
     for (const double E : {10., 1e3, 1e5, 1e7})
       {
-        palpate::Scene scene                                = blob;
-        scene.parameters.material_model.stvk_youngs_modulus = E;
+        palpate::Scene scene = blob;
+        scene.parameters.material_model.set("St.Venant-Kirchhoff",
+                                            "Young's modulus",
+                                            E);
         const palpate::State s =
           run("E = " + palpate::Utilities::to_string(E, 2) + " Pa",
               mesh,
@@ -104,8 +106,10 @@ main(int argc, char **argv)
     double f49 = 0;
     for (const double nu : {0.49, 0.499, 0.4999})
       {
-        palpate::Scene scene                                = blob;
-        scene.parameters.material_model.stvk_poissons_ratio = nu;
+        palpate::Scene scene = blob;
+        scene.parameters.material_model.set("St.Venant-Kirchhoff",
+                                            "Poisson's ratio",
+                                            nu);
         const palpate::State s =
           run("StVK nu = " + palpate::Utilities::to_string(nu, 4),
               mesh,
@@ -135,8 +139,8 @@ main(int argc, char **argv)
       palpate::Scene scene = blob;
       auto          &m     = scene.parameters.material_model;
       m.model_name         = "Mooney-Rivlin";
-      m.mr_c10             = c10;
-      m.mr_c01             = c01;
+      m.set("Mooney-Rivlin", "C10", c10);
+      m.set("Mooney-Rivlin", "C01", c01);
       run("C10 = " + palpate::Utilities::to_string(c10, 4) +
             " Pa, C01 = " + palpate::Utilities::to_string(c01, 4) + " Pa",
           mesh,

@@ -45,8 +45,8 @@ main(int argc, char **argv)
     palpate::NodeSelection::create(scene, mesh);
   const Point3 push{{0, 0, -0.005}};
 
-  auto p                               = scene.parameters;
-  p.material_model.stvk_youngs_modulus = 1e300;
+  auto p = scene.parameters;
+  p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e300);
   {
     palpate::StateSolver solver(mesh, nodes, p);
     report("E = 1e300 Pa", solver.solve(solver.rest_state(), push));
@@ -61,14 +61,15 @@ main(int argc, char **argv)
            solver.solve(solver.rest_state(), {{inf, 0, 0}}));
 
     const palpate::State soft = solver.solve(solver.rest_state(), push);
-    p.material_model.stvk_youngs_modulus = 1e7;
+    p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e7);
     palpate::StateSolver stiff_solver(mesh, nodes, p);
     const palpate::State stiff =
       stiff_solver.solve(stiff_solver.rest_state(), push);
     report("E = 1e5 Pa", soft);
     report("E = 1e7 Pa", stiff);
     const double ratio =
-      1e7 / scene.parameters.material_model.stvk_youngs_modulus;
+      1e7 / scene.parameters.material_model.get_double("St.Venant-Kirchhoff",
+                                                       "Young's modulus");
     Point3 scaled = soft.force;
     for (double &f : scaled)
       f *= ratio;

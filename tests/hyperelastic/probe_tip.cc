@@ -27,15 +27,16 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene                    = shipped_scene("beam.prm");
-  auto          &p                        = scene.parameters;
-  p.mesh.beam_width                       = 0.01;
-  p.mesh.beam_height                      = 0.01;
-  p.material_model.stvk_poissons_ratio    = 0;
+  palpate::Scene scene = shipped_scene("beam.prm");
+  auto          &p     = scene.parameters;
+  p.mesh.beam_width    = 0.01;
+  p.mesh.beam_height   = 0.01;
+  p.material_model.set("St.Venant-Kirchhoff", "Poisson's ratio", 0.0);
   p.boundary_conditions.active_node.point = {{0.1, 0, 0}};
   const palpate::Mesh mesh                = palpate::Mesh::create(scene);
-  const double E = p.material_model.stvk_youngs_modulus, A = 1e-4, L = 0.1,
-               u     = 1e-6;
+  const double        E = p.material_model.get_double("St.Venant-Kirchhoff",
+                                               "Young's modulus"),
+               A = 1e-4, L = 0.1, u = 1e-6;
   const double exact = E * A * u / L;
 
   for (const double radius : {0.008, 0.0})

@@ -125,7 +125,7 @@ main(int argc, char **argv)
   for (const std::string element : {"P1-P1", "Taylor-Hood"})
     {
       palpate::Scene scene = shipped_scene("liver-mooney-rivlin.prm");
-      scene.parameters.material_model.mr_element           = element;
+      scene.parameters.material_model.set("Mooney-Rivlin", "Element", element);
       scene.parameters.nonlinear_solver.residual_tolerance = 1e-11;
       const Body           body(scene);
       palpate::StateSolver solver(body.mesh, body.nodes, scene.parameters);
@@ -159,8 +159,8 @@ main(int argc, char **argv)
 
   // With gravity, the constrained nodes carry the weight rho g V.
   {
-    palpate::Scene scene             = shipped_scene("beam.prm");
-    scene.parameters.effects.gravity = true;
+    palpate::Scene scene = shipped_scene("beam.prm");
+    scene.parameters.effects.turn_on("Gravity");
     scene.parameters.nonlinear_solver.residual_tolerance = 1e-11;
     const Body           body(scene);
     palpate::StateSolver solver(body.mesh, body.nodes, scene.parameters);

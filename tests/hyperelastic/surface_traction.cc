@@ -51,17 +51,17 @@ main(int argc, char **argv)
   initlog();
   const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
-  palpate::Scene scene   = shipped_scene("beam.prm");
-  auto          &e       = scene.parameters.effects;
-  e.surface_traction     = true;
-  e.traction_boundary_id = 1;
-  e.traction             = {{0, 0, -1000}};
-  const auto [f1, sum1]  = solve(scene);
-  e.traction             = {{0, 0, -2000}};
-  const auto [f2, sum2]  = solve(scene);
-  e.surface_traction     = false;
-  const auto [f0, sum0]  = solve(scene);
-  const double load      = 1000 * 4e-4;
+  palpate::Scene scene = shipped_scene("beam.prm");
+  auto          &e     = scene.parameters.effects;
+  e.turn_on("Surface traction", true);
+  e.set("Surface traction", "Traction boundary id", "1");
+  e.set("Surface traction", "Traction", "0, 0, -1000");
+  const auto [f1, sum1] = solve(scene);
+  e.set("Surface traction", "Traction", "0, 0, -2000");
+  const auto [f2, sum2] = solve(scene);
+  e.turn_on("Surface traction", false);
+  const auto [f0, sum0] = solve(scene);
+  const double load     = 1000 * 4e-4;
 
   deallog << "reactions balance t A = 0.4 N: "
           << ok(std::abs(sum1[2] - load) < 1e-9 &&
@@ -76,8 +76,8 @@ main(int argc, char **argv)
                 palpate::Utilities::norm(f0) < 1e-12)
           << std::endl;
 
-  e.surface_traction     = true;
-  e.traction_boundary_id = 7;
+  e.turn_on("Surface traction", true);
+  e.set("Surface traction", "Traction boundary id", "7");
   try
     {
       const palpate::Mesh mesh = palpate::Mesh::create(scene);

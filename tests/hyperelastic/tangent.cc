@@ -157,19 +157,23 @@ main(int argc, char **argv)
         "multipliers",
         1,
         {{0.01, 0, -0.01}});
-  palpate::Scene penalty                                 = mr;
-  penalty.parameters.material_model.mr_incompressibility = "penalty";
-  penalty.parameters.material_model.mr_bulk_modulus      = 2.5e6;
+  palpate::Scene penalty = mr;
+  penalty.parameters.material_model.set("Mooney-Rivlin",
+                                        "Incompressibility",
+                                        "penalty");
+  penalty.parameters.material_model.set("Mooney-Rivlin", "Bulk modulus", 2.5e6);
   check("liver, Mooney-Rivlin P1-P1, penalty",
         penalty,
         "Mooney-Rivlin",
         "elimination",
         1,
         {{0, 0.01, -0.01}});
-  palpate::Scene taylor_hood                       = beam;
-  taylor_hood.parameters.material_model.mr_c10     = 2e4;
-  taylor_hood.parameters.material_model.mr_c01     = 5e3;
-  taylor_hood.parameters.material_model.mr_element = "Taylor-Hood";
+  palpate::Scene taylor_hood = beam;
+  taylor_hood.parameters.material_model.set("Mooney-Rivlin", "C10", 2e4);
+  taylor_hood.parameters.material_model.set("Mooney-Rivlin", "C01", 5e3);
+  taylor_hood.parameters.material_model.set("Mooney-Rivlin",
+                                            "Element",
+                                            "Taylor-Hood");
   check("beam, Mooney-Rivlin Taylor-Hood, exact",
         taylor_hood,
         "Mooney-Rivlin",

@@ -8,11 +8,16 @@
 // match the closed form P = 2 (lambda - lambda^-2) (C10 + C01 / lambda)
 // within 0.5 % for stretches 0.7 ... 1.5, and the volume must stay that of
 // the block: to solver tolerance for Taylor-Hood, reported for P1-P1.
+// The Yeoh plug-in (doc/extending.md's example, one file) the same way:
+// P = 2 (lambda - lambda^-2) (C10 + 2 C20 x + 3 C30 x^2), x = I1 - 3,
+// I1 = lambda^2 + 2/lambda.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "../tests.h"
 
@@ -24,17 +29,27 @@ main(int argc, char **argv)
 
   const double C10 = 2148, C01 = 429.6; // the liver's, Pa
   const double L = 0.02, W = 0.01, H = 0.01;
-  for (const std::string element : {"P1-P1", "Taylor-Hood"})
+  const double Y10 = 2577.5, Y20 = 1288.75, Y30 = 100; // Yeoh, Pa
+  for (const auto &[model, element] :
+       std::vector<std::pair<std::string, std::string>>{
+         {"Mooney-Rivlin", "P1-P1"},
+         {"Mooney-Rivlin", "Taylor-Hood"},
+         {"Yeoh", "P1-P1"}})
     {
       palpate::Scene scene = shipped_scene("liver-mooney-rivlin.prm");
       auto          &p     = scene.parameters;
       p.mesh.source        = "beam";
       p.mesh.beam_length = L, p.mesh.beam_width = W, p.mesh.beam_height = H;
       p.mesh.beam_subdivisions_length = 3, p.mesh.beam_subdivisions_width = 2,
-      p.mesh.beam_subdivisions_height       = 2;
-      p.material_model.mr_c10               = C10;
-      p.material_model.mr_c01               = C01;
-      p.material_model.mr_element           = element;
+      p.mesh.beam_subdivisions_height = 2;
+      p.material_model.set("Mooney-Rivlin", "C10", C10);
+      p.material_model.set("Mooney-Rivlin", "C01", C01);
+      p.material_model.set("Mooney-Rivlin", "Element", element);
+      p.material_model.model_name = model;
+      p.material_model.set("Yeoh", "C10", Y10);
+      p.material_model.set("Yeoh", "C20", Y20);
+      p.material_model.set("Yeoh", "C30", Y30);
+      p.material_model.set("Yeoh", "Element", element);
       p.nonlinear_solver.residual_tolerance = 1e-11;
       const palpate::Mesh mesh              = palpate::Mesh::create(scene);
 
@@ -53,7 +68,8 @@ main(int argc, char **argv)
         }
       palpate::StateSolver solver(mesh, nodes, p);
       auto                &system = solver.system();
-      deallog << element << ": " << system.discretization_description() << ", "
+      deallog << model << ", " << element << ": "
+              << system.discretization_description() << ", "
               << system.n_equations() << " equations" << std::endl;
 
       bool   all_within          = true;
@@ -78,8 +94,11 @@ main(int argc, char **argv)
                     std::abs(system.dof_positions()[d][0] - L) < 1e-12)
                   force += f[d];
               const double P_fe = force / (W * H);
+              const double x    = lambda * lambda + 2 / lambda - 3;
               const double P_exact =
-                2 * (lambda - 1 / (lambda * lambda)) * (C10 + C01 / lambda);
+                2 * (lambda - 1 / (lambda * lambda)) *
+                (model == "Yeoh" ? Y10 + 2 * Y20 * x + 3 * Y30 * x * x :
+                                   C10 + C01 / lambda);
               const double error = std::abs(P_fe - P_exact) / std::abs(P_exact);
               const double volume =
                 system.deformed_volume(state.solution) / (L * W * H);

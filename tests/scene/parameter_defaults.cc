@@ -56,8 +56,13 @@ main(int argc, char **argv)
   const auto &p = scene.parameters;
   deallog << "Mesh/Source = " << p.mesh.source << std::endl;
   deallog << "Material model/Model name = " << p.material_model.model_name
-          << ", E = " << p.material_model.stvk_youngs_modulus
-          << " Pa, nu = " << p.material_model.stvk_poissons_ratio << std::endl;
+          << ", E = "
+          << p.material_model.get_double("St.Venant-Kirchhoff",
+                                         "Young's modulus")
+          << " Pa, nu = "
+          << p.material_model.get_double("St.Venant-Kirchhoff",
+                                         "Poisson's ratio")
+          << std::endl;
   deallog << "Active node/Point = "
           << palpate::Utilities::to_string(
                p.boundary_conditions.active_node.point)

@@ -48,6 +48,22 @@ namespace palpate
     double
     distance(const Point3 &a, const Point3 &b);
 
+    /** a - b. */
+    Point3
+    minus(const Point3 &a, const Point3 &b);
+
+    /** a . b. */
+    double
+    dot(const Point3 &a, const Point3 &b);
+
+    /** a x b. */
+    Point3
+    cross(const Point3 &a, const Point3 &b);
+
+    /** s a. */
+    Point3
+    scaled(const Point3 &a, const double s);
+
     /** Format @p x with @p precision significant digits (no trailing
      * zeros, scientific notation for very small or large numbers). */
     std::string

@@ -157,13 +157,19 @@ namespace palpate
 
     /**
      * Add a dead traction @p traction (Pa, per unit reference area) on the
-     * boundary faces with @p boundary_id, scaled by the load factor. Tests
-     * and benchmarks use it (Cook's membrane); scenes load the body only
-     * through the active node and gravity.
+     * boundary faces with @p boundary_id, scaled by the load factor (the
+     * Surface traction effect, Cook's membrane).
      */
     void
     add_surface_traction(const unsigned int       boundary_id,
                          const Utilities::Point3 &traction);
+
+    /**
+     * Add a dead body force @p b (N/m^3, per unit reference volume), not
+     * scaled by the load factor (the Gravity effect: rho g).
+     */
+    void
+    add_body_force(const Utilities::Point3 &b);
 
     /** The factor that scales the surface tractions (default 1). */
     void

@@ -4,16 +4,48 @@
 #ifndef palpate_hyperelastic_material_h
 #define palpate_hyperelastic_material_h
 
+#include <palpate/base/plugins.h>
 #include <palpate/scene/parameters.h>
 
 #include <deal.II/base/tensor.h>
 
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace palpate
 {
   using dealii::Tensor;
+
+  /**
+   * How the FE module discretises a material: a compressible law needs only
+   * the displacement; an isochoric one (Mooney-Rivlin) needs a pressure
+   * field that imposes J = 1 exactly or penalises J - 1. Materials say what
+   * they need; the FE module reads nothing else of theirs.
+   */
+  struct Formulation
+  {
+    /** The pressure field: none, exact (a Lagrange multiplier of J = 1)
+     * or penalty (kappa/2 (J - 1)^2). */
+    enum class Pressure
+    {
+      none,
+      exact,
+      penalty
+    } pressure = Pressure::none;
+    /** kappa for Pressure::penalty (Pa). */
+    double bulk_modulus = 0;
+    /** The displacement degree the element pair fixes (1 for P1-P1, 2 for
+     * Taylor-Hood), or 0: Discretization / Polynomial degree decides. */
+    unsigned int displacement_degree = 0;
+    /** The element pair's name for reports ("P1-P1", "Taylor-Hood"). */
+    std::string element;
+    /** The Brezzi-Pitkaranta pressure stabilisation of P1-P1 and its
+     * dimensionless factor alpha. */
+    bool   stabilization        = false;
+    double stabilization_factor = 0;
+  };
 
   /**
    * A hyperelastic material in the total Lagrangian setting: a strain
@@ -65,16 +97,94 @@ namespace palpate
     virtual double
     youngs_modulus() const = 0;
 
-    /** One line for reports, e.g. "St.Venant-Kirchhoff, E = 15465 Pa". */
+    /** Poisson's ratio of the small-strain limit: 0.5 for an
+     * incompressible law. The scene report warns about volumetric locking
+     * of compressible laws near 0.5 on linear elements. */
+    virtual double
+    poissons_ratio() const = 0;
+
+    /** The moduli (entry name, Pa) that Scene::validate() holds against
+     * the largest any solid has: beyond it they only overflow the force
+     * scale. By default Young's modulus, unnamed. */
+    virtual std::vector<std::pair<std::string, double>>
+    moduli() const;
+
+    /** What the FE module must add to the displacement field. */
+    virtual Formulation
+    formulation() const
+    {
+      return {};
+    }
+
+    /** The constants for the scene report, e.g. "E = 15465 Pa, nu =
+     * 0.49" (after the model's name). */
     virtual std::string
     description() const = 0;
 
-    /** The material a scene asks for. For Mooney-Rivlin this is the
-     * isochoric energy only; the FE module adds the pressure field.
+    /**
+     * The material a scene asks for, built by the plug-in registered under
+     * Material model / Model name from its entries. For Mooney-Rivlin this
+     * is the isochoric energy only; the FE module adds the pressure field.
+     * Throws Plugins::EntryError for constants that describe no solid.
      */
     static std::unique_ptr<Material>
     create(const Parameters::MaterialModel &parameters);
   };
+
+  /**
+   * Material plug-ins: each registers itself at the end of its `.cc`,
+   *
+   *     PALPATE_REGISTER_MATERIAL(Yeoh, "Yeoh", "one line for the reference")
+   *
+   * with `static void declare_parameters(ParameterHandler &)` (its entries,
+   * in subsection Material model / NAME) and `static
+   * std::unique_ptr<Material> create(const ParameterHandler &)`.
+   */
+  using MaterialRegistry = Plugins::Registry<Material>;
+  extern template class Plugins::Registry<Material>;
+
+#define PALPATE_REGISTER_MATERIAL(classname, name, description) \
+  PALPATE_REGISTER_PLUGIN(::palpate::Material, classname, name, description)
+
+  /**
+   * Helpers for material plug-ins. They throw Plugins::EntryError naming
+   * @p entry when a modulus is not positive.
+   */
+  void
+  check_modulus(const std::string &entry, const double value);
+
+  /** The same for Poisson's ratio: -1 < nu < 0.5. */
+  void
+  check_poissons_ratio(const std::string &entry, const double nu);
+
+  /**
+   * Entries and their parsing shared by the isochoric (incompressible)
+   * plug-ins: Incompressibility (exact|penalty), Bulk modulus, Element
+   * (P1-P1|Taylor-Hood), Stabilization and its factor.
+   */
+  void
+  declare_incompressibility(dealii::ParameterHandler &prm);
+
+  /** The formulation of those entries (throws EntryError). */
+  Formulation
+  parse_incompressibility(const dealii::ParameterHandler &prm);
+
+  /**
+   * The isochoric invariants I1bar = J^(-2/3) tr C, I2bar = J^(-4/3) I2 of
+   * F, with their first and (if asked) second derivatives with respect to
+   * F. An isochoric material W(I1bar, I2bar) needs nothing else.
+   */
+  struct IsochoricInvariants
+  {
+    double       I1bar, I2bar;
+    Tensor<2, 3> dI1bar, dI2bar;
+    Tensor<4, 3> d2I1bar, d2I2bar;
+  };
+
+  void
+  isochoric_invariants(const Tensor<2, 3>  &F,
+                       IsochoricInvariants &invariants,
+                       const bool           second_derivatives);
 
   /**
    * St.Venant-Kirchhoff: W = lambda/2 (tr E)^2 + mu tr(E^2) with the Green
@@ -92,6 +202,18 @@ namespace palpate
     evaluate(const Tensor<2, 3> &F,
              Tensor<2, 3>       &P,
              Tensor<4, 3>       *tangent) const override;
+
+    /** The plug-in's entries and factory (the registry's). */
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+    static std::unique_ptr<Material>
+    create(const dealii::ParameterHandler &prm);
+
+    double
+    poissons_ratio() const override;
+
+    std::vector<std::pair<std::string, double>>
+    moduli() const override;
 
     double
     shear_modulus() const override;
@@ -126,6 +248,18 @@ namespace palpate
     bool
     admissible(const Tensor<2, 3> &F) const override;
 
+    /** The plug-in's entries and factory (the registry's). */
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+    static std::unique_ptr<Material>
+    create(const dealii::ParameterHandler &prm);
+
+    double
+    poissons_ratio() const override;
+
+    std::vector<std::pair<std::string, double>>
+    moduli() const override;
+
     double
     shear_modulus() const override;
 
@@ -152,8 +286,14 @@ namespace palpate
   class MooneyRivlin : public Material
   {
   public:
-    /** @p c10, @p c01 in Pa. */
-    MooneyRivlin(const double c10, const double c01);
+    /** @p c10, @p c01 in Pa; @p formulation: exact incompressibility on
+     * P1-P1 by default. */
+    MooneyRivlin(const double       c10,
+                 const double       c01,
+                 const Formulation &formulation = Formulation());
+
+    Formulation
+    formulation() const override;
 
     double
     evaluate(const Tensor<2, 3> &F,
@@ -169,6 +309,18 @@ namespace palpate
       return true;
     }
 
+    /** The plug-in's entries and factory (the registry's). */
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+    static std::unique_ptr<Material>
+    create(const dealii::ParameterHandler &prm);
+
+    double
+    poissons_ratio() const override;
+
+    std::vector<std::pair<std::string, double>>
+    moduli() const override;
+
     double
     shear_modulus() const override;
 
@@ -181,6 +333,9 @@ namespace palpate
 
     /** The coefficients (Pa). */
     const double c10, c01;
+
+  private:
+    Formulation mixed;
   };
 
   /**

@@ -44,10 +44,6 @@ namespace palpate
      * other free surface vertex, the smallest radius that makes a tip. */
     double tip_neighbour_distance = 0;
 
-    /** With Effects / Surface traction: the loaded boundary faces' number
-     * and reference area (m^2). */
-    unsigned int traction_faces = 0;
-    double       traction_area  = 0;
     /** One line describing how the fixed nodes were chosen. */
     std::string fixed_description;
 

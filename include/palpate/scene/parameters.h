@@ -6,6 +6,7 @@
 
 #include <palpate/base/utilities.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -112,29 +113,32 @@ namespace palpate
     /** `subsection Material model`: the constitutive law and its data. */
     struct MaterialModel
     {
-      /** "St.Venant-Kirchhoff", "Neo-Hookean" or "Mooney-Rivlin". */
+      /** The name of a registered material plug-in
+       * ("St.Venant-Kirchhoff", "Neo-Hookean", "Mooney-Rivlin", ...). */
       std::string model_name;
       /** Mass density, kg/m^3 (used by gravity only). */
       double density;
 
-      /** St.Venant-Kirchhoff: Young's modulus (Pa), Poisson's ratio. */
-      double stvk_youngs_modulus, stvk_poissons_ratio;
-      /** Compressible neo-Hookean: Young's modulus (Pa), Poisson's ratio. */
-      double nh_youngs_modulus, nh_poissons_ratio;
-      /** Mooney-Rivlin coefficients C10, C01 and bulk modulus, Pa. */
-      double mr_c10, mr_c01, mr_bulk_modulus;
-      /** Mooney-Rivlin incompressibility: "exact" or "penalty". */
-      std::string mr_incompressibility;
-      /** Mooney-Rivlin element pair: "P1-P1" or "Taylor-Hood". */
-      std::string mr_element;
-      /** Pressure stabilisation for P1-P1: "none" or "Brezzi-Pitkaranta". */
-      std::string mr_stabilization;
-      /** Dimensionless factor of the pressure stabilisation. */
-      double mr_stabilization_factor;
+      /** Every registered model's entries (subsection Material model /
+       * NAME), as the scene set them or by default; only model_name's are
+       * used. Material::create() builds the material from them. */
+      std::map<std::string, std::map<std::string, std::string>> models;
 
-      /** Whether the model imposes incompressibility (adds pressure DoFs). */
-      bool
-      incompressible() const;
+      /** Set the entry @p entry of model @p model (tests, the study);
+       * the other entries keep their values (or defaults). */
+      void
+      set(const std::string &model,
+          const std::string &entry,
+          const std::string &value);
+      void
+      set(const std::string &model, const std::string &entry, double value);
+
+      /** The value of entry @p entry of model @p model (its default if
+       * the scene did not set it). */
+      std::string
+      get(const std::string &model, const std::string &entry) const;
+      double
+      get_double(const std::string &model, const std::string &entry) const;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
@@ -159,14 +163,27 @@ namespace palpate
     /** `subsection Effects`: what the scene simulates; all off by default. */
     struct Effects
     {
-      /** Body force rho*g. */
-      bool   gravity;
-      Point3 gravitational_acceleration;
-      /** A dead-load traction (Pa, per reference area) on the boundary
-       * faces with one boundary id. */
-      bool         surface_traction;
-      unsigned int traction_boundary_id;
-      Point3       traction;
+      /** The load effects (plug-ins: gravity, surface traction, ...):
+       * which are on (`Effects / NAME = true`), by name. */
+      std::map<std::string, bool> switches;
+      /** Each load effect's own entries, as the scene set them or by
+       * default (Effect::create_enabled() builds the effects from them). */
+      std::map<std::string, std::map<std::string, std::string>> loads;
+
+      /** Whether the load effect @p name is on. */
+      bool
+      on(const std::string &name) const;
+
+      /** Switch the load effect @p name on or off (tests, programs). */
+      void
+      turn_on(const std::string &name, const bool on = true);
+
+      /** Set the entry @p entry of the load effect @p effect. */
+      void
+      set(const std::string &effect,
+          const std::string &entry,
+          const std::string &value);
+
       /** Shape (whole displacement field) interpolation for rendering. */
       bool   shape_output;
       double shape_output_rate;

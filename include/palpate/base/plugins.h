@@ -1,0 +1,152 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_base_plugins_h
+#define palpate_base_plugins_h
+
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace dealii
+{
+  class ParameterHandler;
+}
+
+namespace palpate
+{
+  /**
+   * Pieces of palpate chosen by name in a scene (materials, effects) are
+   * plug-ins, registered the way ASPECT registers its material models: the
+   * plug-in's `.cc` ends with a registration macro that puts its name, a
+   * one-line description, its `declare_parameters` and its factory into the
+   * registry of its interface. The `Selection` patterns, the parameter
+   * reference, the scene report and the error messages are generated from
+   * the registry, so a new plug-in is one new file (doc/extending.md).
+   */
+  namespace Plugins
+  {
+    /**
+     * The values of a plug-in's own entries (entry name -> value, as text),
+     * as a scene file set them or as declared by default. Kept as text so
+     * that a scene can be copied, compared and changed (tests, the accuracy
+     * study) without knowing the plug-in's types.
+     */
+    using Entries = std::map<std::string, std::string>;
+
+    /**
+     * What a plug-in's factory throws when its entries do not make sense
+     * together (e.g. nu = 0.5). The scene turns it into an InputError that
+     * names the file, the line and the full entry path.
+     */
+    class EntryError : public std::runtime_error
+    {
+    public:
+      /** @p entry is the name inside the plug-in's own subsection. */
+      EntryError(const std::string &entry,
+                 const std::string &problem,
+                 const std::string &fix)
+        : std::runtime_error(entry + ": " + problem + "; " + fix)
+        , entry(entry)
+        , problem(problem)
+        , fix(fix)
+      {}
+
+      const std::string entry, problem, fix;
+    };
+
+    /** The declarations of one plug-in's entries, as its own subsection. */
+    using DeclareFunction = void (*)(dealii::ParameterHandler &prm);
+
+    /**
+     * The names and default values of the entries a declare function
+     * declares (it is run on a scratch ParameterHandler).
+     */
+    Entries
+    declared_entries(const DeclareFunction declare);
+
+    /**
+     * A scratch ParameterHandler with the plug-in's declarations and the
+     * values of @p entries set (unknown names and values that do not match
+     * an entry's pattern throw EntryError), for the plug-in's factory.
+     */
+    std::unique_ptr<dealii::ParameterHandler>
+    make_parameter_handler(const DeclareFunction declare,
+                           const Entries        &entries);
+
+    /**
+     * The registry of the plug-ins of one @p Interface. Each plug-in is a
+     * name (as scenes spell it), a one-line description, the declarations
+     * of its own entries and a factory that builds it from them.
+     */
+    template <typename Interface>
+    class Registry
+    {
+    public:
+      /** Build the plug-in from its entries (the ParameterHandler holds
+       * only them). Throws EntryError for values that make no sense. */
+      using CreateFunction =
+        std::unique_ptr<Interface> (*)(const dealii::ParameterHandler &prm);
+
+      struct Plugin
+      {
+        std::string     name;
+        std::string     description;
+        DeclareFunction declare_parameters;
+        CreateFunction  create;
+      };
+
+      /** Register @p plugin (at static initialisation, by the macro).
+       * Returns true; a second plug-in with the same name aborts: two
+       * files would claim one name. */
+      static bool
+      add(const Plugin &plugin);
+
+      /** Every registered plug-in, sorted by name. */
+      static const std::vector<Plugin> &
+      plugins();
+
+      /** The plug-in called @p name, or nullptr. */
+      static const Plugin *
+      find(const std::string &name);
+
+      /** The names joined by '|', for a Patterns::Selection. */
+      static std::string
+      selection();
+
+      /** The names as a sentence ("A, B or C"), for messages. */
+      static std::string
+      names_sentence();
+
+      /** Build the plug-in called @p name from @p entries (missing entries
+       * take their default). Throws EntryError. */
+      static std::unique_ptr<Interface>
+      create(const std::string &name, const Entries &entries);
+
+    private:
+      static std::vector<Plugin> &
+      storage();
+    };
+  } // namespace Plugins
+} // namespace palpate
+
+/**
+ * Register the plug-in @p classname of @p Interface under @p name. The class
+ * provides `static void declare_parameters(dealii::ParameterHandler &)` and
+ * `static std::unique_ptr<Interface> create(const dealii::ParameterHandler
+ * &)`. Put it at the end of the plug-in's `.cc`, at namespace scope.
+ */
+#define PALPATE_REGISTER_PLUGIN(Interface, classname, name, description) \
+  namespace                                                              \
+  {                                                                      \
+    [[maybe_unused]] const bool palpate_plugin_registered_##classname =  \
+      ::palpate::Plugins::Registry<Interface>::add(                      \
+        {name,                                                           \
+         description,                                                    \
+         &classname::declare_parameters,                                 \
+         &classname::create});                                           \
+  }
+
+#endif

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/plugins.h>
+#include <palpate/base/utilities.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <sstream>
+
+namespace palpate
+{
+  namespace Plugins
+  {
+    Entries
+    declared_entries(const DeclareFunction declare)
+    {
+      // deal.II 9.4 cannot list a subsection's entries; its short output
+      // format can ("set NAME = VALUE", one per line, names padded).
+      dealii::ParameterHandler prm;
+      declare(prm);
+      std::ostringstream out;
+      prm.print_parameters(out, dealii::ParameterHandler::ShortPRM);
+      Entries            entries;
+      std::istringstream in(out.str());
+      std::string        line;
+      while (std::getline(in, line))
+        {
+          line = Utilities::trim(line);
+          if (line.rfind("set ", 0) != 0)
+            continue;
+          const auto equals = line.find('=');
+          if (equals == std::string::npos)
+            continue;
+          entries[Utilities::trim(line.substr(4, equals - 4))] =
+            Utilities::trim(line.substr(equals + 1));
+        }
+      return entries;
+    }
+
+
+
+    std::unique_ptr<dealii::ParameterHandler>
+    make_parameter_handler(const DeclareFunction declare,
+                           const Entries        &entries)
+    {
+      auto prm = std::make_unique<dealii::ParameterHandler>();
+      declare(*prm);
+      for (const auto &[name, value] : entries)
+        try
+          {
+            prm->set(name, value);
+          }
+        catch (const std::exception &)
+          {
+            const auto declared = declared_entries(declare);
+            throw EntryError(name,
+                             declared.count(name) == 0 ?
+                               "no such entry" :
+                               "\"" + value + "\" is not a valid value",
+                             declared.count(name) == 0 ?
+                               "remove it." :
+                               "the default is " + declared.at(name) + ".");
+          }
+      return prm;
+    }
+  } // namespace Plugins
+} // namespace palpate
