@@ -294,6 +294,12 @@ namespace palpate
           << shape->frames().second << " skipped for missing states, "
           << shape->frames_skipped_busy()
           << " skipped while the machine was busy"
+          << (shape->frames_decimated() > 0 ?
+                ", " + std::to_string(shape->frames_decimated()) +
+                  " thinned out (past half of Shape output limit = " +
+                  Utilities::to_string(p.effects.shape_output_limit, 4) +
+                  " MiB the rate halves, past 3/4 it halves again, ...)" :
+                std::string())
           << (shape->frames_over_limit() > 0 ?
                 ", " + std::to_string(shape->frames_over_limit()) +
                   " left out beyond Shape output limit = " +

@@ -61,9 +61,11 @@ namespace palpate
     const std::function<double()> clock;
     const double                  max_bytes;
     double                        bytes = 0;
+    unsigned long                 due   = 0; // moving frames, for decimation
     ShapeFrames                   frames;
     std::atomic<bool>             running{false};
-    std::atomic<unsigned int>     written{0}, skipped{0}, busy{0}, over{0};
+    std::atomic<unsigned int>     written{0}, skipped{0}, busy{0}, over{0},
+      thinned{0};
     std::string failure; // written by the thread before it ends
     std::vector<std::pair<double, std::string>> records;
     std::thread                                 thread;
@@ -228,6 +230,22 @@ namespace palpate
             any  = true;
             continue;
           }
+        // Decimation: past half the limit every 2nd frame is written, past
+        // 3/4 every 4th, past 7/8 every 8th, ... so a long run keeps frames
+        // of its whole length at a coarser rate instead of stopping.
+        {
+          unsigned int stride = 1;
+          for (double left = max_bytes - bytes;
+               left <= 0.5 * max_bytes / stride && stride < (1u << 20);)
+            stride *= 2;
+          if (due++ % stride != 0)
+            {
+              ++thinned;
+              last = x;
+              any  = true;
+              continue;
+            }
+        }
         GridIndex             lower;
         std::array<double, 3> local;
         if (!grid.locate(x, lower, local))
@@ -350,6 +368,14 @@ namespace palpate
   ShapeInterpolator::frames_skipped_busy() const
   {
     return impl->busy.load();
+  }
+
+
+
+  unsigned int
+  ShapeInterpolator::frames_decimated() const
+  {
+    return impl->thinned.load();
   }
 
 

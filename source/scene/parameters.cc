@@ -568,8 +568,11 @@ namespace palpate
                           Patterns::Double(0.),
                           "The most the shape frames of one run may write "
                           "(MiB), so that a long run cannot fill the disk: "
-                          "beyond it no frame is written, and the run says "
-                          "how many it left out. A frame of a 500-node liver "
+                          "past half of it every 2nd frame is written, past "
+                          "3/4 every 4th, and so on (a long run keeps frames "
+                          "of its whole length); at the limit no frame is "
+                          "written. The run says how many it thinned out and "
+                          "left out. A frame of a 500-node liver "
                           "is about 85 KiB (about 2.5 MiB per second at "
                           "30 Hz).");
         prm.declare_entry("VTU export",

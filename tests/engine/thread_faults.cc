@@ -209,6 +209,43 @@ main(int argc, char **argv)
             << ", frames written: " << shape.frames().first
             << ", later frames left out and counted: "
             << (left_out ? "yes" : "NO") << std::endl;
+    const auto frame_bytes =
+      std::filesystem::file_size("limited/beam-shape-00000.vtu");
+    std::filesystem::remove_all("limited");
+
+    // Decimation: with room for 8 frames, the first 4 are written at the
+    // full rate; past half the limit every 2nd, past 3/4 every 4th, past
+    // 7/8 every 8th; then none.
+    palpate::Interaction decimated(scene);
+    decimated.attach();
+    wait_for([&] { return decimated.initial_cloud_complete(); }, 300);
+    palpate::ShapeInterpolator thinned(
+      decimated, 50, "limited", "beam", nullptr, 8.0 * frame_bytes);
+    thinned.start();
+    step               = 0;
+    const bool reached = wait_for(
+      [&] {
+        decimated.force({{1e-5 * (++step % 20), 0, 0}});
+        return thinned.frames_over_limit() >= 3;
+      },
+      60);
+    thinned.stop();
+    decimated.detach();
+    const unsigned int written = thinned.frames().first;
+    deallog << "decimation: limit reached " << (reached ? "yes" : "NO")
+            << ", frames written 7-9: "
+            << (written >= 7 && written <= 9 ? "yes" : "NO")
+            << ", frames thinned out (expected about 1 + 3 + 7 = 11) 8-16: "
+            << (thinned.frames_decimated() >= 8 &&
+                    thinned.frames_decimated() <= 16 ?
+                  "yes" :
+                  "NO")
+            << std::endl;
+    if (written < 7 || written > 9 || thinned.frames_decimated() < 8 ||
+        thinned.frames_decimated() > 16)
+      deallog << "  written " << written << ", thinned "
+              << thinned.frames_decimated() << ", frame " << frame_bytes
+              << " bytes" << std::endl;
     std::filesystem::remove_all("limited");
   }
 }

@@ -94,6 +94,11 @@ namespace palpate
     unsigned int
     frames_skipped_busy() const;
 
+    /** Frames thinned out to stay under @p max_bytes: past half of it
+     * every 2nd frame is written, past 3/4 every 4th, and so on. */
+    unsigned int
+    frames_decimated() const;
+
     /** Frames left out because the frames reached @p max_bytes. */
     unsigned int
     frames_over_limit() const;
