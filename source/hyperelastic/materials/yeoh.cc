@@ -135,7 +135,8 @@ namespace palpate
                " Pa, C30 = " + Utilities::to_string(c[2]) + " Pa, " +
                (mixed.pressure == Formulation::Pressure::exact ?
                   "exactly incompressible, " + mixed.element + " elements" :
-                  "nearly incompressible");
+                  "nearly incompressible, bulk modulus " +
+                    Utilities::to_string(mixed.bulk_modulus) + " Pa");
       }
 
     private:
