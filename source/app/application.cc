@@ -11,8 +11,10 @@
 #include <palpate/haptics/run_summary.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
+#include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -42,6 +44,15 @@ namespace palpate
       "                                  tolerance, staging, mesh and element\n"
       "                                  against direct solves; recommends a\n"
       "                                  setting (doc/accuracy-vs-time.md)\n"
+      "  palpate mesh SURFACE OUT.msh [--nodes N] [--scale S]\n"
+      "               [--time-limit T]\n"
+      "                                  make a tetrahedral mesh of an organ's\n"
+      "                                  closed surface (.stl, .obj, .ply, .vtk,\n"
+      "                                  .vtp; S metres per file unit, 0.001\n"
+      "                                  for millimetres; N nodes, 1500 by\n"
+      "                                  default): repairs, checks, meshes with\n"
+      "                                  Gmsh, reports the quality\n"
+      "                                  (doc/your-organ.md)\n"
       "  mpirun -np N palpate SCENE.prm  the same with Engine / Type = mpi:\n"
       "                                  rank 0 is the haptic client, ranks\n"
       "                                  1..N-1 are solver servers\n"
@@ -163,6 +174,102 @@ namespace palpate
                ExitStatus::solve_failed;
     }
 
+    /** A whole number or a positive number from the command line. */
+    double
+    number_argument(const std::string &option,
+                    const std::string &value,
+                    const double       lo,
+                    const double       hi,
+                    const std::string &example)
+    {
+      std::size_t end = 0;
+      double      x   = 0;
+      try
+        {
+          x = std::stod(value, &end);
+        }
+      catch (const std::exception &)
+        {
+          end = 0;
+        }
+      if (end != value.size() || !(x >= lo && x <= hi))
+        throw InputError("command line",
+                         0,
+                         option + " " + value,
+                         "expected a number from " + Utilities::to_string(lo) +
+                           " to " + Utilities::to_string(hi),
+                         "e.g. " + option + " " + example + ".");
+      return x;
+    }
+
+    /** palpate mesh SURFACE OUT.msh [--nodes N] [--scale S]
+     * [--time-limit T]. */
+    int
+    run_mesh(const std::vector<std::string> &args, std::ostream &out)
+    {
+      if (args.size() < 3 || args[1][0] == '-' || args[2][0] == '-')
+        throw InputError("command line",
+                         0,
+                         "mesh",
+                         "'mesh' needs a surface file and an output file",
+                         "run 'palpate mesh SURFACE.stl OUT.msh --scale "
+                         "0.001' (for a surface in millimetres).");
+      double       scale = 1, time_limit = 60;
+      unsigned int nodes = 1500;
+      for (unsigned int i = 3; i < args.size(); ++i)
+        {
+          const bool has_value = i + 1 < args.size();
+          if (args[i] == "--nodes" && has_value)
+            nodes = static_cast<unsigned int>(
+              number_argument("--nodes", args[++i], 50, 200000, "1500"));
+          else if (args[i] == "--scale" && has_value)
+            scale = number_argument("--scale", args[++i], 1e-9, 1e9, "0.001");
+          else if (args[i] == "--time-limit" && has_value)
+            time_limit =
+              number_argument("--time-limit", args[++i], 0.01, 86400, "60");
+          else
+            throw InputError("command line",
+                             0,
+                             args[i],
+                             "unexpected argument '" + args[i] + "'",
+                             "run 'palpate --help' for the usage.");
+        }
+      if (std::filesystem::path(args[2]).extension() != ".msh")
+        throw InputError("command line",
+                         0,
+                         args[2],
+                         "the volume mesh is written as Gmsh 2.2, so its "
+                         "name must end in .msh",
+                         "e.g. 'palpate mesh " + args[1] + " organ.msh'.");
+      {
+        // Check that the output can be written before any work.
+        const auto      dir = std::filesystem::path(args[2]).parent_path();
+        std::error_code ec;
+        if (!dir.empty())
+          std::filesystem::create_directories(dir, ec);
+        const bool    existed = std::filesystem::exists(args[2]);
+        std::ofstream probe(args[2], std::ios::app);
+        if (!probe)
+          throw OutputError("cannot write '" + args[2] +
+                            "': check that its directory exists and is "
+                            "writable");
+        probe.close();
+        if (!existed)
+          std::filesystem::remove(args[2], ec);
+      }
+      out << "palpate mesh: " << args[1] << " -> " << args[2] << " (about "
+          << nodes << " nodes, " << Utilities::to_string(scale, 6)
+          << " m per file unit)\n";
+      const SurfaceMeshReport report = mesh_surface_file(
+        args[1], scale, "--scale", nodes, time_limit, args[2]);
+      for (const auto &line : report.lines())
+        out << "  " << line << "\n";
+      out << "  use it:        subsection Mesh: set Source = file, set File "
+             "name = "
+          << args[2] << ", set Scale factor = 1 (the mesh is in metres)\n";
+      return ExitStatus::success;
+    }
+
     int
     dispatch(const std::vector<std::string> &args, std::ostream &out)
     {
@@ -230,6 +337,8 @@ namespace palpate
                                "run 'palpate --help' for the usage.");
           return run_scene(args[1], target, true, out);
         }
+      if (args[0] == "mesh")
+        return run_mesh(args, out);
       if (args[0] == "study")
         {
           if (args.size() < 2 || args[1].empty() || args[1][0] == '-')

@@ -86,6 +86,12 @@ namespace palpate
 
     auto         trajectory = Trajectory::create(scene);
     const double duration   = trajectory->duration();
+    // How far the scene's own trajectory takes the probe from rest, along
+    // any axis: beyond the grid's extent the force fades to zero.
+    double reach = 0;
+    for (unsigned int k = 0; k <= 1000; ++k)
+      for (const double x : trajectory->position(duration * k / 1000))
+        reach = std::max(reach, std::abs(x));
     if (duration > Limits::max_motion_duration)
       throw InputError(
         scene.resolve_path(p.haptics.trajectory.file_name),
@@ -116,8 +122,15 @@ namespace palpate
         << "  device:        " << device.description() << "\n"
         << "  haptic loop:   " << p.haptics.loop_rate << " Hz, force limit "
         << p.haptics.force_limit << " N, at most " << p.haptics.max_force_change
-        << " N change per tick\n"
-        << std::flush;
+        << " N change per tick\n";
+    if (reach > grid.half_width() * grid.spacing())
+      out << "  warning:       the trajectory goes " << 1000 * reach
+          << " mm from rest, beyond the state space's extent of +-"
+          << 1000 * grid.half_width() * grid.spacing()
+          << " mm: there the force fades to zero. Enlarge State space / "
+             "Extent to at least "
+          << 1000 * reach << " mm.\n";
+    out << std::flush;
 
     const std::string stem =
       scene.file().empty() ?

@@ -5,7 +5,9 @@
 #include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/material.h>
 #include <palpate/mesh/mesh.h>
+#include <palpate/mesh/mesh_quality.h>
 #include <palpate/mesh/node_selection.h>
+#include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
 #include <iomanip>
@@ -56,6 +58,42 @@ namespace palpate
       << Utilities::to_string(box.second, 4) << "] m, size "
       << box.second[0] - box.first[0] << " x " << box.second[1] - box.first[1]
       << " x " << box.second[2] - box.first[2] << " m\n";
+    // Quality, and slivers where the body deforms most: near the active
+    // node (within a tenth of the body's size).
+    const MeshQuality quality = mesh_quality(mesh.vertices(), mesh.cells());
+    s << "  quality:       " << quality.summary() << "\n";
+    if (nodes.active_vertex != NodeSelection::no_active_node)
+      {
+        const auto  &x     = mesh.vertices();
+        const auto  &xa0   = x[nodes.active_vertex];
+        const double near  = 0.1 * mesh.diameter();
+        unsigned int close = 0;
+        for (const unsigned int c : quality.slivers)
+          {
+            bool is_near = false;
+            for (const unsigned int v : mesh.cells()[c])
+              is_near = is_near || Utilities::distance(x[v], xa0) < near;
+            close += is_near;
+          }
+        if (close > 0)
+          s << "  warning:       " << close << " of the "
+            << quality.slivers.size() << " slivers lie within " << 1000 * near
+            << " mm of the active node, where the body deforms most: their "
+               "strains are unreliable and Newton may need more steps. A "
+               "finer or optimised mesh (palpate mesh, or Gmsh's "
+               "Optimize) removes them.\n";
+      }
+    // A body smaller than 2 cm or larger than 1 m is likely a unit slip
+    // (2 mm and 2 m are refused outright).
+    if (const std::string advice =
+          unit_advice(mesh.diameter(),
+                      p.mesh.source == "file" || p.mesh.source == "surface" ?
+                        p.mesh.scale_factor :
+                        1.0);
+        !advice.empty() &&
+        (p.mesh.source == "file" || p.mesh.source == "surface"))
+      s << "  warning:       the body is " << mesh.diameter()
+        << " m across: is Mesh / Scale factor right? " << advice << ".\n";
 
     const auto &f  = p.boundary_conditions.fixed_nodes;
     const auto &a  = p.boundary_conditions.active_node;
@@ -68,6 +106,13 @@ namespace palpate
     if (a.selection == "nearest surface node")
       s << ", the surface node nearest to (" << Utilities::to_string(a.point, 4)
         << ") m, " << 1000 * nodes.active_distance << " mm away";
+    if (a.selection == "nearest surface node" &&
+        nodes.active_distance > 0.1 * mesh.diameter())
+      s << "\n  warning:       the Point is " << 1000 * nodes.active_distance
+        << " mm from the body's surface ("
+        << 100 * nodes.active_distance / mesh.diameter()
+        << " % of its size): is it in the mesh's scaled coordinates (metres, "
+           "after Scale factor)? The bounding box is below.";
     if (!nodes.tip_vertices.empty() ||
         p.boundary_conditions.active_node.tip_radius > 0)
       s << "\n  probe tip:     radius "

@@ -102,7 +102,19 @@ namespace palpate
           << state.max_increment_iterations << " per increment)\n"
           << "  force on probe: (" << Utilities::to_string(state.force, 5)
           << ") N, |f| = "
-          << Utilities::to_string(Utilities::norm(state.force), 5) << " N\n";
+          << Utilities::to_string(Utilities::norm(state.force), 5) << " N\n"
+          << (Utilities::norm(state.force) >
+                  3 * scene.parameters.haptics.force_limit ?
+                "  warning:        this is " +
+                  Utilities::to_string(Utilities::norm(state.force) /
+                                         scene.parameters.haptics.force_limit,
+                                       3) +
+                  " times the device's force limit (Haptics / Force limit = " +
+                  Utilities::to_string(scene.parameters.haptics.force_limit,
+                                       4) +
+                  " N): the device would clip it. Is the modulus in Pa, the "
+                  "push in metres, the mesh's Scale factor right?\n" :
+                std::string());
     else
       out << "  FAILURE POINT:  " << to_string(state.status) << ": "
           << state.message << "\n  (no force is reported for a failure point)\n"

@@ -4,6 +4,7 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh.h>
+#include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
 #include <deal.II/grid/tria.h>
@@ -11,7 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -75,6 +78,83 @@ namespace palpate
           i         = parent[i];
         }
       return i;
+    }
+
+    /**
+     * Mesh / Source = surface: the volume mesh palpate made of the surface
+     * before, or a new one. Its name holds a hash of the surface file's
+     * bytes, the scale factor and the target, so a changed surface or
+     * setting is meshed again and an unchanged one never is.
+     */
+    Mesh
+    from_surface(const Scene &scene)
+    {
+      namespace fs     = std::filesystem;
+      const auto &p    = scene.parameters.mesh;
+      const auto  path = scene.resolve_path(p.file_name);
+      std::string bytes;
+      {
+        std::ifstream in(path, std::ios::binary);
+        if (!in)
+          throw scene.error(
+            "Mesh/File name",
+            "the surface file '" + path + "' " +
+              (fs::exists(path) ? "cannot be read" : "does not exist"),
+            "a relative path is relative to the directory of the scene "
+            "file.");
+        std::ostringstream s;
+        s << in.rdbuf();
+        bytes = s.str();
+      }
+      std::uint64_t hash = 1469598103934665603ull; // FNV-1a
+      for (const char c :
+           bytes + "|" + Utilities::to_string(p.scale_factor, 17) + "|" +
+             std::to_string(p.surface_target_nodes) + "|palpate-mesh-1")
+        hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+      char hex[17];
+      std::snprintf(hex, sizeof(hex), "%016llx", (unsigned long long)hash);
+      const fs::path  directory(p.surface_mesh_directory);
+      std::error_code ec;
+      fs::create_directories(directory, ec);
+      if (ec || !fs::is_directory(directory))
+        throw scene.error("Mesh/Surface/Volume mesh directory",
+                          "the directory '" + directory.string() +
+                            "' cannot be created (" + ec.message() + ")",
+                          "name a directory palpate may write to.");
+      const fs::path file =
+        directory / (fs::path(path).stem().string() + "-" +
+                     std::to_string(p.surface_target_nodes) + "-" +
+                     std::string(hex).substr(0, 8) + ".msh");
+      std::string how = "reused";
+      if (!fs::exists(file))
+        try
+          {
+            const auto report = mesh_surface_file(path,
+                                                  p.scale_factor,
+                                                  "Mesh / Scale factor",
+                                                  p.surface_target_nodes,
+                                                  p.surface_time_limit,
+                                                  file.string());
+            how               = "meshed now in " +
+                  Utilities::to_string(report.meshing.seconds, 3) + " s";
+            const auto repairs = report.repairs.lines();
+            for (const auto &r : repairs)
+              how += "; " + r;
+          }
+        catch (const InputError &e)
+          {
+            throw InputError(e.file(),
+                             e.line(),
+                             e.entry(),
+                             e.problem(),
+                             e.fix() + " (The scene '" + scene.file() +
+                               "' reads this surface through Mesh / File "
+                               "name.)");
+          }
+      return Mesh(read_mesh_file(file.string()),
+                  1.0,
+                  p.file_name + ", meshed by palpate into " + file.string() +
+                    " (" + how + ")");
     }
 
     std::string
@@ -359,6 +439,13 @@ namespace palpate
       return Mesh(generate_beam(p), 1.0, "the beam generator");
     if (p.source == "blob")
       return Mesh(generate_blob(p), 1.0, "the blob generator");
+
+    if (p.source == "surface")
+      {
+        auto mesh = from_surface(scene);
+        check_size(scene, mesh);
+        return mesh;
+      }
 
     const std::string path = scene.resolve_path(p.file_name);
     if (!std::filesystem::exists(path))

@@ -501,6 +501,24 @@ namespace palpate
     MeshData
     read_vtk(const std::string &filename)
     {
+      // A surface (POLYDATA) is not a volume mesh, whatever its encoding:
+      // say so before anything else.
+      {
+        std::ifstream head(filename, std::ios::binary);
+        std::string   start(512, '\0');
+        head.read(&start[0], start.size());
+        start.resize(head.gcount());
+        if (start.find("DATASET POLYDATA") != std::string::npos)
+          throw InputError(filename,
+                           0,
+                           "mesh file",
+                           "this legacy VTK file is a surface (POLYDATA): "
+                           "palpate needs a tetrahedral volume mesh here",
+                           "make one with 'palpate mesh " + filename +
+                             " OUT.msh --scale S' (S = metres per file "
+                             "unit, 0.001 for millimetres), or set Mesh / "
+                             "Source = surface with this file as File name.");
+      }
       LineReader reader(filename);
       MeshData   data;
 
@@ -1118,7 +1136,7 @@ namespace palpate
     }
 
     MeshData
-    read_vtu(const std::string &filename)
+    read_vtk_xml(const std::string &filename, const bool polydata)
     {
       std::string text = file_contents(filename);
 
@@ -1148,13 +1166,21 @@ namespace palpate
                          "check the file name and extension (.msh, .vtk, "
                          ".vtu).");
       const std::string file_tag = tag_at(file_tag_begin);
-      if (attribute(file_tag, "type") != "UnstructuredGrid")
-        throw InputError(filename,
-                         1,
-                         "mesh file",
-                         "the VTK XML file is not an UnstructuredGrid",
-                         "save the tetrahedral mesh as a .vtu unstructured "
-                         "grid.");
+      const std::string expected = polydata ? "PolyData" : "UnstructuredGrid";
+      if (attribute(file_tag, "type") != expected)
+        throw InputError(
+          filename,
+          1,
+          polydata ? "surface file" : "mesh file",
+          "the VTK XML file is a " + attribute(file_tag, "type") + ", not a " +
+            expected,
+          polydata ? "save the surface as a .vtp PolyData of triangles." :
+          attribute(file_tag, "type") == "PolyData" ?
+                     "this is a surface: give it to 'palpate mesh SURFACE "
+                     "OUT.msh', or set Mesh / Source = surface, to make a "
+                     "tetrahedral mesh of it." :
+                     "save the tetrahedral mesh as a .vtu unstructured "
+                     "grid.");
       if (attribute(file_tag, "byte_order") == "BigEndian")
         throw InputError(filename,
                          1,
@@ -1216,12 +1242,17 @@ namespace palpate
       const unsigned int  piece_line = line_at(text, piece);
       const std::uint64_t n_points   = count_attribute(
         filename, piece_line, "Piece", piece_tag, "NumberOfPoints");
-      const std::uint64_t n_cells = count_attribute(
-        filename, piece_line, "Piece", piece_tag, "NumberOfCells");
+      const std::uint64_t n_cells =
+        count_attribute(filename,
+                        piece_line,
+                        "Piece",
+                        piece_tag,
+                        polydata ? "NumberOfPolys" : "NumberOfCells");
 
       // Collect the data arrays of the <Points> and <Cells> sections.
       std::map<std::string, std::vector<double>> arrays;
-      for (const std::string section : {"Points", "Cells"})
+      for (const std::string &section :
+           {std::string("Points"), std::string(polydata ? "Polys" : "Cells")})
         {
           const auto begin = text.find("<" + section + ">", piece);
           const auto end   = text.find("</" + section + ">", piece);
@@ -1261,6 +1292,8 @@ namespace palpate
               pos         = next;
             }
         }
+      if (polydata)
+        arrays["types"].assign(n_cells, 0); // polygons, split below
       for (const std::string key :
            {"points", "connectivity", "offsets", "types"})
         if (arrays.count(key) == 0)
@@ -1325,12 +1358,46 @@ namespace palpate
           types.push_back(type <= 255 ? static_cast<int>(type) : -1);
           begin = end;
         }
+      if (polydata)
+        {
+          // Polygons: split into fans of triangles.
+          for (const auto &cell : cells)
+            for (std::size_t k = 1; k + 1 < cell.size(); ++k)
+              {
+                for (const long v : {cell[0], cell[k], cell[k + 1]})
+                  if (static_cast<std::size_t>(v) >= n_points)
+                    throw InputError(filename,
+                                     1,
+                                     "surface file",
+                                     "a polygon refers to point " +
+                                       std::to_string(v) + " of " +
+                                       std::to_string(n_points),
+                                     "the file is damaged; write it again.");
+                data.triangles.push_back(
+                  {{static_cast<unsigned int>(cell[0]),
+                    static_cast<unsigned int>(cell[k]),
+                    static_cast<unsigned int>(cell[k + 1])}});
+                data.triangle_boundary_ids.push_back(0);
+                data.triangle_lines.push_back(0);
+              }
+          data.format = std::string("VTP ") +
+                        (ctx.compressed ? "zlib-compressed" : "uncompressed");
+          return data;
+        }
       LineReader reader(filename);
       add_vtk_cells(
         reader, cells, types, std::vector<unsigned int>(cells.size(), 0), data);
       return data;
     }
   } // namespace
+
+
+
+  MeshData
+  read_vtp(const std::string &filename)
+  {
+    return read_vtk_xml(filename, true);
+  }
 
 
 
@@ -1384,7 +1451,18 @@ namespace palpate
     if (extension == ".vtk")
       return read_vtk(filename);
     if (extension == ".vtu")
-      return read_vtu(filename);
+      return read_vtk_xml(filename, false);
+    if (extension == ".vtp" || extension == ".stl" || extension == ".obj" ||
+        extension == ".ply")
+      throw InputError(filename,
+                       0,
+                       "mesh file",
+                       "this is a surface file (" + extension +
+                         "): palpate needs a tetrahedral volume mesh here",
+                       "make one with 'palpate mesh " + filename +
+                         " OUT.msh --scale S' (S = metres per file unit, "
+                         "0.001 for millimetres), or set Mesh / Source = "
+                         "surface with this file as File name.");
     throw InputError(filename,
                      0,
                      "mesh file",

@@ -52,11 +52,14 @@ namespace palpate
       {
         prm.declare_entry("Source",
                           "blob",
-                          Patterns::Selection("file|beam|blob"),
+                          Patterns::Selection("file|surface|beam|blob"),
                           "Where the tetrahedral mesh of the body comes from: "
-                          "a mesh file, or one of the built-in generators "
-                          "(a rectangular beam, an organ-like blob). The "
-                          "generators need no external data.");
+                          "a mesh file; an organ's closed surface (File name: "
+                          ".stl, .obj, .ply, .vtk or .vtp), meshed by palpate "
+                          "(see subsection Surface) and kept for the next "
+                          "run; or one of the built-in generators (a "
+                          "rectangular beam, an organ-like blob), which need "
+                          "no external data.");
         prm.declare_entry(
           "File name",
           "",
@@ -64,8 +67,10 @@ namespace palpate
           "Mesh file read when Source = file: Gmsh .msh (format 2.2 or "
           "v1, ASCII), legacy VTK .vtk (ASCII UNSTRUCTURED_GRID) or "
           ".vtu (ASCII or base64 binary, uncompressed). Only linear "
-          "tetrahedra form the body; triangles set boundary ids. A relative "
-          "path is relative to the directory of the scene file.");
+          "tetrahedra form the body; triangles set boundary ids. With "
+          "Source = surface: the organ's closed surface (.stl, .obj, .ply, "
+          ".vtk POLYDATA, .vtp). A relative path is relative to the "
+          "directory of the scene file.");
         prm.declare_entry("Scale factor",
                           "1",
                           Patterns::Double(0.),
@@ -94,6 +99,32 @@ namespace palpate
                             Patterns::List(Patterns::Integer(1), 3, 3, ","),
                             "Number of hexahedral blocks along x, y, z; each "
                             "block is split into tetrahedra (dimensionless).");
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Surface");
+        {
+          prm.declare_entry("Target nodes",
+                            "1500",
+                            Patterns::Integer(50, 200000),
+                            "With Source = surface: about how many nodes the "
+                            "volume mesh has (within 15 %). The paper's "
+                            "livers have 501 and 2011; each state costs "
+                            "roughly in proportion.");
+          prm.declare_entry("Time limit",
+                            "60",
+                            Patterns::Double(0.01),
+                            "With Source = surface: the most the meshing may "
+                            "take (s); Gmsh is stopped after it, so a bad "
+                            "surface cannot hang palpate.");
+          prm.declare_entry(
+            "Volume mesh directory",
+            "meshes",
+            Patterns::DirectoryName(),
+            "With Source = surface: where palpate keeps the volume meshes it "
+            "makes (Gmsh 2.2, in metres), relative to the current "
+            "directory. A mesh is reused while the surface file, the scale "
+            "factor and the target are the same.");
         }
         prm.leave_subsection();
 
@@ -139,6 +170,14 @@ namespace palpate
           beam_subdivisions_length = sub[0];
           beam_subdivisions_width  = sub[1];
           beam_subdivisions_height = sub[2];
+        }
+        prm.leave_subsection();
+
+        prm.enter_subsection("Surface");
+        {
+          surface_target_nodes   = prm.get_integer("Target nodes");
+          surface_time_limit     = prm.get_double("Time limit");
+          surface_mesh_directory = prm.get("Volume mesh directory");
         }
         prm.leave_subsection();
 

@@ -3,6 +3,7 @@
 
 #include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/material.h>
+#include <palpate/mesh/surface.h>
 #include <palpate/scene/scene.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -854,6 +855,28 @@ namespace palpate
                   "Source = file, but no mesh file is named",
                   "set File name to a .msh, .vtk or .vtu file, or choose "
                   "Source = beam or blob.");
+    if (p.mesh.source == "surface" && p.mesh.file_name.empty())
+      throw error("Mesh/File name",
+                  "Source = surface, but no surface file is named",
+                  "set File name to the organ's closed surface (.stl, .obj, "
+                  ".ply, .vtk or .vtp).");
+    // A file named for a generator is a mistake: the run would silently
+    // use a beam or blob instead of the organ the user meant.
+    if ((p.mesh.source == "beam" || p.mesh.source == "blob") &&
+        !p.mesh.file_name.empty() && line_of("Mesh/File name") > 0)
+      throw error("Mesh/File name",
+                  "a file is named, but Source = " + p.mesh.source +
+                    " generates the mesh and ignores it",
+                  "set Source = file (a tetrahedral mesh) or Source = "
+                  "surface (an organ's surface, meshed by palpate), or "
+                  "remove File name.");
+    if (p.mesh.source == "file" && is_surface_file_name(p.mesh.file_name) &&
+        std::filesystem::path(p.mesh.file_name).extension() != ".vtk")
+      throw error("Mesh/Source",
+                  "Source = file reads a tetrahedral mesh, but '" +
+                    p.mesh.file_name + "' is a surface",
+                  "set Source = surface: palpate then meshes the surface "
+                  "(and keeps the mesh for the next run).");
     if (p.mesh.scale_factor <= 0)
       throw error("Mesh/Scale factor",
                   "the scale factor must be positive",

@@ -55,6 +55,14 @@ namespace palpate
    */
   MeshData
   read_mesh_file(const std::string &filename);
+
+  /**
+   * Read a VTK XML PolyData file (.vtp, the same encodings as .vtu): its
+   * points, and its polygons split into triangles (boundary id 0). For the
+   * surface reader.
+   */
+  MeshData
+  read_vtp(const std::string &filename);
 } // namespace palpate
 
 #endif

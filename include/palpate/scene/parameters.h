@@ -31,7 +31,7 @@ namespace palpate
     /** `subsection Mesh`: where the body's tetrahedral mesh comes from. */
     struct Mesh
     {
-      /** "file", "beam" or "blob". */
+      /** "file", "surface", "beam" or "blob". */
       std::string source;
       /** Mesh file (.msh Gmsh 2.2 or v1, .vtk, .vtu) as written in the scene.
        */
@@ -47,6 +47,12 @@ namespace palpate
       /** Blob generator: semi-axes in metres and refinement count. */
       Point3       blob_semi_axes;
       unsigned int blob_refinements;
+
+      /** Source = surface: the volume mesh's target node count, the
+       * meshing time limit (s) and where the volume meshes are kept. */
+      unsigned int surface_target_nodes;
+      double       surface_time_limit;
+      std::string  surface_mesh_directory;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);

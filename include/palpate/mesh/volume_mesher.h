@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_mesh_volume_mesher_h
+#define palpate_mesh_volume_mesher_h
+
+#include <palpate/mesh/mesh_quality.h>
+#include <palpate/mesh/surface.h>
+#include <palpate/mesh/surface_repair.h>
+
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  /** What mesh_volume() made. */
+  struct VolumeMeshing
+  {
+    unsigned int nodes = 0, tetrahedra = 0, surface_triangles = 0;
+    /** The element size the mesher was given (m). */
+    double size = 0;
+    /** Meshing attempts (the size is corrected toward the target count). */
+    unsigned int attempts = 0;
+    /** Wall-clock time of the meshing (s). */
+    double seconds = 0;
+  };
+
+  /**
+   * Remesh the closed, repaired @p surface (metres) to elements of about
+   * the size that gives @p target_nodes nodes, tetrahedralise it with Gmsh
+   * (its API: surface classification, reparametrisation, Frontal-Delaunay
+   * surfaces and Delaunay volumes, then optimisation) and write the volume
+   * mesh to @p out_msh as Gmsh 2.2 ASCII in metres (physical volume 1,
+   * boundary triangles with boundary id 1).
+   *
+   * Gmsh runs in a child process that is killed after @p time_limit
+   * seconds, so a bad surface can never hang palpate. Failures (the limit,
+   * a surface Gmsh cannot mesh, e.g. with self-intersections left after
+   * remeshing) throw an InputError naming @p surface_name and the fix.
+   */
+  VolumeMeshing
+  mesh_volume(const Surface     &surface,
+              const unsigned int target_nodes,
+              const double       time_limit,
+              const std::string &out_msh,
+              const std::string &surface_name);
+
+  /** Everything `palpate mesh` (and Mesh / Source = surface) did. */
+  struct SurfaceMeshReport
+  {
+    /** The surface as read (after the scale factor). */
+    std::string                      format;
+    unsigned int                     vertices = 0, triangles = 0;
+    double                           diameter = 0, area = 0;
+    std::array<Utilities::Point3, 2> box;
+    SurfaceRepair                    repairs;
+    /** The repaired surface's volume (m^3). */
+    double volume = 0;
+    /** Intersecting triangle pairs of the input, and where the first is. */
+    unsigned int      self_intersections = 0;
+    Utilities::Point3 intersection{{0, 0, 0}};
+    VolumeMeshing     meshing;
+    /** The volume mesh's volume (m^3) and quality. */
+    double      mesh_volume = 0;
+    MeshQuality quality;
+
+    /** The report, a line each, indented by two spaces. */
+    std::vector<std::string>
+    lines() const;
+  };
+
+  /**
+   * The whole way from a surface file to a volume mesh: read @p surface_file
+   * (coordinates times @p scale, metres per file unit), check that the body
+   * has an organ's size (else an InputError on @p scale_entry that names
+   * the likely unit), repair it, count its self-intersections, mesh it
+   * (mesh_volume()) to @p out_msh and measure the result's quality.
+   */
+  SurfaceMeshReport
+  mesh_surface_file(const std::string &surface_file,
+                    const double       scale,
+                    const std::string &scale_entry,
+                    const unsigned int target_nodes,
+                    const double       time_limit,
+                    const std::string &out_msh);
+
+  /**
+   * Advice for a body @p size metres across at @p factor metres per file
+   * unit: which unit the file most likely uses and the factor to set
+   * ("it looks like millimetres: set 0.001"), or "" if the size is an
+   * organ's (2 cm to 1 m).
+   */
+  std::string
+  unit_advice(const double size, const double factor);
+} // namespace palpate
+
+#endif

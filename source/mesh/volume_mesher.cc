@@ -1,0 +1,420 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/exceptions.h>
+#include <palpate/mesh/mesh_file.h>
+#include <palpate/mesh/volume_mesher.h>
+
+#include <gmsh.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+#include <thread>
+
+namespace palpate
+{
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    /**
+     * The meshing itself, in the child process: Gmsh's STL-remeshing
+     * workflow (its tutorial t13). The triangles become one discrete
+     * surface; classifySurfaces() splits it into patches that can be
+     * parametrised (a closed surface cannot be mapped to a plane in one
+     * piece); createGeometry() builds the parametrisations; the patches
+     * bound a volume, and the mesher remeshes the patches at the target
+     * size and fills the volume. Classification at 180 degrees (no
+     * sharp-edge curves) suits smooth organs; if Gmsh cannot parametrise
+     * the patches it makes, smaller angles give it more, smaller ones.
+     * Returns "nodes tets triangles size attempts" or "ERROR message".
+     */
+    std::string
+    mesh_in_child(const Surface     &s,
+                  const unsigned int target,
+                  const std::string &out)
+    {
+      const double volume = s.volume();
+      // Nodes of a Delaunay mesh with sizes in [h/2, h]: about V / (0.8 h^3)
+      // (measured on the liver surfaces); corrected after each attempt.
+      double       h = std::cbrt(volume / (0.8 * std::max(target, 10u)));
+      std::string  last_error;
+      unsigned int attempts = 0;
+      for (unsigned int pass = 0; pass < 4; ++pass)
+        {
+          bool        meshed = false;
+          std::size_t nodes = 0, tets = 0, triangles = 0;
+          for (const double angle : {180., 60., 40., 20.})
+            {
+              ++attempts;
+              gmsh::initialize();
+              gmsh::option::setNumber("General.Terminal", 0);
+              gmsh::option::setNumber("General.NumThreads", 1);
+              gmsh::logger::start();
+              try
+                {
+                  gmsh::model::add("organ");
+                  const int tag = gmsh::model::addDiscreteEntity(2);
+                  std::vector<std::size_t> node_tags(s.vertices.size());
+                  std::vector<double>      xyz;
+                  for (std::size_t v = 0; v < s.vertices.size(); ++v)
+                    {
+                      node_tags[v] = v + 1;
+                      for (const double x : s.vertices[v])
+                        xyz.push_back(x);
+                    }
+                  gmsh::model::mesh::addNodes(2, tag, node_tags, xyz);
+                  std::vector<std::size_t> element_tags, element_nodes;
+                  for (std::size_t t = 0; t < s.triangles.size(); ++t)
+                    {
+                      element_tags.push_back(t + 1);
+                      for (const unsigned int v : s.triangles[t])
+                        element_nodes.push_back(v + 1);
+                    }
+                  gmsh::model::mesh::addElementsByType(tag,
+                                                       2,
+                                                       element_tags,
+                                                       element_nodes);
+                  gmsh::model::mesh::classifySurfaces(angle * M_PI / 180,
+                                                      true,
+                                                      true,
+                                                      M_PI);
+                  gmsh::model::mesh::createGeometry();
+                  std::vector<std::pair<int, int>> surfaces;
+                  gmsh::model::getEntities(surfaces, 2);
+                  std::vector<int> surface_tags;
+                  for (const auto &e : surfaces)
+                    surface_tags.push_back(e.second);
+                  const int loop =
+                    gmsh::model::geo::addSurfaceLoop(surface_tags);
+                  const int body = gmsh::model::geo::addVolume({loop});
+                  gmsh::model::geo::synchronize();
+                  gmsh::model::addPhysicalGroup(3, {body}, 1);
+                  gmsh::model::addPhysicalGroup(2, surface_tags, 1);
+                  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * h);
+                  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+                  gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+                  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+                  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+                  gmsh::option::setNumber("Mesh.Algorithm",
+                                          6); // Frontal-Delaunay
+                  gmsh::option::setNumber("Mesh.Algorithm3D", 1); // Delaunay
+                  gmsh::option::setNumber("Mesh.Optimize", 1);
+                  gmsh::model::mesh::generate(3);
+
+                  std::vector<std::size_t> tags;
+                  std::vector<double>      coords, parametric;
+                  gmsh::model::mesh::getNodes(tags, coords, parametric);
+                  std::vector<int>                      types;
+                  std::vector<std::vector<std::size_t>> elements, enodes;
+                  gmsh::model::mesh::getElements(types, elements, enodes, 3);
+                  nodes = tags.size();
+                  tets  = 0;
+                  for (std::size_t k = 0; k < types.size(); ++k)
+                    if (types[k] == 4)
+                      tets += elements[k].size();
+                  gmsh::model::mesh::getElements(types, elements, enodes, 2);
+                  triangles = 0;
+                  for (std::size_t k = 0; k < types.size(); ++k)
+                    if (types[k] == 2)
+                      triangles += elements[k].size();
+                  if (tets == 0)
+                    throw std::runtime_error("Gmsh made no tetrahedra");
+                  gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
+                  gmsh::option::setNumber("Mesh.Binary", 0);
+                  gmsh::write(out);
+                  meshed = true;
+                }
+              catch (...)
+                {
+                  std::string error;
+                  gmsh::logger::getLastError(error);
+                  last_error = error.empty() ? "Gmsh failed" : error;
+                }
+              gmsh::logger::stop();
+              gmsh::finalize();
+              if (meshed)
+                break;
+            }
+          if (!meshed)
+            return "ERROR " + last_error;
+          // Close enough to the target? Otherwise correct the size by the
+          // cube root of the ratio (nodes ~ 1/h^3) and mesh again.
+          const double ratio = double(nodes) / target;
+          if (std::abs(ratio - 1) <= 0.15 || pass == 3)
+            {
+              std::ostringstream s;
+              s.precision(17);
+              s << nodes << ' ' << tets << ' ' << triangles << ' ' << h << ' '
+                << attempts;
+              return s.str();
+            }
+          h *= std::cbrt(ratio);
+        }
+      return "ERROR unreachable";
+    }
+  } // namespace
+
+
+
+  VolumeMeshing
+  mesh_volume(const Surface     &surface,
+              const unsigned int target_nodes,
+              const double       time_limit,
+              const std::string &out_msh,
+              const std::string &surface_name)
+  {
+    const auto        start = Clock::now();
+    const std::string tmp =
+      out_msh + ".tmp-" + std::to_string(::getpid()) + ".msh";
+
+    int channel[2];
+    if (::pipe(channel) != 0)
+      throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+    std::fflush(nullptr);
+    const pid_t child = ::fork();
+    if (child < 0)
+      throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+    if (child == 0)
+      {
+        // The child: mesh, report through the pipe, leave without running
+        // the parent's atexit handlers (MPI, deal.II).
+        ::close(channel[0]);
+        std::string report;
+        try
+          {
+            report = mesh_in_child(surface, target_nodes, tmp);
+          }
+        catch (const std::exception &e)
+          {
+            report = std::string("ERROR ") + e.what();
+          }
+        catch (...)
+          {
+            report = "ERROR Gmsh failed";
+          }
+        std::size_t written = 0;
+        while (written < report.size())
+          {
+            const auto n = ::write(channel[1],
+                                   report.data() + written,
+                                   report.size() - written);
+            if (n <= 0)
+              break;
+            written += n;
+          }
+        ::close(channel[1]);
+        ::_exit(0);
+      }
+
+    // The parent: wait for the report, at most time_limit seconds.
+    ::close(channel[1]);
+    std::string report;
+    bool        finished = false;
+    while (true)
+      {
+        int         status = 0;
+        const pid_t done   = ::waitpid(child, &status, WNOHANG);
+        if (done == child)
+          {
+            finished = WIFEXITED(status);
+            break;
+          }
+        if (std::chrono::duration<double>(Clock::now() - start).count() >
+            time_limit)
+          {
+            ::kill(child, SIGKILL);
+            ::waitpid(child, &status, 0);
+            break;
+          }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    {
+      char buffer[4096];
+      // The pipe holds everything the child wrote (far less than its
+      // capacity), so reading after it ended cannot block.
+      ssize_t n;
+      while ((n = ::read(channel[0], buffer, sizeof(buffer))) > 0)
+        report.append(buffer, n);
+      ::close(channel[0]);
+    }
+    const double seconds =
+      std::chrono::duration<double>(Clock::now() - start).count();
+    const auto fail = [&](const std::string &problem, const std::string &fix) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      return InputError(surface_name, 0, "surface", problem, fix);
+    };
+    if (!finished || report.empty())
+      throw fail("meshing did not finish within the time limit of " +
+                   Utilities::to_string(time_limit, 3) +
+                   " s (Gmsh was "
+                   "stopped after " +
+                   Utilities::to_string(seconds, 3) + " s)",
+                 "ask for fewer nodes (palpate mesh --nodes, Mesh / Surface / "
+                 "Target nodes), allow more time (--time-limit, Mesh / "
+                 "Surface / Time limit), or simplify the surface.");
+    if (report.rfind("ERROR ", 0) == 0)
+      throw fail(
+        "Gmsh could not mesh the surface: " + report.substr(6) +
+          (report.find("intersect") != std::string::npos ?
+             " (the surface intersects itself where the remeshed surface "
+             "is finer than the fold)" :
+             ""),
+        "check the surface for self-intersections and folds (palpate mesh "
+        "reports them; MeshLab: Filters > Cleaning and Repairing > Select "
+        "Self Intersecting Faces); fewer nodes give a coarser surface that "
+        "smooths small folds away.");
+    VolumeMeshing      result;
+    std::istringstream in(report);
+    in >> result.nodes >> result.tetrahedra >> result.surface_triangles >>
+      result.size >> result.attempts;
+    result.seconds = seconds;
+    std::filesystem::rename(tmp, out_msh);
+    return result;
+  }
+
+
+
+  std::string
+  unit_advice(const double size, const double factor)
+  {
+    if (size >= 0.02 && size <= 1)
+      return "";
+    // The file's own size, and the units that would make it an organ.
+    const double                          file_size = size / factor;
+    const std::pair<double, const char *> units[]   = {{0.001, "millimetres"},
+                                                       {0.01, "centimetres"},
+                                                       {1, "metres"}};
+    for (const auto &[unit, name] : units)
+      if (file_size * unit >= 0.02 && file_size * unit <= 1)
+        return std::string("it looks like ") + name + ": set " +
+               Utilities::to_string(unit, 3) + " (the body is then " +
+               Utilities::to_string(file_size * unit, 3) + " m across)";
+    return "for the body to be 0.25 m across (a liver), set " +
+           Utilities::to_string(factor * 0.25 / size, 4);
+  }
+
+
+
+  std::vector<std::string>
+  SurfaceMeshReport::lines() const
+  {
+    std::vector<std::string> l;
+    l.push_back("surface:       " + format + ", " + std::to_string(vertices) +
+                " vertices, " + std::to_string(triangles) + " triangles, " +
+                Utilities::to_string(box[1][0] - box[0][0], 3) + " x " +
+                Utilities::to_string(box[1][1] - box[0][1], 3) + " x " +
+                Utilities::to_string(box[1][2] - box[0][2], 3) + " m");
+    const auto r = repairs.lines();
+    if (r.empty())
+      l.push_back("repairs:       none needed");
+    for (std::size_t k = 0; k < r.size(); ++k)
+      l.push_back((k == 0 ? "repairs:       " : "               ") + r[k]);
+    l.push_back("closed:        yes, volume " +
+                Utilities::to_string(volume * 1e6, 4) + " cm^3");
+    l.push_back("intersections: " +
+                (self_intersections == 0 ?
+                   std::string("none") :
+                   std::to_string(self_intersections) +
+                     " pairs of triangles cross (the first near (" +
+                     Utilities::to_string(intersection, 4) +
+                     ") m); the remeshed surface crosses nowhere (checked)"));
+    l.push_back("volume mesh:   " + std::to_string(meshing.nodes) + " nodes, " +
+                std::to_string(meshing.tetrahedra) + " tetrahedra, " +
+                std::to_string(meshing.surface_triangles) +
+                " boundary triangles (boundary id 1), element size " +
+                Utilities::to_string(meshing.size * 1000, 3) + " mm, volume " +
+                Utilities::to_string(mesh_volume * 1e6, 4) + " cm^3 (" +
+                Utilities::to_string(100 * (mesh_volume / volume - 1), 2) +
+                " % against the surface)");
+    l.push_back("meshing:       Gmsh " + std::string(GMSH_API_VERSION) + ", " +
+                Utilities::to_string(meshing.seconds, 3) + " s, " +
+                std::to_string(meshing.attempts) + " attempt" +
+                (meshing.attempts > 1 ? "s" : ""));
+    l.push_back("quality:       " + quality.summary());
+    return l;
+  }
+
+
+
+  SurfaceMeshReport
+  mesh_surface_file(const std::string &surface_file,
+                    const double       scale,
+                    const std::string &scale_entry,
+                    const unsigned int target_nodes,
+                    const double       time_limit,
+                    const std::string &out_msh)
+  {
+    SurfaceMeshReport report;
+    Surface           s = read_surface(surface_file, scale);
+    report.format       = s.format;
+    report.vertices     = s.vertices.size();
+    report.triangles    = s.triangles.size();
+    report.diameter     = s.diameter();
+    report.box          = s.bounding_box();
+    report.area         = s.area();
+    // An organ is 2 cm to 1 m across: anything else is a unit mistake.
+    if (const std::string advice = unit_advice(report.diameter, scale);
+        !advice.empty())
+      throw InputError(surface_file,
+                       0,
+                       scale_entry + " = " + Utilities::to_string(scale, 6),
+                       "with this scale factor the body is " +
+                         Utilities::to_string(report.diameter, 3) +
+                         " m across (the diagonal of its bounding box); an "
+                         "organ is 0.02 to 1 m across",
+                       advice + ".");
+    report.repairs = repair_surface(s, surface_file);
+    report.volume  = s.volume();
+    report.self_intersections =
+      count_self_intersections(s, report.intersection);
+    report.meshing =
+      mesh_volume(s, target_nodes, time_limit, out_msh, surface_file);
+    const MeshData data = read_mesh_file(out_msh);
+    report.quality      = mesh_quality(data.nodes, data.tetrahedra);
+    {
+      // The remeshed boundary must not cross itself: a fold larger than
+      // the elements survives remeshing, and Gmsh's volume mesh of it
+      // would not be the organ.
+      Surface boundary;
+      boundary.vertices  = data.nodes;
+      boundary.triangles = data.triangles;
+      Utilities::Point3 where;
+      if (const unsigned int n = count_self_intersections(boundary, where);
+          n > 0)
+        {
+          std::error_code ec;
+          std::filesystem::remove(out_msh, ec);
+          throw InputError(
+            surface_file,
+            0,
+            "surface",
+            "the surface intersects itself: " + std::to_string(n) +
+              " pairs of triangles of the remeshed surface cross (near (" +
+              Utilities::to_string(where, 4) + ") m)",
+            "remove the fold or self-intersection in your segmentation tool "
+            "(MeshLab: Filters > Cleaning and Repairing > Select Self "
+            "Intersecting Faces, then delete and close the hole), or ask for "
+            "fewer nodes: a coarser surface smooths small folds away.");
+        }
+    }
+    for (const auto &t : data.tetrahedra)
+      {
+        using namespace Utilities;
+        const auto &x = data.nodes;
+        report.mesh_volume += std::abs(dot(minus(x[t[1]], x[t[0]]),
+                                           cross(minus(x[t[2]], x[t[0]]),
+                                                 minus(x[t[3]], x[t[0]])))) /
+                              6;
+      }
+    return report;
+  }
+} // namespace palpate
