@@ -112,7 +112,7 @@ namespace palpate
         << " mm from the body's surface ("
         << 100 * nodes.active_distance / mesh.diameter()
         << " % of its size): is it in the mesh's scaled coordinates (metres, "
-           "after Scale factor)? The bounding box is below.";
+           "after Scale factor)? The mesh's bounding box is above.";
     if (!nodes.tip_vertices.empty() ||
         p.boundary_conditions.active_node.tip_radius > 0)
       s << "\n  probe tip:     radius "
