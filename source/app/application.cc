@@ -3,6 +3,7 @@
 
 #include <palpate/app/application.h>
 #include <palpate/app/interaction_run.h>
+#include <palpate/app/precompute.h>
 #include <palpate/app/scene_report.h>
 #include <palpate/app/static_solve.h>
 #include <palpate/app/study.h>
@@ -53,6 +54,11 @@ namespace palpate
       "                                  default): repairs, checks, meshes with\n"
       "                                  Gmsh, reports the quality\n"
       "                                  (doc/your-organ.md)\n"
+      "  palpate precompute SCENE.prm [--radius R]\n"
+      "                                  compute every state within R metres\n"
+      "                                  of rest (default: the cloud radius)\n"
+      "                                  into the scene's State space / Store\n"
+      "                                  (HDF5); interrupted, it resumes\n"
       "  mpirun -np N palpate SCENE.prm  the same with Engine / Type = mpi:\n"
       "                                  rank 0 is the haptic client, ranks\n"
       "                                  1..N-1 are solver servers\n"
@@ -84,13 +90,17 @@ namespace palpate
     int
     run_server_rank(const std::vector<std::string> &args, std::ostream &err)
     {
-      if (args.size() != 1 || args[0].empty() || args[0][0] == '-' ||
-          args[0] == "solve")
+      // palpate precompute under mpirun: the servers compute, rank 0 writes.
+      const bool precompute = args.size() >= 2 && args[0] == "precompute";
+      if (!precompute && (args.size() != 1 || args[0].empty() ||
+                          args[0][0] == '-' || args[0] == "solve"))
         return ExitStatus::success;
       try
         {
-          const Scene scene = Scene::read(args[0]);
-          if (!serves(scene, false))
+          const Scene scene = Scene::read(precompute ? args[1] : args[0]);
+          if (precompute ?
+                !(mpi_size() > 1 && scene.parameters.engine.type == "mpi") :
+                !serves(scene, false))
             return ExitStatus::success;
           const Mesh          mesh  = Mesh::create(scene);
           const NodeSelection nodes = NodeSelection::create(scene, mesh);
@@ -339,6 +349,32 @@ namespace palpate
         }
       if (args[0] == "mesh")
         return run_mesh(args, out);
+      if (args[0] == "precompute")
+        {
+          if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
+            throw InputError("command line",
+                             0,
+                             "precompute",
+                             "'precompute' needs a scene file",
+                             "run 'palpate precompute SCENE.prm [--radius "
+                             "R]'.");
+          double radius = 0;
+          for (unsigned int i = 2; i < args.size(); ++i)
+            if (args[i] == "--radius" && i + 1 < args.size())
+              radius = number_argument("--radius", args[++i], 1e-4, 10, "0.05");
+            else
+              throw InputError("command line",
+                               0,
+                               args[i],
+                               "unexpected argument '" + args[i] + "'",
+                               "run 'palpate --help' for the usage.");
+          const Scene         scene = Scene::read(args[1]);
+          const Mesh          mesh  = Mesh::create(scene);
+          const NodeSelection nodes = NodeSelection::create(scene, mesh);
+          print_scene_report(out, scene, mesh, nodes);
+          out << "\n";
+          return run_precompute(out, scene, radius);
+        }
       if (args[0] == "study")
         {
           if (args.size() < 2 || args[1].empty() || args[1][0] == '-')

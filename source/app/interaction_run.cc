@@ -295,6 +295,8 @@ namespace palpate
             summary.write_json(file);
         });
       }
+    if (const std::string store = interaction.store_report(); !store.empty())
+      out << "  state store:   " << store << "\n";
     if (p.effects.force_log)
       {
         const std::string file =

@@ -11,13 +11,17 @@
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
+#include <palpate/state_space/state_store.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <ostream>
 #include <stdexcept>
+#include <thread>
 
 namespace palpate
 {
@@ -49,8 +53,47 @@ namespace palpate
             cloud_size +=
               Utilities::norm(grid.position(GridIndex{{i, j, k}})) <= radius;
       check_memory_budget();
+      // The store's states go into the cache before the engine starts, so
+      // that it computes only what is missing.
+      if (!scene.parameters.state_space.store.empty())
+        {
+          store = std::make_unique<StateStore>(
+            scene.parameters.state_space.store,
+            StoreFingerprint::of(scene, mesh, nodes));
+          loaded = store->load(cache, grid);
+        }
       engine =
         PrecomputationEngine::create(scene, mesh, nodes, grid, cache, hip);
+    }
+
+    /** Append the cache's new states to the store, every quarter second
+     * while attached (a thread of its own, never the real-time one). */
+    void
+    write_store()
+    {
+      while (store_running.load())
+        {
+          append_to_store();
+          std::unique_lock<std::mutex> lock(store_mutex);
+          store_wake.wait_for(lock, std::chrono::milliseconds(250), [&] {
+            return !store_running.load();
+          });
+        }
+    }
+
+    void
+    append_to_store()
+    {
+      std::lock_guard<std::mutex> lock(store_append_mutex);
+      try
+        {
+          stored += store->append(cache, grid);
+        }
+      catch (const std::exception &e)
+        {
+          if (store_error.empty())
+            store_error = e.what();
+        }
     }
 
     /**
@@ -90,6 +133,16 @@ namespace palpate
     HipChannel                                   hip;
     std::unique_ptr<PrecomputationEngine>        engine;
     std::unique_ptr<std::atomic<std::uint8_t>[]> used;
+
+    // The state store (State space / Store) and its writer thread.
+    std::unique_ptr<StateStore> store;
+    StateStore::Loaded          loaded;
+    std::thread                 store_writer;
+    std::atomic<bool>           store_running{false};
+    std::mutex                  store_mutex, store_append_mutex;
+    std::condition_variable     store_wake;
+    std::atomic<unsigned int>   stored{0};
+    std::string                 store_error;
 
     // Real-time state (touched by force() only).
     ForceFilter           filter;
@@ -147,6 +200,8 @@ namespace palpate
       true, std::memory_order_release); // force() restarts its contact logic
     s.engine->start();
     s.is_attached.store(true);
+    if (s.store && !s.store_running.exchange(true))
+      s.store_writer = std::thread([&s] { s.write_store(); });
   }
 
 
@@ -157,6 +212,13 @@ namespace palpate
     Impl &s = *impl;
     s.is_attached.store(false);
     s.engine->stop();
+    if (s.store_running.exchange(false))
+      {
+        s.store_wake.notify_all();
+        s.store_writer.join();
+      }
+    if (s.store)
+      s.append_to_store(); // what the engine finished last
   }
 
 
@@ -433,6 +495,37 @@ namespace palpate
         s.nodes = std::move(old_nodes);
         throw;
       }
+    // The store holds states of the old physics: nothing of the new ones
+    // may go into it (its fingerprint would lie).
+    if (s.store)
+      {
+        s.store.reset();
+        s.store_error = "the parameters changed during the interaction, so "
+                        "the states computed after the change were not "
+                        "stored (they belong to other physics)";
+      }
+  }
+
+
+
+  std::string
+  Interaction::store_report() const
+  {
+    const Impl &s = *impl;
+    if (s.scene.parameters.state_space.store.empty())
+      return "";
+    std::string r =
+      "loaded " + std::to_string(s.loaded.states) + " states and " +
+      std::to_string(s.loaded.failures) + " failure points from " +
+      s.scene.parameters.state_space.store +
+      (s.loaded.damaged > 0 ?
+         " (" + std::to_string(s.loaded.damaged) +
+           " damaged records skipped: their checksums do not match)" :
+         std::string()) +
+      "; appended " + std::to_string(s.stored.load());
+    if (!s.store_error.empty())
+      r += "; " + s.store_error;
+    return r;
   }
 
 

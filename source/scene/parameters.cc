@@ -857,6 +857,17 @@ namespace palpate
           "factorisation) and the neighbours' stiffnesses; the force and "
           "the stiffness are continuous, so a coarser grid gives the same "
           "accuracy (doc/accuracy-vs-time.md).");
+        prm.declare_entry(
+          "Store",
+          "",
+          Patterns::Anything(),
+          "An HDF5 file of computed states (relative to the current "
+          "directory), or empty for none. When set, the states in it are "
+          "loaded before attaching (no waiting where states exist) and the "
+          "states the run computes are appended. 'palpate precompute' fills "
+          "it off-line. A store computed for other physics (mesh, material, "
+          "fixed or active node, element, grid, tolerances, effects) is "
+          "refused, naming what differs.");
       }
       prm.leave_subsection();
     }
@@ -871,6 +882,7 @@ namespace palpate
         grid_spacing  = prm.get_double("Grid spacing");
         extent        = prm.get_double("Extent");
         interpolation = prm.get("Interpolation");
+        store         = prm.get("Store");
       }
       prm.leave_subsection();
     }

@@ -26,6 +26,8 @@ namespace palpate
     constexpr int server_lost = 5;
     /** The run finished, but an output file could not be written. */
     constexpr int output_failed = 6;
+    /** The run was interrupted (Ctrl-C); what it finished is kept. */
+    constexpr int interrupted = 130;
   } // namespace ExitStatus
 
   /**

@@ -114,6 +114,11 @@ namespace palpate
     MissingCause
     missing_cause() const noexcept;
 
+    /** With State space / Store: what was loaded from the store and
+     * appended to it, in one line; "" without a store. */
+    std::string
+    store_report() const;
+
     /** Whether the cloud around the attach position has been computed
      * (latched: stays true once it was). */
     bool

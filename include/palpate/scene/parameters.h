@@ -260,6 +260,8 @@ namespace palpate
        * "trilinear" (the paper's, C0) or "tricubic Hermite" (C1, from the
        * corners' forces and stiffnesses). */
       std::string interpolation;
+      /** The HDF5 state store ("" for none). */
+      std::string store;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
