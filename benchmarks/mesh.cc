@@ -43,36 +43,6 @@ using namespace palpate;
 
 namespace
 {
-  /** Each triangle split into four at its edge midpoints. */
-  void
-  subdivide(Surface &s)
-  {
-    std::map<std::pair<unsigned int, unsigned int>, unsigned int> middle;
-    const auto mid = [&](unsigned int a, unsigned int b) {
-      const auto key = std::minmax(a, b);
-      if (middle.count(key) == 0)
-        {
-          Utilities::Point3 m;
-          for (unsigned int d = 0; d < 3; ++d)
-            m[d] = 0.5 * (s.vertices[a][d] + s.vertices[b][d]);
-          middle[key] = s.vertices.size();
-          s.vertices.push_back(m);
-        }
-      return middle[key];
-    };
-    std::vector<std::array<unsigned int, 3>> finer;
-    for (const auto &t : s.triangles)
-      {
-        const unsigned int a = mid(t[0], t[1]), b = mid(t[1], t[2]),
-                           c = mid(t[2], t[0]);
-        finer.push_back({{t[0], a, c}});
-        finer.push_back({{t[1], b, a}});
-        finer.push_back({{t[2], c, b}});
-        finer.push_back({{a, b, c}});
-      }
-    s.triangles = finer;
-  }
-
   /** The user's surface, written to @p file; returns its vertex count. */
   unsigned int
   make_user_surface(const std::string &file)

@@ -112,6 +112,18 @@ namespace palpate
               shown = done;
             }
         }
+      // States held elsewhere (MPI servers) reach the store when it asks
+      // for them, while the engine runs: wait until every finished state is
+      // stored (at most 60 s).
+      for (const auto wait = Clock::now();
+           !interrupted.load() &&
+           std::chrono::duration<double>(Clock::now() - wait).count() < 60;)
+        {
+          const auto c = interaction.cache().counts();
+          if (interaction.stored_points() >= c.first + c.second)
+            break;
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
       interaction.detach(); // appends what was finished last
       std::signal(SIGINT, previous_int);
       std::signal(SIGTERM, previous_term);

@@ -362,7 +362,14 @@ namespace palpate
               }
             else
               {
-                cache.publish_failure(h.point, h.generation);
+                // A solve that threw reports "converged" as its status:
+                // count it with the solver's failures.
+                const auto reason = static_cast<SolveStatus>(h.status);
+                cache.publish_failure(h.point,
+                                      h.generation,
+                                      reason == SolveStatus::converged ?
+                                        SolveStatus::linear_solver_failure :
+                                        reason);
                 ++stats.failed;
               }
             if (h.flags & Flags::error)

@@ -295,7 +295,7 @@ namespace palpate
                                   generation);
                   }
                 else
-                  cache.publish_failure(task.target, generation);
+                  cache.publish_failure(task.target, generation, result.status);
               }
           }
         catch (const std::exception &e)
@@ -310,7 +310,11 @@ namespace palpate
           {
             solved           = true;
             result.converged = false;
-            cache.publish_failure(task.target, generation);
+            // The solve threw (the message is reported): count it with the
+            // solver's failures.
+            cache.publish_failure(task.target,
+                                  generation,
+                                  SolveStatus::linear_solver_failure);
           }
         const double duration = now() - start;
 

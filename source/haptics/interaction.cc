@@ -508,6 +508,15 @@ namespace palpate
 
 
 
+  unsigned int
+  Interaction::stored_points() const
+  {
+    const Impl &s = *impl;
+    return s.loaded.states + s.loaded.failures + s.stored.load();
+  }
+
+
+
   std::string
   Interaction::store_report() const
   {

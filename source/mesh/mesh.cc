@@ -81,6 +81,21 @@ namespace palpate
     }
 
     /**
+     * @p e with the scene that reads the file named in its fix, so that the
+     * user knows where to point it elsewhere.
+     */
+    InputError
+    read_by(const InputError &e, const Scene &scene, const std::string &what)
+    {
+      return InputError(e.file(),
+                        e.line(),
+                        e.entry(),
+                        e.problem(),
+                        e.fix() + " (The scene '" + scene.file() + "' reads " +
+                          what + " through Mesh / File name.)");
+    }
+
+    /**
      * Mesh / Source = surface: the volume mesh palpate made of the surface
      * before, or a new one. Its name holds a hash of the surface file's
      * bytes, the scale factor and the target, so a changed surface or
@@ -143,13 +158,7 @@ namespace palpate
           }
         catch (const InputError &e)
           {
-            throw InputError(e.file(),
-                             e.line(),
-                             e.entry(),
-                             e.problem(),
-                             e.fix() + " (The scene '" + scene.file() +
-                               "' reads this surface through Mesh / File "
-                               "name.)");
+            throw read_by(e, scene, "this surface");
           }
       return Mesh(read_mesh_file(file.string()),
                   1.0,
@@ -467,14 +476,7 @@ namespace palpate
       }
     catch (const InputError &e)
       {
-        // Say which scene asked for this file, so the user knows where to
-        // point it elsewhere.
-        throw InputError(e.file(),
-                         e.line(),
-                         e.entry(),
-                         e.problem(),
-                         e.fix() + " (The scene '" + scene.file() +
-                           "' reads this file through Mesh / File name.)");
+        throw read_by(e, scene, "this file");
       }
     check_size(scene, *mesh);
     return std::move(*mesh);

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 
 namespace palpate
@@ -68,6 +69,37 @@ namespace palpate
       return 0;
     const auto box = bounding_box();
     return Utilities::distance(box[0], box[1]);
+  }
+
+
+
+  void
+  subdivide(Surface &s)
+  {
+    std::map<std::pair<unsigned int, unsigned int>, unsigned int> middle;
+    const auto mid = [&](const unsigned int a, const unsigned int b) {
+      const auto key = std::minmax(a, b);
+      const auto it  = middle.find(key);
+      if (it != middle.end())
+        return it->second;
+      Point3 m;
+      for (unsigned int d = 0; d < 3; ++d)
+        m[d] = 0.5 * (s.vertices[a][d] + s.vertices[b][d]);
+      s.vertices.push_back(m);
+      return middle[key] = s.vertices.size() - 1;
+    };
+    std::vector<std::array<unsigned int, 3>> finer;
+    finer.reserve(4 * s.triangles.size());
+    for (const auto &t : s.triangles)
+      {
+        const unsigned int a = mid(t[0], t[1]), b = mid(t[1], t[2]),
+                           c = mid(t[2], t[0]);
+        finer.push_back({{t[0], a, c}});
+        finer.push_back({{t[1], b, a}});
+        finer.push_back({{t[2], c, b}});
+        finer.push_back({{a, b, c}});
+      }
+    s.triangles = std::move(finer);
   }
 
 
@@ -597,6 +629,20 @@ namespace palpate
               words >> n >> size;
               polygons          = keyword == "POLYGONS";
               const bool strips = keyword == "TRIANGLE_STRIPS";
+              // A polygon is a fan of triangles; a strip alternates its
+              // orientation; vertices and lines are not part of a surface.
+              const auto add_cell = [&](const std::vector<long long> &cell) {
+                if (polygons)
+                  add_polygon(s, cell, filename, 0);
+                else if (strips)
+                  for (std::size_t k = 0; k + 2 < cell.size(); ++k)
+                    add_polygon(s,
+                                {cell[k + k % 2],
+                                 cell[k + 1 - k % 2],
+                                 cell[k + 2]},
+                                filename,
+                                0);
+              };
               // VTK 5.1 writes OFFSETS and CONNECTIVITY arrays instead.
               const auto save = pos;
               const auto peek = next_line();
@@ -612,23 +658,16 @@ namespace palpate
                   const auto connectivity = values(size, type);
                   for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
                     {
+                      if (offsets[i] < 0 || offsets[i] > offsets[i + 1] ||
+                          offsets[i + 1] > connectivity.size())
+                        throw bad(filename,
+                                  0,
+                                  "the OFFSETS array is inconsistent",
+                                  damaged);
                       std::vector<long long> cell(
                         connectivity.begin() + std::size_t(offsets[i]),
                         connectivity.begin() + std::size_t(offsets[i + 1]));
-                      if (polygons)
-                        add_polygon(s, cell, filename, 0);
-                      else if (strips)
-                        for (std::size_t k2 = 0; k2 + 2 < cell.size(); ++k2)
-                          add_polygon(s,
-                                      k2 % 2 == 0 ?
-                                        std::vector<long long>{cell[k2],
-                                                               cell[k2 + 1],
-                                                               cell[k2 + 2]} :
-                                        std::vector<long long>{cell[k2 + 1],
-                                                               cell[k2],
-                                                               cell[k2 + 2]},
-                                      filename,
-                                      0);
+                      add_cell(cell);
                     }
                   continue;
                 }
@@ -645,20 +684,7 @@ namespace palpate
                   std::vector<long long> cell(list.begin() + k,
                                               list.begin() + k + m);
                   k += m;
-                  if (polygons)
-                    add_polygon(s, cell, filename, 0);
-                  else if (strips)
-                    for (std::size_t k2 = 0; k2 + 2 < cell.size(); ++k2)
-                      add_polygon(s,
-                                  k2 % 2 == 0 ?
-                                    std::vector<long long>{cell[k2],
-                                                           cell[k2 + 1],
-                                                           cell[k2 + 2]} :
-                                    std::vector<long long>{cell[k2 + 1],
-                                                           cell[k2],
-                                                           cell[k2 + 2]},
-                                  filename,
-                                  0);
+                  add_cell(cell);
                 }
             }
           else if (keyword == "POINT_DATA" || keyword == "CELL_DATA" ||

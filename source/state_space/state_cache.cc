@@ -143,6 +143,7 @@ namespace palpate
     , current_generation(1)
     , states(grid.size())
     , is_wanted(grid.size(), 0)
+    , reasons(grid.size(), SolveStatus::max_iterations)
     , budget(memory_budget)
   {}
 
@@ -265,13 +266,24 @@ namespace palpate
 
   void
   StateCache::publish_failure(const unsigned int  point,
-                              const std::uint64_t generation)
+                              const std::uint64_t generation,
+                              const SolveStatus   reason)
   {
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
+    reasons[point] = reason;
     write_entry(
       entries[point], {{0, 0, 0}}, nullptr, PointStatus::failed, generation);
+  }
+
+
+
+  SolveStatus
+  StateCache::failure_reason(const unsigned int point) const
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    return reasons[point];
   }
 
 

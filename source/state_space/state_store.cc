@@ -582,7 +582,8 @@ namespace palpate
             state.multipliers = std::move(r.multipliers);
           }
         else
-          state.message = "a failure point (from the store)";
+          state.message =
+            "a failure point (" + to_string(state.status) + ", from the store)";
         states.emplace_back(r.point, std::move(state));
       }
     return states;
@@ -616,7 +617,7 @@ namespace palpate
           }
         else
           {
-            cache.publish_failure(point, generation);
+            cache.publish_failure(point, generation, state.status);
             ++loaded.failures;
           }
       }
@@ -639,7 +640,7 @@ namespace palpate
           {
             State failure;
             failure.converged = false;
-            failure.status    = SolveStatus::max_iterations;
+            failure.status    = cache.failure_reason(p);
             append(p, failure);
             ++n;
           }

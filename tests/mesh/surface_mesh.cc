@@ -62,32 +62,7 @@ namespace
                    {{3, 2, 6}},   {{3, 6, 8}},  {{3, 8, 9}},  {{4, 9, 5}},
                    {{2, 4, 11}},  {{6, 2, 10}}, {{8, 6, 7}},  {{9, 8, 1}}};
     for (unsigned int level = 0; level < levels; ++level)
-      {
-        std::map<std::pair<unsigned int, unsigned int>, unsigned int> middle;
-        const auto mid = [&](unsigned int a, unsigned int b) {
-          const auto key = std::minmax(a, b);
-          if (middle.count(key) == 0)
-            {
-              Point3 m;
-              for (unsigned int d = 0; d < 3; ++d)
-                m[d] = 0.5 * (s.vertices[a][d] + s.vertices[b][d]);
-              middle[key] = s.vertices.size();
-              s.vertices.push_back(m);
-            }
-          return middle[key];
-        };
-        std::vector<std::array<unsigned int, 3>> finer;
-        for (const auto &T : s.triangles)
-          {
-            const unsigned int a = mid(T[0], T[1]), b = mid(T[1], T[2]),
-                               c2 = mid(T[2], T[0]);
-            finer.push_back({{T[0], a, c2}});
-            finer.push_back({{T[1], b, a}});
-            finer.push_back({{T[2], c2, b}});
-            finer.push_back({{a, b, c2}});
-          }
-        s.triangles = finer;
-      }
+      palpate::subdivide(s);
     for (auto &v : s.vertices)
       {
         const double n = palpate::Utilities::norm(v);

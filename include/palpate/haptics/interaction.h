@@ -119,6 +119,10 @@ namespace palpate
     std::string
     store_report() const;
 
+    /** With a store: the grid points it holds (loaded and appended). */
+    unsigned int
+    stored_points() const;
+
     /** Whether the cloud around the attach position has been computed
      * (latched: stays true once it was). */
     bool

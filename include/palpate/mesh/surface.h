@@ -44,6 +44,14 @@ namespace palpate
   };
 
   /**
+   * Split each triangle of @p surface into four at its edge midpoints
+   * (shared midpoints once): the same shape with four times the triangles.
+   * For tests and benchmarks that need finer surfaces of a known shape.
+   */
+  void
+  subdivide(Surface &surface);
+
+  /**
    * The surface file formats palpate reads and writes, by extension: .stl
    * (ASCII or binary), .obj, .ply (ASCII, binary little or big endian),
    * .vtk (legacy POLYDATA, ASCII or binary), .vtp (VTK XML PolyData: ascii,

@@ -5,6 +5,7 @@
 #define palpate_state_space_state_cache_h
 
 #include <palpate/base/utilities.h>
+#include <palpate/hyperelastic/state.h>
 #include <palpate/state_space/state_grid.h>
 
 #include <array>
@@ -92,9 +93,16 @@ namespace palpate
     std::vector<unsigned int>
     take_wanted();
 
-    /** Record @p point as a failure point (for @p generation). */
+    /** Record @p point as a failure point (for @p generation), and why no
+     * equilibrium was found there. */
     void
-    publish_failure(const unsigned int point, const std::uint64_t generation);
+    publish_failure(const unsigned int  point,
+                    const std::uint64_t generation,
+                    const SolveStatus   reason = SolveStatus::max_iterations);
+
+    /** Why the failure point @p point failed (for the state store). */
+    SolveStatus
+    failure_reason(const unsigned int point) const;
 
     /** What is known about @p point in the current generation. Lock-free
      * unless a writer is preempted mid-write; not for the real-time side. */
@@ -196,6 +204,7 @@ namespace palpate
     // is a read), and whether each is already in the list.
     mutable std::vector<unsigned int> wanted;
     mutable std::vector<std::uint8_t> is_wanted;
+    std::vector<SolveStatus>          reasons; // of failure points
     std::size_t                       bytes = 0, budget;
     unsigned int                      held = 0, evicted = 0;
     Utilities::Point3                 focus = {{0, 0, 0}};
