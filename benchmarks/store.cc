@@ -10,12 +10,18 @@
 // - write rate: the cloud's states appended to a new store (each record
 //   flushed, as palpate writes them), states/s;
 // - read rate: every record read back and checked, states/s;
-// - bytes per state in the file.
+// - bytes per state in the file;
+// - the haptic loop while the store is appended to: the scene's stroke run
+//   on the full store (its new states appended by the writer thread), its
+//   deadline misses and missing-data events, against the same run without
+//   a store (liver501).
 //
 // --quick: liver501 only.
 
+#include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/haptics/run_summary.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
@@ -136,6 +142,38 @@ main(int argc, char **argv)
                 << " first_force_from_nothing_ms=" << 1000 * from_nothing
                 << " damaged=" << damaged << "\n";
       }
+      if (mesh == "liver501")
+        {
+          // The stroke with the store (loading before, appending during)
+          // and without, for the haptic loop's timing.
+          std::ostringstream quiet;
+          Scene              plain = scene;
+          plain.parameters.state_space.store.clear();
+          plain.parameters.output.summary_formats.clear();
+          scene.parameters.output.summary_formats.clear();
+          plain.parameters.output.directory =
+            scene.parameters.output.directory = "bench-output";
+          const RunSummary with               = run_interaction(quiet, scene);
+          const RunSummary without            = run_interaction(quiet, plain);
+          std::filesystem::remove_all("bench-output");
+          std::cout << "\nThe stroke on liver501: with the store (loaded, "
+                       "appended while the loop runs) "
+                    << with.deadline_misses << " deadline misses, "
+                    << with.missing_events
+                    << " missing-data events, motion after "
+                    << 1000 * with.motion_start << " ms; without a store "
+                    << without.deadline_misses << " deadline misses, "
+                    << without.missing_events
+                    << " missing-data events, motion after "
+                    << 1000 * without.motion_start << " ms\n";
+          results
+            << "RESULT store mesh=liver501 stroke=yes store_deadline_misses="
+            << with.deadline_misses
+            << " plain_deadline_misses=" << without.deadline_misses
+            << " store_missing_events=" << with.missing_events
+            << " store_motion_start_ms=" << 1000 * with.motion_start
+            << " plain_motion_start_ms=" << 1000 * without.motion_start << "\n";
+        }
       std::filesystem::remove(p.state_space.store);
     }
   std::cout << "\n" << results.str();
