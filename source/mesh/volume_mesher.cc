@@ -340,6 +340,13 @@ namespace palpate
                 std::to_string(meshing.attempts) + " attempt" +
                 (meshing.attempts > 1 ? "s" : ""));
     l.push_back("quality:       " + quality.summary());
+    if (!quality.slivers.empty())
+      l.push_back("warning:       " + std::to_string(quality.slivers.size()) +
+                  " slivers (flat tetrahedra, usually at sharp edges of a "
+                  "coarse surface): their strains are unreliable. The scene "
+                  "report says if they lie near the active node; smoothing the "
+                  "surface's sharp edges (or another node count) may remove "
+                  "them.");
     return l;
   }
 
