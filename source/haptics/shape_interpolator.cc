@@ -223,21 +223,23 @@ namespace palpate
         interaction.hip().read(x, v);
         if (any && Utilities::distance(x, last) <= 1e-6)
           continue; // not moving: the last frame still shows it
-        if (bytes >= max_bytes)
+        // Decimation: past half the limit every 2nd frame is written, past
+        // 3/4 every 4th, past 7/8 every 8th, ... so a long run keeps frames
+        // of its whole length at a coarser rate instead of stopping. Below
+        // 1/64 of the rate (the last 1/128 of the room) the limit is
+        // reached: no more frames.
+        unsigned int stride = 1;
+        for (const double left = max_bytes - bytes;
+             left <= 0.5 * max_bytes / stride && stride <= 64;)
+          stride *= 2;
+        if (bytes >= max_bytes || stride > 64)
           {
             ++over; // the output limit: no more frames
             last = x;
             any  = true;
             continue;
           }
-        // Decimation: past half the limit every 2nd frame is written, past
-        // 3/4 every 4th, past 7/8 every 8th, ... so a long run keeps frames
-        // of its whole length at a coarser rate instead of stopping.
         {
-          unsigned int stride = 1;
-          for (double left = max_bytes - bytes;
-               left <= 0.5 * max_bytes / stride && stride < (1u << 20);)
-            stride *= 2;
           if (due++ % stride != 0)
             {
               ++thinned;

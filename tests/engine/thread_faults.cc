@@ -235,14 +235,11 @@ main(int argc, char **argv)
     deallog << "decimation: limit reached " << (reached ? "yes" : "NO")
             << ", frames written 7-9: "
             << (written >= 7 && written <= 9 ? "yes" : "NO")
-            << ", frames thinned out (expected about 1 + 3 + 7 = 11) 8-16: "
-            << (thinned.frames_decimated() >= 8 &&
-                    thinned.frames_decimated() <= 16 ?
-                  "yes" :
-                  "NO")
-            << std::endl;
-    if (written < 7 || written > 9 || thinned.frames_decimated() < 8 ||
-        thinned.frames_decimated() > 16)
+            << ", frames thinned out: at least 8 (about 1 + 3 + 7 = 11 when "
+               "the frames are equally large; more when the last written "
+               "frames leave little room) "
+            << (thinned.frames_decimated() >= 8 ? "yes" : "NO") << std::endl;
+    if (written < 7 || written > 9 || thinned.frames_decimated() < 8)
       deallog << "  written " << written << ", thinned "
               << thinned.frames_decimated() << ", frame " << frame_bytes
               << " bytes" << std::endl;
