@@ -198,7 +198,6 @@ namespace palpate
     const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / rate));
     auto              next = t0;
-    const auto       &grid = interaction.grid();
     Utilities::Point3 last{{0, 0, 0}};
     bool              any = false;
     while (running.load())
@@ -248,43 +247,11 @@ namespace palpate
               continue;
             }
         }
-        GridIndex             lower;
-        std::array<double, 3> local;
-        if (!grid.locate(x, lower, local))
+        State blend;
+        if (!blend_shape(interaction, x, blend))
           {
             ++skipped;
             continue;
-          }
-        const auto                   corners = grid.corners(lower);
-        const auto                   w       = trilinear_weights(local);
-        std::shared_ptr<const State> states[8];
-        bool                         complete = true;
-        for (unsigned int k = 0; k < 8 && complete; ++k)
-          {
-            states[k] = interaction.cache().state(corners[k]);
-            complete  = states[k] != nullptr;
-          }
-        if (!complete)
-          {
-            ++skipped;
-            continue;
-          }
-        // The blended state: displacement (and pressure), multipliers.
-        State blend               = *states[0];
-        blend.active_displacement = x;
-        for (double &u : blend.solution)
-          u = 0;
-        for (double &m : blend.multipliers)
-          m = 0;
-        blend.force = {{0, 0, 0}};
-        for (unsigned int k = 0; k < 8; ++k)
-          {
-            for (std::size_t i = 0; i < blend.solution.size(); ++i)
-              blend.solution[i] += w[k] * states[k]->solution[i];
-            for (std::size_t i = 0; i < blend.multipliers.size(); ++i)
-              blend.multipliers[i] += w[k] * states[k]->multipliers[i];
-            for (unsigned int d = 0; d < 3; ++d)
-              blend.force[d] += w[k] * states[k]->force[d];
           }
         char name[64];
         std::snprintf(name, sizeof(name), "-shape-%05u.vtu", written.load());
@@ -296,6 +263,48 @@ namespace palpate
         last = x;
         any  = true;
       }
+  }
+
+
+
+  bool
+  blend_shape(const Interaction       &interaction,
+              const Utilities::Point3 &x,
+              State                   &result)
+  {
+    const auto           &grid = interaction.grid();
+    GridIndex             lower;
+    std::array<double, 3> local;
+    if (!grid.locate(x, lower, local))
+      return false;
+    const auto                   corners = grid.corners(lower);
+    const auto                   w       = trilinear_weights(local);
+    std::shared_ptr<const State> states[8];
+    for (unsigned int k = 0; k < 8; ++k)
+      {
+        states[k] = interaction.cache().state(corners[k]);
+        if (states[k] == nullptr)
+          return false;
+      }
+    // The blended state: displacement (and pressure), multipliers, force.
+    State blend               = *states[0];
+    blend.active_displacement = x;
+    for (double &u : blend.solution)
+      u = 0;
+    for (double &m : blend.multipliers)
+      m = 0;
+    blend.force = {{0, 0, 0}};
+    for (unsigned int k = 0; k < 8; ++k)
+      {
+        for (std::size_t i = 0; i < blend.solution.size(); ++i)
+          blend.solution[i] += w[k] * states[k]->solution[i];
+        for (std::size_t i = 0; i < blend.multipliers.size(); ++i)
+          blend.multipliers[i] += w[k] * states[k]->multipliers[i];
+        for (unsigned int d = 0; d < 3; ++d)
+          blend.force[d] += w[k] * states[k]->force[d];
+      }
+    result = std::move(blend);
+    return true;
   }
 
 

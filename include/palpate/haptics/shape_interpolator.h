@@ -13,6 +13,7 @@
 namespace palpate
 {
   class Interaction;
+  struct State;
   class Mesh;
   class HyperelasticSystem;
   struct NodeSelection;
@@ -41,11 +42,31 @@ namespace palpate
           const std::array<double, 3> &force,
           const std::string           &file) const;
 
+    /** The DoFs of each mesh vertex's displacement (x, y, z). */
+    const std::vector<std::array<unsigned int, 3>> &
+    dofs_of_vertices() const
+    {
+      return vertex_dofs;
+    }
+
   private:
     std::vector<std::array<unsigned int, 3>> vertex_dofs;
     std::string                              flags, geometry;
     unsigned int                             n_cells;
   };
+
+  /**
+   * The body's state at the HIP displacement @p x (m): the solutions,
+   * multipliers and forces of the 8 corners of its cell, blended
+   * trilinearly, into @p blend. False (and @p blend unchanged) if @p x is
+   * outside the state space or a corner's whole state is not in the cache.
+   * Allocates: for the shape interpolator and the live view, never the
+   * real-time thread.
+   */
+  bool
+  blend_shape(const Interaction       &interaction,
+              const Utilities::Point3 &x,
+              State                   &blend);
 
   /**
    * The shape interpolator: at Effects / Shape output rate (about 30 Hz),
