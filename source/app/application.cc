@@ -5,6 +5,7 @@
 #include <palpate/app/interaction_run.h>
 #include <palpate/app/precompute.h>
 #include <palpate/app/scene_report.h>
+#include <palpate/app/serve.h>
 #include <palpate/app/static_solve.h>
 #include <palpate/app/study.h>
 #include <palpate/base/exceptions.h>
@@ -59,6 +60,10 @@ namespace palpate
       "                                  of rest (default: the cloud radius)\n"
       "                                  into the scene's State space / Store\n"
       "                                  (HDF5); interrupted, it resumes\n"
+      "  palpate serve SCENE.prm [--port P] [--host H]\n"
+      "                                  the interaction with a live view in a\n"
+      "                                  browser (http://127.0.0.1:8080/): the\n"
+      "                                  mouse is the device\n"
       "  mpirun -np N palpate SCENE.prm  the same with Engine / Type = mpi:\n"
       "                                  rank 0 is the haptic client, ranks\n"
       "                                  1..N-1 are solver servers\n"
@@ -349,6 +354,35 @@ namespace palpate
         }
       if (args[0] == "mesh")
         return run_mesh(args, out);
+      if (args[0] == "serve")
+        {
+          if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
+            throw InputError("command line",
+                             0,
+                             "serve",
+                             "'serve' needs a scene file",
+                             "run 'palpate serve SCENE.prm [--port P]'.");
+          int         port = 8080;
+          std::string host = "127.0.0.1";
+          for (unsigned int i = 2; i < args.size(); ++i)
+            if (args[i] == "--port" && i + 1 < args.size())
+              port = static_cast<int>(
+                number_argument("--port", args[++i], 1, 65535, "8080"));
+            else if (args[i] == "--host" && i + 1 < args.size())
+              host = args[++i];
+            else
+              throw InputError("command line",
+                               0,
+                               args[i],
+                               "unexpected argument '" + args[i] + "'",
+                               "run 'palpate --help' for the usage.");
+          const Scene         scene = Scene::read(args[1]);
+          const Mesh          mesh  = Mesh::create(scene);
+          const NodeSelection nodes = NodeSelection::create(scene, mesh);
+          print_scene_report(out, scene, mesh, nodes);
+          out << "\n";
+          return run_serve(out, scene, host, port);
+        }
       if (args[0] == "precompute")
         {
           if (args.size() < 2 || args[1].empty() || args[1][0] == '-')

@@ -1,0 +1,394 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/app/application.h>
+#include <palpate/app/serve.h>
+#include <palpate/base/exceptions.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/haptics/shape_interpolator.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <httplib.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+namespace palpate
+{
+  /** The page (serve_page.cc): three.js draws the surface, the HIP and the
+   * force; the mouse drags the HIP in the view plane, the wheel moves it
+   * in depth. */
+  extern const char *const live_view_page;
+
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    std::string
+    json_array(const std::vector<double> &v, const unsigned int digits = 6)
+    {
+      std::ostringstream s;
+      s.precision(digits);
+      s << '[';
+      for (std::size_t i = 0; i < v.size(); ++i)
+        s << (i ? "," : "") << (std::isfinite(v[i]) ? v[i] : 0.0);
+      s << ']';
+      return s.str();
+    }
+
+    std::string
+    json_point(const Utilities::Point3 &p)
+    {
+      return json_array({p[0], p[1], p[2]}, 9);
+    }
+
+    const char *
+    cause_name(const MissingCause c)
+    {
+      switch (c)
+        {
+          case MissingCause::none:
+            return "none";
+          case MissingCause::not_computed:
+            return "not computed yet";
+          case MissingCause::failure_region:
+            return "failure region";
+          default:
+            return "outside the state space";
+        }
+    }
+  } // namespace
+
+
+
+  struct LiveServer::Impl
+  {
+    Impl(const Scene &scene, const double max_speed)
+      : interaction(scene)
+      , max_speed(max_speed)
+      , rate(scene.parameters.haptics.loop_rate)
+    {
+      for (auto &a : {&target, &hip, &force})
+        for (auto &x : *a)
+          x.store(0);
+      // The surface: its vertices (rest positions), triangles, and the
+      // DoFs of each vertex's displacement.
+      const Mesh              &mesh = interaction.mesh();
+      const HyperelasticSystem system(mesh,
+                                      interaction.nodes(),
+                                      interaction.scene().parameters);
+      const ShapeFrames        frames(mesh, interaction.nodes(), system);
+      std::map<unsigned int, unsigned int> compact;
+      for (const auto &face : mesh.surface_faces())
+        {
+          std::array<unsigned int, 3> t;
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              const unsigned int v  = face.vertices[k];
+              const auto         it = compact.find(v);
+              if (it == compact.end())
+                {
+                  t[k] = compact[v] = surface.size();
+                  surface.push_back(v);
+                }
+              else
+                t[k] = it->second;
+            }
+          triangles.push_back(t);
+        }
+      for (const unsigned int v : surface)
+        dofs.push_back(frames.dofs_of_vertices()[v]);
+
+      std::vector<double> xyz, tri, fixed;
+      for (const unsigned int v : surface)
+        for (const double x : mesh.vertices()[v])
+          xyz.push_back(x);
+      for (const auto &t : triangles)
+        for (const unsigned int v : t)
+          tri.push_back(v);
+      for (const unsigned int v : interaction.nodes().fixed_vertices)
+        if (compact.count(v) > 0)
+          fixed.push_back(compact[v]);
+      const auto  active = compact.find(interaction.nodes().active_vertex);
+      const auto &grid   = interaction.grid();
+      std::ostringstream m;
+      m << "{\"vertices\":" << json_array(xyz, 9)
+        << ",\"triangles\":" << json_array(tri, 9)
+        << ",\"fixed\":" << json_array(fixed, 9) << ",\"active\":"
+        << (active == compact.end() ? -1 : int(active->second))
+        << ",\"spacing\":" << grid.spacing()
+        << ",\"extent\":" << grid.spacing() * grid.half_width()
+        << ",\"diameter\":" << mesh.diameter() << ",\"scene\":\""
+        << interaction.scene().file() << "\"}";
+      mesh_json = m.str();
+      displacement.assign(3 * surface.size(), 0.0);
+
+      std::ifstream     three("/usr/share/javascript/three/three.min.js");
+      std::stringstream s;
+      s << three.rdbuf();
+      three_js = s.str();
+      if (three_js.empty())
+        throw NotAvailableError("the live view's 3-D rendering (three.js)",
+                                "/usr/share/javascript/three/three.min.js: "
+                                "install Debian's libjs-three");
+    }
+
+    /** The device: at the loop rate, move the HIP toward the target at
+     * most at max_speed, and ask the interaction for the force. */
+    void
+    run_device()
+    {
+      const auto period = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(1.0 / rate));
+      const double      step = max_speed / rate;
+      Utilities::Point3 x{{0, 0, 0}};
+      auto              next = Clock::now();
+      while (running.load())
+        {
+          next += period;
+          std::this_thread::sleep_until(next);
+          Utilities::Point3 d;
+          for (unsigned int k = 0; k < 3; ++k)
+            d[k] = target[k].load() - x[k];
+          const double n = Utilities::norm(d);
+          const double s = n > step ? step / n : 1.0;
+          for (unsigned int k = 0; k < 3; ++k)
+            x[k] += s * d[k];
+          const Utilities::Point3 f = interaction.force(x);
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              hip[k].store(x[k]);
+              force[k].store(f[k]);
+            }
+          cause.store(static_cast<std::uint8_t>(interaction.missing_cause()));
+        }
+    }
+
+    std::string
+    frame()
+    {
+      Utilities::Point3 x, f, t;
+      for (unsigned int k = 0; k < 3; ++k)
+        {
+          x[k] = hip[k].load();
+          f[k] = force[k].load();
+          t[k] = target[k].load();
+        }
+      State                       blend;
+      const bool                  complete = blend_shape(interaction, x, blend);
+      std::lock_guard<std::mutex> lock(mutex);
+      if (complete)
+        for (std::size_t v = 0; v < surface.size(); ++v)
+          for (unsigned int k = 0; k < 3; ++k)
+            displacement[3 * v + k] = blend.solution[dofs[v][k]];
+      const auto         counts = interaction.cache().counts();
+      std::ostringstream s;
+      s << "{\"hip\":" << json_point(x) << ",\"target\":" << json_point(t)
+        << ",\"force\":" << json_point(f)
+        << ",\"shape\":" << (complete ? "true" : "false") << ",\"missing\":\""
+        << cause_name(static_cast<MissingCause>(cause.load()))
+        << "\",\"available\":" << counts.first
+        << ",\"failed\":" << counts.second << ",\"cloud_complete\":"
+        << (interaction.initial_cloud_complete() ? "true" : "false")
+        << ",\"attached\":" << (interaction.attached() ? "true" : "false")
+        << ",\"displacement\":" << json_array(displacement, 6) << "}";
+      return s.str();
+    }
+
+    Interaction                              interaction;
+    const double                             max_speed, rate;
+    std::vector<unsigned int>                surface;
+    std::vector<std::array<unsigned int, 3>> triangles, dofs;
+    std::string                              mesh_json, three_js;
+    std::vector<double>                      displacement;
+    std::atomic<double>                      target[3], hip[3], force[3];
+    std::atomic<std::uint8_t>                cause{0};
+    std::atomic<bool>                        running{true};
+    std::mutex                               mutex;
+    httplib::Server                          server;
+    std::thread                              http, device;
+    int                                      bound = 0;
+  };
+
+
+
+  LiveServer::LiveServer(const Scene       &scene,
+                         const std::string &host,
+                         const int          port,
+                         const double       max_speed)
+    : impl(std::make_unique<Impl>(scene, max_speed))
+  {
+    Impl &s      = *impl;
+    auto &server = s.server;
+    server.Get("/", [](const httplib::Request &, httplib::Response &res) {
+      res.set_content(live_view_page, "text/html");
+    });
+    server.Get("/three.min.js",
+               [&s](const httplib::Request &, httplib::Response &res) {
+                 res.set_content(s.three_js, "application/javascript");
+               });
+    server.Get("/mesh", [&s](const httplib::Request &, httplib::Response &res) {
+      res.set_content(s.mesh_json, "application/json");
+    });
+    server.Get("/frame",
+               [&s](const httplib::Request &, httplib::Response &res) {
+                 res.set_content(s.frame(), "application/json");
+               });
+    server.Post(
+      "/hip", [&s](const httplib::Request &req, httplib::Response &res) {
+        // "x,y,z": the target displacement from rest (m). Anything else, or
+        // a target beyond twice the state space, is refused: the device
+        // keeps its target.
+        try
+          {
+            const auto   x     = Utilities::parse_point(req.body);
+            const double limit = 2 * s.interaction.grid().spacing() *
+                                 s.interaction.grid().half_width();
+            for (const double c : x)
+              if (!std::isfinite(c) || std::abs(c) > limit)
+                throw std::invalid_argument("out of range");
+            for (unsigned int k = 0; k < 3; ++k)
+              s.target[k].store(x[k]);
+            res.set_content("ok", "text/plain");
+          }
+        catch (const std::exception &)
+          {
+            res.status = 400;
+            res.set_content("expected x,y,z in metres (the HIP's displacement "
+                            "from rest, within twice the state space)",
+                            "text/plain");
+          }
+      });
+    server.Post("/attach",
+                [&s](const httplib::Request &, httplib::Response &res) {
+                  s.interaction.attach();
+                  res.set_content("ok", "text/plain");
+                });
+    server.Post("/detach",
+                [&s](const httplib::Request &, httplib::Response &res) {
+                  s.interaction.detach();
+                  res.set_content("ok", "text/plain");
+                });
+    server.Post("/reset",
+                [&s](const httplib::Request &, httplib::Response &res) {
+                  for (auto &t : s.target)
+                    t.store(0);
+                  res.set_content("ok", "text/plain");
+                });
+    server.set_payload_max_length(4096);
+    s.bound = port == 0 ? server.bind_to_any_port(host) :
+                          (server.bind_to_port(host, port) ? port : -1);
+    if (s.bound <= 0)
+      throw InputError("command line",
+                       0,
+                       "--port " + std::to_string(port),
+                       "cannot listen on " + host + ":" + std::to_string(port) +
+                         " (in use, or not allowed)",
+                       "choose another port, e.g. --port 8081.");
+    s.interaction.attach();
+    s.device = std::thread([&s] { s.run_device(); });
+    s.http   = std::thread([&s] { s.server.listen_after_bind(); });
+  }
+
+
+
+  LiveServer::~LiveServer()
+  {
+    stop();
+  }
+
+
+
+  void
+  LiveServer::stop()
+  {
+    Impl &s = *impl;
+    if (!s.running.exchange(false))
+      return;
+    s.server.stop();
+    if (s.http.joinable())
+      s.http.join();
+    if (s.device.joinable())
+      s.device.join();
+    s.interaction.detach();
+  }
+
+
+
+  int
+  LiveServer::port() const
+  {
+    return impl->bound;
+  }
+
+
+
+  const Interaction &
+  LiveServer::interaction() const
+  {
+    return impl->interaction;
+  }
+
+
+
+  void
+  LiveServer::last(Utilities::Point3 &hip, Utilities::Point3 &force) const
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+      {
+        hip[k]   = impl->hip[k].load();
+        force[k] = impl->force[k].load();
+      }
+  }
+
+
+
+  namespace
+  {
+    std::atomic<bool> stop_serving{false};
+
+    extern "C" void
+    on_stop(int)
+    {
+      stop_serving.store(true);
+    }
+  } // namespace
+
+
+
+  int
+  run_serve(std::ostream      &out,
+            const Scene       &scene,
+            const std::string &host,
+            const int          port)
+  {
+    LiveServer server(scene, host, port);
+    out << "Live view: open http://" << host << ":" << server.port()
+        << "/ in a browser. Drag with the mouse to move the probe in the "
+           "view plane, the wheel moves it in depth; keys: a attach, d "
+           "detach, r back to rest. Ctrl-C ends.\n"
+        << std::flush;
+    stop_serving.store(false);
+    auto *const previous_int  = std::signal(SIGINT, on_stop);
+    auto *const previous_term = std::signal(SIGTERM, on_stop);
+    while (!stop_serving.load())
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::signal(SIGINT, previous_int);
+    std::signal(SIGTERM, previous_term);
+    server.stop();
+    out << "Live view ended.\n";
+    return ExitStatus::success;
+  }
+} // namespace palpate

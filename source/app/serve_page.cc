@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The live view's page (palpate serve): HTML and JavaScript, drawn with
+// three.js (Debian's libjs-three, served by palpate as /three.min.js).
+
+namespace palpate
+{
+  extern const char *const live_view_page;
+  const char *const        live_view_page = R"page(<!doctype html>
+<html>
+<head>
+<meta charset="utf-8">
+<title>palpate live view</title>
+<style>
+  body { margin: 0; overflow: hidden; font: 13px sans-serif; background: #20242b; }
+  #info { position: absolute; top: 8px; left: 8px; color: #eee;
+          background: rgba(0,0,0,0.5); padding: 8px; border-radius: 4px; }
+  #warn { color: #ffb347; }
+  #plot { position: absolute; bottom: 8px; left: 8px; background: rgba(0,0,0,0.5); }
+</style>
+</head>
+<body>
+<div id="info">
+  <b>palpate</b> <span id="scene"></span><br>
+  force: <span id="force">-</span> N<br>
+  HIP: <span id="hip">-</span> mm<br>
+  states: <span id="states">-</span><br>
+  <span id="warn"></span><br>
+  drag: move the probe &middot; wheel: depth &middot; a/d: attach/detach &middot; r: rest
+</div>
+<canvas id="plot" width="320" height="100"></canvas>
+<script src="/three.min.js"></script>
+<script>
+"use strict";
+const state = { mesh: null, frame: null, forces: [], target: [0, 0, 0] };
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setSize(window.innerWidth, window.innerHeight);
+document.body.insertBefore(renderer.domElement, document.body.firstChild);
+const scene = new THREE.Scene();
+const camera = new THREE.PerspectiveCamera(40, window.innerWidth / window.innerHeight, 0.001, 100);
+scene.add(new THREE.AmbientLight(0x606060));
+const light = new THREE.DirectionalLight(0xffffff, 0.8);
+light.position.set(1, 2, 3);
+scene.add(light);
+let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1;
+
+function post(path, body) {
+  return fetch(path, { method: "POST", body: body || "" });
+}
+
+fetch("/mesh").then(r => r.json()).then(m => {
+  state.mesh = m;
+  document.getElementById("scene").textContent = m.scene;
+  rest = new Float32Array(m.vertices);
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(m.vertices), 3));
+  geometry.setIndex(m.triangles);
+  geometry.computeVertexNormals();
+  organ = new THREE.Mesh(geometry, new THREE.MeshPhongMaterial(
+    { color: 0xb0505a, side: THREE.DoubleSide, flatShading: false }));
+  scene.add(organ);
+  // Fixed nodes: small blue points.
+  const fixed = new THREE.BufferGeometry();
+  const fx = [];
+  for (const i of m.fixed) fx.push(m.vertices[3 * i], m.vertices[3 * i + 1], m.vertices[3 * i + 2]);
+  fixed.setAttribute("position", new THREE.BufferAttribute(new Float32Array(fx), 3));
+  scene.add(new THREE.Points(fixed, new THREE.PointsMaterial({ color: 0x4080ff, size: m.diameter / 60 })));
+  activeIndex = m.active;
+  probe = new THREE.Mesh(new THREE.SphereGeometry(m.diameter / 80, 16, 12),
+                         new THREE.MeshPhongMaterial({ color: 0xffd040 }));
+  scene.add(probe);
+  arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.01, 0x40ff80);
+  scene.add(arrow);
+  geometry.computeBoundingSphere();
+  const c = geometry.boundingSphere.center, r = geometry.boundingSphere.radius;
+  camera.position.set(c.x, c.y - 0.2 * r, c.z + 3.2 * r);
+  camera.up.set(0, 1, 0);
+  camera.lookAt(c);
+  setInterval(poll, 33);
+});
+
+function poll() {
+  fetch("/frame").then(r => r.json()).then(f => {
+    state.frame = f;
+    const m = state.mesh, p = organ.geometry.attributes.position;
+    for (let i = 0; i < p.array.length; ++i) p.array[i] = rest[i] + f.displacement[i];
+    p.needsUpdate = true;
+    organ.geometry.computeVertexNormals();
+    const a = 3 * activeIndex;
+    const x = new THREE.Vector3(rest[a] + f.hip[0], rest[a + 1] + f.hip[1], rest[a + 2] + f.hip[2]);
+    probe.position.copy(x);
+    const force = new THREE.Vector3(f.force[0], f.force[1], f.force[2]);
+    const magnitude = force.length();
+    if (magnitude > 1e-9) {
+      arrow.visible = true;
+      arrow.position.copy(x);
+      arrow.setDirection(force.clone().normalize());
+      arrow.setLength(0.02 * m.diameter * magnitude + 0.005);
+    } else {
+      arrow.visible = false;
+    }
+    document.getElementById("force").textContent =
+      f.force.map(v => v.toFixed(3)).join(", ") + " (|f| = " + magnitude.toFixed(3) + ")";
+    document.getElementById("hip").textContent = f.hip.map(v => (1000 * v).toFixed(1)).join(", ");
+    document.getElementById("states").textContent = f.available + " computed, " + f.failed +
+      " failure points" + (f.cloud_complete ? "" : " (initial cloud in progress)");
+    document.getElementById("warn").textContent =
+      (f.attached ? "" : "detached ") + (f.missing !== "none" ? "missing data: " + f.missing : "");
+    state.forces.push(magnitude);
+    if (state.forces.length > 320) state.forces.shift();
+    plot();
+  });
+}
+
+function plot() {
+  const canvas = document.getElementById("plot"), g = canvas.getContext("2d");
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  const top = Math.max(1, ...state.forces);
+  g.strokeStyle = "#40ff80";
+  g.beginPath();
+  state.forces.forEach((v, i) => {
+    const y = canvas.height - 4 - (canvas.height - 8) * v / top;
+    if (i === 0) g.moveTo(i, y); else g.lineTo(i, y);
+  });
+  g.stroke();
+  g.fillStyle = "#eee";
+  g.fillText("|f| (N), max " + top.toFixed(2), 4, 12);
+}
+
+// The mouse as a 3-DOF device: drag in the view plane, wheel in depth.
+let dragging = false, last = null, lastSent = 0;
+function sendTarget() {
+  const now = performance.now();
+  if (now - lastSent < 16) return;
+  lastSent = now;
+  post("/hip", state.target.map(v => v.toFixed(6)).join(","));
+}
+function move(dx, dy, dz) {
+  const m = state.mesh;
+  if (!m) return;
+  const scale = m.diameter / window.innerHeight;
+  const right = new THREE.Vector3(), up = new THREE.Vector3(), back = new THREE.Vector3();
+  camera.matrixWorld.extractBasis(right, up, back);
+  const d = right.multiplyScalar(dx * scale).add(up.multiplyScalar(-dy * scale))
+              .add(back.multiplyScalar(dz * scale));
+  for (let k = 0; k < 3; ++k) {
+    state.target[k] = Math.max(-m.extent, Math.min(m.extent, state.target[k] + d.getComponent(k)));
+  }
+  sendTarget();
+}
+renderer.domElement.addEventListener("mousedown", e => { dragging = true; last = [e.clientX, e.clientY]; });
+window.addEventListener("mouseup", () => { dragging = false; });
+window.addEventListener("mousemove", e => {
+  if (!dragging) return;
+  move(e.clientX - last[0], e.clientY - last[1], 0);
+  last = [e.clientX, e.clientY];
+});
+renderer.domElement.addEventListener("wheel", e => { e.preventDefault(); move(0, 0, 0.2 * e.deltaY); },
+                                     { passive: false });
+window.addEventListener("keydown", e => {
+  if (e.key === "a") post("/attach");
+  if (e.key === "d") post("/detach");
+  if (e.key === "r") { state.target = [0, 0, 0]; post("/reset"); }
+});
+window.addEventListener("resize", () => {
+  camera.aspect = window.innerWidth / window.innerHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(window.innerWidth, window.innerHeight);
+});
+(function animate() { requestAnimationFrame(animate); renderer.render(scene, camera); })();
+window.palpate = state;
+</script>
+</body>
+</html>
+)page";
+} // namespace palpate

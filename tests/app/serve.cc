@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// palpate serve's server (issue 16), driven over HTTP as the page drives it,
+// on the small beam:
+// - the page, three.js and the surface are served; the surface has the
+//   mesh's surface vertices, the fixed and active nodes;
+// - a target sent with POST /hip is reached by the device thread, and the
+//   force /frame shows equals the state's force at that grid point (the
+//   interpolation's exact value there, 1e-9 relative);
+// - the shape /frame shows is that state's displacement;
+// - the server survives garbage, a flood of targets and a client that
+//   connects and leaves without a word.
+
+#include <palpate/app/serve.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <httplib.h>
+
+#include <chrono>
+#include <thread>
+
+#include "../tests.h"
+
+namespace
+{
+  /** The numbers of the JSON array after "key": in @p json. */
+  std::vector<double>
+  numbers(const std::string &json, const std::string &key)
+  {
+    std::vector<double> v;
+    auto                at = json.find("\"" + key + "\":[");
+    if (at == std::string::npos)
+      return v;
+    at += key.size() + 4;
+    const auto         end = json.find(']', at);
+    std::istringstream s(json.substr(at, end - at));
+    std::string        item;
+    while (std::getline(s, item, ','))
+      v.push_back(std::stod(item));
+    return v;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
+
+  const palpate::Scene scene = small_beam_scene();
+  palpate::LiveServer  server(scene, "127.0.0.1", 0, 0.05);
+  httplib::Client      client("127.0.0.1", server.port());
+  client.set_read_timeout(10, 0);
+
+  const auto  page  = client.Get("/");
+  const auto  three = client.Get("/three.min.js");
+  const auto  mesh  = client.Get("/mesh");
+  const auto &body  = server.interaction().mesh();
+  deallog << "page served: "
+          << ok(page && page->status == 200 &&
+                page->body.find("/three.min.js") != std::string::npos)
+          << ", three.js: " << ok(three && three->body.size() > 100000)
+          << ", surface: "
+          << ok(mesh && numbers(mesh->body, "vertices").size() ==
+                          3 * body.n_surface_vertices())
+          << " (" << body.n_surface_vertices() << " vertices)" << std::endl;
+
+  // The initial cloud, then a target on a grid point.
+  const auto start = std::chrono::steady_clock::now();
+  while (!server.interaction().initial_cloud_complete() &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(120))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const auto                &grid   = server.interaction().grid();
+  const auto                 point  = grid.linear({{0, 0, -1}});
+  const auto                 target = grid.position(point);
+  const auto                 sent   = client.Post("/hip",
+                                palpate::Utilities::to_string(target, 17),
+                                "text/plain");
+  palpate::Utilities::Point3 hip, force;
+  for (unsigned int k = 0; k < 200; ++k)
+    {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      server.last(hip, force);
+      if (palpate::Utilities::distance(hip, target) < 1e-12 && k > 50)
+        break;
+    }
+  const auto frame = client.Get("/frame");
+  const auto shown = numbers(frame->body, "force");
+  const auto state = server.interaction().cache().state(point);
+  deallog << "target sent: " << ok(sent && sent->status == 200) << ", reached: "
+          << ok(palpate::Utilities::distance(hip, target) < 1e-12)
+          << ", force shown = the state's force (1e-9): "
+          << ok(state && shown.size() == 3 &&
+                palpate::Utilities::distance({{shown[0], shown[1], shown[2]}},
+                                             state->force) <
+                  1e-9 * palpate::Utilities::norm(state->force) + 1e-12)
+          << ", shape shown: "
+          << ok(frame->body.find("\"shape\":true") != std::string::npos)
+          << std::endl;
+
+  // Garbage, a flood, a silent client.
+  const auto   garbage  = client.Post("/hip", "not a point", "text/plain");
+  const auto   nan      = client.Post("/hip", "nan,0,0", "text/plain");
+  const auto   far      = client.Post("/hip", "5,0,0", "text/plain");
+  unsigned int accepted = 0;
+  for (unsigned int k = 0; k < 300; ++k)
+    if (const auto r = client.Post("/hip", "0,0,-0.001", "text/plain");
+        r && r->status == 200)
+      ++accepted;
+  {
+    httplib::Client silent("127.0.0.1", server.port());
+    silent.set_connection_timeout(1, 0);
+    silent.Get("/nothing-here");
+  }
+  const auto after = client.Get("/frame");
+  deallog << "garbage refused (400): " << ok(garbage && garbage->status == 400)
+          << ", NaN refused: " << ok(nan && nan->status == 400)
+          << ", 5 m refused: " << ok(far && far->status == 400)
+          << ", a flood of 300 targets accepted: " << ok(accepted == 300)
+          << ", still serving: " << ok(after && after->status == 200)
+          << std::endl;
+  server.stop();
+}
