@@ -235,6 +235,10 @@ namespace palpate
     server.Get("/", [](const httplib::Request &, httplib::Response &res) {
       res.set_content(live_view_page, "text/html");
     });
+    server.Get("/favicon.ico",
+               [](const httplib::Request &, httplib::Response &res) {
+                 res.status = 204;
+               });
     server.Get("/three.min.js",
                [&s](const httplib::Request &, httplib::Response &res) {
                  res.set_content(s.three_js, "application/javascript");
@@ -288,6 +292,11 @@ namespace palpate
                   res.set_content("ok", "text/plain");
                 });
     server.set_payload_max_length(4096);
+    // A browser keeps connections open: with cpp-httplib's default pool
+    // (one thread per core less one: one here) a kept-alive connection
+    // would hold back every other request for its 5 s timeout.
+    server.new_task_queue = [] { return new httplib::ThreadPool(8); };
+    server.set_keep_alive_timeout(1);
     s.bound = port == 0 ? server.bind_to_any_port(host) :
                           (server.bind_to_port(host, port) ? port : -1);
     if (s.bound <= 0)

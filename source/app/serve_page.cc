@@ -33,6 +33,12 @@ namespace palpate
 <script src="/three.min.js"></script>
 <script>
 "use strict";
+// Errors show on the page (and to a browser test reading it).
+function showError(message) {
+  document.getElementById("warn").textContent = "page error: " + message;
+}
+window.addEventListener("error", e => showError(e.message));
+window.addEventListener("unhandledrejection", e => showError(String(e.reason)));
 const state = { mesh: null, frame: null, forces: [], target: [0, 0, 0] };
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setSize(window.innerWidth, window.innerHeight);
