@@ -193,7 +193,32 @@ namespace palpate
         for (std::size_t v = 0; v < surface.size(); ++v)
           for (unsigned int k = 0; k < 3; ++k)
             displacement[3 * v + k] = blend.solution[dofs[v][k]];
-      const auto         counts = interaction.cache().counts();
+      const auto counts = interaction.cache().counts();
+      // The cloud around the HIP, as the paper's Fig. 1 draws it: each grid
+      // point within the cloud radius with its status (0 not computed or
+      // being computed, 1 computed, 2 a failure point), as i, j, k, status.
+      const auto     &grid   = interaction.grid();
+      const GridIndex centre = grid.nearest(x);
+      const double    radius =
+        interaction.scene().parameters.scheduler.cloud_radius;
+      const int           reach = std::ceil(radius / grid.spacing());
+      std::vector<double> cloud;
+      for (int i = -reach; i <= reach; ++i)
+        for (int j = -reach; j <= reach; ++j)
+          for (int k = -reach; k <= reach; ++k)
+            {
+              const GridIndex g{{centre[0] + i, centre[1] + j, centre[2] + k}};
+              if (!grid.contains(g) ||
+                  grid.spacing() * std::sqrt(double(i * i + j * j + k * k)) >
+                    radius)
+                continue;
+              cloud.insert(cloud.end(),
+                           {double(g[0]),
+                            double(g[1]),
+                            double(g[2]),
+                            double(static_cast<int>(
+                              interaction.cache().status(grid.linear(g))))});
+            }
       std::ostringstream s;
       s << "{\"hip\":" << json_point(x) << ",\"target\":" << json_point(t)
         << ",\"force\":" << json_point(f)
@@ -203,6 +228,7 @@ namespace palpate
         << ",\"failed\":" << counts.second << ",\"cloud_complete\":"
         << (interaction.initial_cloud_complete() ? "true" : "false")
         << ",\"attached\":" << (interaction.attached() ? "true" : "false")
+        << ",\"cloud\":" << json_array(cloud, 6)
         << ",\"displacement\":" << json_array(displacement, 6) << "}";
       return s.str();
     }

@@ -49,7 +49,8 @@ scene.add(new THREE.AmbientLight(0x606060));
 const light = new THREE.DirectionalLight(0xffffff, 0.8);
 light.position.set(1, 2, 3);
 scene.add(light);
-let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1;
+let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1, cloudPoints = null;
+const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2]];
 
 function post(path, body) {
   return fetch(path, { method: "POST", body: body || "" });
@@ -76,6 +77,11 @@ fetch("/mesh").then(r => r.json()).then(m => {
   probe = new THREE.Mesh(new THREE.SphereGeometry(m.diameter / 80, 16, 12),
                          new THREE.MeshPhongMaterial({ color: 0xffd040 }));
   scene.add(probe);
+  // The state cloud (the paper's Fig. 1): grey not computed yet, green
+  // computed, red failure points; it follows the probe.
+  cloudPoints = new THREE.Points(new THREE.BufferGeometry(),
+    new THREE.PointsMaterial({ size: m.diameter / 150, vertexColors: true }));
+  scene.add(cloudPoints);
   arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.01, 0x40ff80);
   scene.add(arrow);
   geometry.computeBoundingSphere();
@@ -96,6 +102,15 @@ function poll() {
     const a = 3 * activeIndex;
     const x = new THREE.Vector3(rest[a] + f.hip[0], rest[a + 1] + f.hip[1], rest[a + 2] + f.hip[2]);
     probe.position.copy(x);
+    const c = f.cloud, n = c.length / 4, xyz = new Float32Array(3 * n), rgb = new Float32Array(3 * n);
+    for (let i = 0; i < n; ++i) {
+      for (let k = 0; k < 3; ++k) {
+        xyz[3 * i + k] = rest[a + k] + m.spacing * c[4 * i + k];
+        rgb[3 * i + k] = cloudColors[c[4 * i + 3]][k];
+      }
+    }
+    cloudPoints.geometry.setAttribute("position", new THREE.BufferAttribute(xyz, 3));
+    cloudPoints.geometry.setAttribute("color", new THREE.BufferAttribute(rgb, 3));
     const force = new THREE.Vector3(f.force[0], f.force[1], f.force[2]);
     const magnitude = force.length();
     if (magnitude > 1e-9) {
