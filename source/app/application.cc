@@ -189,6 +189,30 @@ namespace palpate
                ExitStatus::solve_failed;
     }
 
+    /** The error for a command-line argument palpate does not know. */
+    InputError
+    unexpected(const std::string &argument)
+    {
+      return InputError("command line",
+                        0,
+                        argument,
+                        "unexpected argument '" + argument + "'",
+                        "run 'palpate --help' for the usage.");
+    }
+
+    /** Read the scene @p file, build its mesh and nodes, and print its
+     * report: what precompute, serve and study show first. */
+    Scene
+    read_and_report(const std::string &file, std::ostream &out)
+    {
+      const Scene         scene = Scene::read(file);
+      const Mesh          mesh  = Mesh::create(scene);
+      const NodeSelection nodes = NodeSelection::create(scene, mesh);
+      print_scene_report(out, scene, mesh, nodes);
+      out << "\n";
+      return scene;
+    }
+
     /** A whole number or a positive number from the command line. */
     double
     number_argument(const std::string &option,
@@ -243,11 +267,7 @@ namespace palpate
             time_limit =
               number_argument("--time-limit", args[++i], 0.01, 86400, "60");
           else
-            throw InputError("command line",
-                             0,
-                             args[i],
-                             "unexpected argument '" + args[i] + "'",
-                             "run 'palpate --help' for the usage.");
+            throw unexpected(args[i]);
         }
       if (std::filesystem::path(args[2]).extension() != ".msh")
         throw InputError("command line",
@@ -345,11 +365,7 @@ namespace palpate
                   }
               }
             else
-              throw InputError("command line",
-                               0,
-                               args[i],
-                               "unexpected argument '" + args[i] + "'",
-                               "run 'palpate --help' for the usage.");
+              throw unexpected(args[i]);
           return run_scene(args[1], target, true, out);
         }
       if (args[0] == "mesh")
@@ -371,16 +387,8 @@ namespace palpate
             else if (args[i] == "--host" && i + 1 < args.size())
               host = args[++i];
             else
-              throw InputError("command line",
-                               0,
-                               args[i],
-                               "unexpected argument '" + args[i] + "'",
-                               "run 'palpate --help' for the usage.");
-          const Scene         scene = Scene::read(args[1]);
-          const Mesh          mesh  = Mesh::create(scene);
-          const NodeSelection nodes = NodeSelection::create(scene, mesh);
-          print_scene_report(out, scene, mesh, nodes);
-          out << "\n";
+              throw unexpected(args[i]);
+          const Scene scene = read_and_report(args[1], out);
           return run_serve(out, scene, host, port);
         }
       if (args[0] == "precompute")
@@ -397,16 +405,8 @@ namespace palpate
             if (args[i] == "--radius" && i + 1 < args.size())
               radius = number_argument("--radius", args[++i], 1e-4, 10, "0.05");
             else
-              throw InputError("command line",
-                               0,
-                               args[i],
-                               "unexpected argument '" + args[i] + "'",
-                               "run 'palpate --help' for the usage.");
-          const Scene         scene = Scene::read(args[1]);
-          const Mesh          mesh  = Mesh::create(scene);
-          const NodeSelection nodes = NodeSelection::create(scene, mesh);
-          print_scene_report(out, scene, mesh, nodes);
-          out << "\n";
+              throw unexpected(args[i]);
+          const Scene scene = read_and_report(args[1], out);
           return run_precompute(out, scene, radius);
         }
       if (args[0] == "study")
@@ -451,11 +451,7 @@ namespace palpate
                   options.samples = static_cast<unsigned int>(n);
                 }
               else
-                throw InputError("command line",
-                                 0,
-                                 args[i],
-                                 "unexpected argument '" + args[i] + "'",
-                                 "run 'palpate --help' for the usage.");
+                throw unexpected(args[i]);
             }
           if (!options.finer_mesh.empty() && !std::ifstream(options.finer_mesh))
             throw InputError("command line",
@@ -465,11 +461,7 @@ namespace palpate
                                "' cannot be read",
                              "give a finer mesh of the same organ, in the "
                              "scene's file unit (its Scale factor applies).");
-          const Scene         scene = Scene::read(args[1]);
-          const Mesh          mesh  = Mesh::create(scene);
-          const NodeSelection nodes = NodeSelection::create(scene, mesh);
-          print_scene_report(out, scene, mesh, nodes);
-          out << "\n";
+          const Scene scene = read_and_report(args[1], out);
           run_study(out, scene, options);
           return ExitStatus::success;
         }
