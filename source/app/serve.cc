@@ -20,6 +20,7 @@
 #include <cmath>
 #include <csignal>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -90,7 +91,7 @@ namespace palpate
                                       interaction.nodes(),
                                       interaction.scene().parameters);
       const ShapeFrames        frames(mesh, interaction.nodes(), system);
-      std::map<unsigned int, unsigned int> compact;
+      std::map<unsigned int, unsigned int> &compact = surface_index;
       for (const auto &face : mesh.surface_faces())
         {
           std::array<unsigned int, 3> t;
@@ -166,7 +167,13 @@ namespace palpate
           const double s = n > step ? step / n : 1.0;
           for (unsigned int k = 0; k < 3; ++k)
             x[k] += s * d[k];
-          const Utilities::Point3 f = interaction.force(x);
+          Utilities::Point3 f;
+          {
+            // Held while the parameters change (the interaction is
+            // detached and its scene replaced then).
+            std::lock_guard<std::mutex> lock(device_mutex);
+            f = interaction.force(x);
+          }
           for (unsigned int k = 0; k < 3; ++k)
             {
               hip[k].store(x[k]);
@@ -186,9 +193,10 @@ namespace palpate
           f[k] = force[k].load();
           t[k] = target[k].load();
         }
+      // The lock first: the parameters (and the nodes) may be changing.
+      std::lock_guard<std::mutex> lock(mutex);
       State                       blend;
       const bool                  complete = blend_shape(interaction, x, blend);
-      std::lock_guard<std::mutex> lock(mutex);
       if (complete)
         for (std::size_t v = 0; v < surface.size(); ++v)
           for (unsigned int k = 0; k < 3; ++k)
@@ -228,6 +236,10 @@ namespace palpate
         << ",\"failed\":" << counts.second << ",\"cloud_complete\":"
         << (interaction.initial_cloud_complete() ? "true" : "false")
         << ",\"attached\":" << (interaction.attached() ? "true" : "false")
+        << ",\"active\":"
+        << (surface_index.count(interaction.nodes().active_vertex) ?
+              int(surface_index.at(interaction.nodes().active_vertex)) :
+              -1)
         << ",\"cloud\":" << json_array(cloud, 6)
         << ",\"displacement\":" << json_array(displacement, 6) << "}";
       return s.str();
@@ -242,10 +254,40 @@ namespace palpate
     std::atomic<double>                      target[3], hip[3], force[3];
     std::atomic<std::uint8_t>                cause{0};
     std::atomic<bool>                        running{true};
-    std::mutex                               mutex;
-    httplib::Server                          server;
-    std::thread                              http, device;
-    int                                      bound = 0;
+    std::mutex                               mutex, device_mutex;
+    // Mesh vertex -> its index among the surface's vertices.
+    std::map<unsigned int, unsigned int> surface_index;
+
+    /** Change the scene's parameters on the fly: detach, change (the
+     * cache is invalidated and the states are computed again), attach.
+     * Returns "" or the reason the change was refused. */
+    std::string
+    change(const std::function<void(Parameters::AllParameters &)> &edit)
+    {
+      std::lock_guard<std::mutex> lock(device_mutex), frame_lock(mutex);
+      Parameters::AllParameters   p = interaction.scene().parameters;
+      edit(p);
+      interaction.detach();
+      std::string refused;
+      try
+        {
+          interaction.change_parameters(p);
+        }
+      catch (const InputError &e)
+        {
+          refused = e.problem() + " (" + e.fix() + ")";
+        }
+      catch (const std::exception &e)
+        {
+          refused = e.what();
+        }
+      interaction.attach();
+      return refused;
+    }
+
+    httplib::Server server;
+    std::thread     http, device;
+    int             bound = 0;
   };
 
 
@@ -301,6 +343,63 @@ namespace palpate
                             "text/plain");
           }
       });
+    // On-the-fly changes (the paper's): a material constant, as
+    // "ENTRY=VALUE" of the scene's model; another active node, as the point
+    // "x,y,z" (m, mesh coordinates) whose nearest surface node it becomes.
+    server.Post(
+      "/material", [&s](const httplib::Request &req, httplib::Response &res) {
+        const auto eq = req.body.find('=');
+        if (eq == std::string::npos)
+          {
+            res.status = 400;
+            res.set_content("expected ENTRY=VALUE, e.g. Young's "
+                            "modulus=20000",
+                            "text/plain");
+            return;
+          }
+        const std::string entry = Utilities::trim(req.body.substr(0, eq));
+        const std::string value = Utilities::trim(req.body.substr(eq + 1));
+        std::string       refused;
+        try
+          {
+            refused = s.change([&](Parameters::AllParameters &p) {
+              p.material_model.set(p.material_model.model_name, entry, value);
+            });
+          }
+        catch (const std::exception &e)
+          {
+            refused = e.what();
+          }
+        res.status = refused.empty() ? 200 : 400;
+        res.set_content(refused.empty() ?
+                          "changed: the states are computed again "
+                          "for the new constant" :
+                          "refused: " + refused,
+                        "text/plain");
+      });
+    server.Post("/active",
+                [&s](const httplib::Request &req, httplib::Response &res) {
+                  std::string refused;
+                  try
+                    {
+                      const auto point = Utilities::parse_point(req.body);
+                      for (auto &t : s.target) // the new node, at rest
+                        t.store(0);
+                      refused = s.change([&](Parameters::AllParameters &p) {
+                        p.boundary_conditions.active_node.selection =
+                          "nearest surface node";
+                        p.boundary_conditions.active_node.point = point;
+                      });
+                    }
+                  catch (const std::exception &e)
+                    {
+                      refused = e.what();
+                    }
+                  res.status = refused.empty() ? 200 : 400;
+                  res.set_content(refused.empty() ? "changed" :
+                                                    "refused: " + refused,
+                                  "text/plain");
+                });
     server.Post("/attach",
                 [&s](const httplib::Request &, httplib::Response &res) {
                   s.interaction.attach();

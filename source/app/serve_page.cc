@@ -27,7 +27,8 @@ namespace palpate
   HIP: <span id="hip">-</span> mm<br>
   states: <span id="states">-</span><br>
   <span id="warn"></span><br>
-  drag: move the probe &middot; wheel: depth &middot; a/d: attach/detach &middot; r: rest
+  drag: move the probe &middot; wheel: depth &middot; a/d: attach/detach &middot; r: rest<br>
+  m: change a material constant &middot; shift-click: another active node
 </div>
 <canvas id="plot" width="320" height="100"></canvas>
 <script src="/three.min.js"></script>
@@ -99,6 +100,7 @@ function poll() {
     for (let i = 0; i < p.array.length; ++i) p.array[i] = rest[i] + f.displacement[i];
     p.needsUpdate = true;
     organ.geometry.computeVertexNormals();
+    if (f.active >= 0) activeIndex = f.active;
     const a = 3 * activeIndex;
     const x = new THREE.Vector3(rest[a] + f.hip[0], rest[a + 1] + f.hip[1], rest[a + 2] + f.hip[2]);
     probe.position.copy(x);
@@ -179,7 +181,27 @@ window.addEventListener("mousemove", e => {
 });
 renderer.domElement.addEventListener("wheel", e => { e.preventDefault(); move(0, 0, 0.2 * e.deltaY); },
                                      { passive: false });
+// Shift-click on the surface: make the nearest surface node the active node.
+renderer.domElement.addEventListener("click", e => {
+  if (!e.shiftKey || !organ) return;
+  const mouse = new THREE.Vector2(2 * e.clientX / window.innerWidth - 1,
+                                  1 - 2 * e.clientY / window.innerHeight);
+  const ray = new THREE.Raycaster();
+  ray.setFromCamera(mouse, camera);
+  const hit = ray.intersectObject(organ)[0];
+  if (!hit) return;
+  const v = 3 * hit.face.a;  // a vertex of the face hit, at rest
+  state.target = [0, 0, 0];
+  post("/active", [rest[v], rest[v + 1], rest[v + 2]].map(x => x.toFixed(6)).join(","))
+    .then(r => r.text()).then(t => { document.getElementById("warn").textContent = "active node: " + t; });
+});
 window.addEventListener("keydown", e => {
+  if (e.key === "m") {
+    // The paper's on-the-fly parameter change: a constant of the material.
+    const change = window.prompt("Material constant (ENTRY=VALUE), e.g. Young's modulus=20000");
+    if (change) post("/material", change).then(r => r.text())
+      .then(t => { document.getElementById("warn").textContent = t; });
+  }
   if (e.key === "a") post("/attach");
   if (e.key === "d") post("/detach");
   if (e.key === "r") { state.target = [0, 0, 0]; post("/reset"); }

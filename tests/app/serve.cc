@@ -10,7 +10,12 @@
 //   interpolation's exact value there, 1e-9 relative);
 // - the shape /frame shows is that state's displacement;
 // - the server survives garbage, a flood of targets and a client that
-//   connects and leaves without a word.
+//   connects and leaves without a word;
+// - a material constant changed on the fly (Young's modulus doubled) makes
+//   the states be computed again: St.Venant-Kirchhoff's force at a fixed
+//   displacement is proportional to E, so it doubles (1e-6); a constant
+//   that describes no solid is refused with the reason, the old one kept;
+// - another active node can be picked; the frame names it.
 
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
@@ -122,6 +127,36 @@ main(int argc, char **argv)
           << ", 5 m refused: " << ok(far && far->status == 400)
           << ", a flood of 300 targets accepted: " << ok(accepted == 300)
           << ", still serving: " << ok(after && after->status == 200)
+          << std::endl;
+
+  // On the fly: Young's modulus doubled. Back to the same target.
+  const double before = palpate::Utilities::norm(state->force);
+  const auto   changed =
+    client.Post("/material", "Young's modulus=2e5", "text/plain");
+  const auto refused =
+    client.Post("/material", "Young's modulus=-1", "text/plain");
+  client.Post("/hip", palpate::Utilities::to_string(target, 17), "text/plain");
+  std::shared_ptr<const palpate::State> again;
+  for (unsigned int k = 0; k < 1200 && !again; ++k)
+    {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      again = server.interaction().cache().state(point);
+    }
+  deallog << "Young's modulus doubled on the fly: "
+          << ok(changed && changed->status == 200)
+          << ", the force doubles (1e-6): "
+          << ok(again &&
+                std::abs(palpate::Utilities::norm(again->force) / before - 2) <
+                  1e-6)
+          << "; a negative modulus refused: "
+          << ok(refused && refused->status == 400 &&
+                refused->body.rfind("refused", 0) == 0)
+          << std::endl;
+  const auto picked = client.Post("/active", "0.1,0.01,0.01", "text/plain");
+  const auto last   = client.Get("/frame");
+  deallog << "another active node picked: "
+          << ok(picked && picked->status == 200 && last &&
+                last->body.find("\"active\":") != std::string::npos)
           << std::endl;
   server.stop();
 }
