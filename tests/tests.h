@@ -10,6 +10,8 @@
 #define palpate_tests_h
 
 #include <palpate/base/environment.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
@@ -84,6 +86,28 @@ struct Body
   palpate::Mesh          mesh;
   palpate::NodeSelection nodes;
 };
+
+/**
+ * The probe's force (N) with the active node held at rest, and the sum of
+ * every nodal reaction (fixed nodes and probe, N): zero unless a load acts.
+ */
+inline std::pair<palpate::Utilities::Point3, palpate::Utilities::Point3>
+force_and_reactions_at_rest(const palpate::Scene &scene)
+{
+  const palpate::Mesh          mesh = palpate::Mesh::create(scene);
+  const palpate::NodeSelection nodes =
+    palpate::NodeSelection::create(scene, mesh);
+  palpate::StateSolver solver(mesh, nodes, scene.parameters);
+  const palpate::State s = solver.solve(solver.rest_state(), {{0, 0, 0}});
+  AssertThrow(s.converged, dealii::ExcInternalError());
+  const auto                 r = solver.system().nodal_residual(s.solution);
+  const auto                &component = solver.system().dof_components();
+  palpate::Utilities::Point3 sum{{0, 0, 0}};
+  for (std::size_t d = 0; d < r.size(); ++d)
+    if (component[d] < 3)
+      sum[component[d]] += r[d];
+  return {s.force, sum};
+}
 
 /** A shipped scene from parameters/, e.g. "liver-stvk.prm". */
 inline palpate::Scene

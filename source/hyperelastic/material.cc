@@ -70,6 +70,22 @@ namespace palpate
 
 
 
+  /**
+   * Young's modulus and Poisson's ratio of a compressible plug-in, checked
+   * (St.Venant-Kirchhoff and Neo-Hookean share these entries).
+   */
+  std::pair<double, double>
+  parse_young_poisson(const dealii::ParameterHandler &prm)
+  {
+    const double E  = prm.get_double("Young's modulus");
+    const double nu = prm.get_double("Poisson's ratio");
+    check_poissons_ratio("Poisson's ratio", nu);
+    check_modulus("Young's modulus", E);
+    return {E, nu};
+  }
+
+
+
   void
   declare_incompressibility(dealii::ParameterHandler &prm)
   {
@@ -262,10 +278,7 @@ namespace palpate
   std::unique_ptr<Material>
   StVenantKirchhoff::create(const dealii::ParameterHandler &prm)
   {
-    const double E  = prm.get_double("Young's modulus");
-    const double nu = prm.get_double("Poisson's ratio");
-    check_poissons_ratio("Poisson's ratio", nu);
-    check_modulus("Young's modulus", E);
+    const auto [E, nu] = parse_young_poisson(prm);
     return std::make_unique<StVenantKirchhoff>(E, nu);
   }
 
@@ -383,10 +396,7 @@ namespace palpate
   std::unique_ptr<Material>
   NeoHookean::create(const dealii::ParameterHandler &prm)
   {
-    const double E  = prm.get_double("Young's modulus");
-    const double nu = prm.get_double("Poisson's ratio");
-    check_poissons_ratio("Poisson's ratio", nu);
-    check_modulus("Young's modulus", E);
+    const auto [E, nu] = parse_young_poisson(prm);
     return std::make_unique<NeoHookean>(E, nu);
   }
 

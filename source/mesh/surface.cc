@@ -794,6 +794,27 @@ namespace palpate
         std::reverse(b, b + sizeof(value));
       out.write(reinterpret_cast<const char *>(b), sizeof(value));
     };
+    // PLY and legacy VTK list the vertices, then each triangle as its count
+    // (3) and its vertices: as text, or binary in the file's byte order.
+    const auto put_vertices = [&](const bool big_endian) {
+      for (unsigned int v = 0; v < s.vertices.size(); ++v)
+        if (binary)
+          for (unsigned int d = 0; d < 3; ++d)
+            put(x(v, d), big_endian);
+        else
+          out << x(v, 0) << ' ' << x(v, 1) << ' ' << x(v, 2) << '\n';
+    };
+    const auto put_triangles = [&](const bool big_endian, const auto count) {
+      for (const auto &t : s.triangles)
+        if (binary)
+          {
+            put(count, big_endian);
+            for (const unsigned int v : t)
+              put(static_cast<std::int32_t>(v), big_endian);
+          }
+        else
+          out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+    };
     if (e == ".stl" && binary)
       {
         out << std::string(80, ' ');
@@ -838,44 +859,18 @@ namespace palpate
                "z\nelement face "
             << s.triangles.size()
             << "\nproperty list uchar int vertex_indices\nend_header\n";
-        for (unsigned int v = 0; v < s.vertices.size(); ++v)
-          if (binary)
-            for (unsigned int d = 0; d < 3; ++d)
-              put(x(v, d), false);
-          else
-            out << x(v, 0) << ' ' << x(v, 1) << ' ' << x(v, 2) << '\n';
-        for (const auto &t : s.triangles)
-          if (binary)
-            {
-              put(static_cast<std::uint8_t>(3), false);
-              for (const unsigned int v : t)
-                put(static_cast<std::int32_t>(v), false);
-            }
-          else
-            out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+        put_vertices(false);
+        put_triangles(false, static_cast<std::uint8_t>(3));
       }
     else if (e == ".vtk")
       {
         out << "# vtk DataFile Version 3.0\nwritten by palpate\n"
             << (binary ? "BINARY" : "ASCII") << "\nDATASET POLYDATA\nPOINTS "
             << s.vertices.size() << " double\n";
-        for (unsigned int v = 0; v < s.vertices.size(); ++v)
-          if (binary)
-            for (unsigned int d = 0; d < 3; ++d)
-              put(x(v, d), true);
-          else
-            out << x(v, 0) << ' ' << x(v, 1) << ' ' << x(v, 2) << '\n';
+        put_vertices(true);
         out << (binary ? "\n" : "") << "POLYGONS " << s.triangles.size() << ' '
             << 4 * s.triangles.size() << '\n';
-        for (const auto &t : s.triangles)
-          if (binary)
-            {
-              put(static_cast<std::int32_t>(3), true);
-              for (const unsigned int v : t)
-                put(static_cast<std::int32_t>(v), true);
-            }
-          else
-            out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+        put_triangles(true, static_cast<std::int32_t>(3));
         if (binary)
           out << '\n';
       }

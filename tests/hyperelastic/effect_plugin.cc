@@ -90,19 +90,7 @@ namespace
   palpate::Utilities::Point3
   reactions(const palpate::Scene &scene)
   {
-    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
-    const palpate::NodeSelection nodes =
-      palpate::NodeSelection::create(scene, mesh);
-    palpate::StateSolver solver(mesh, nodes, scene.parameters);
-    const palpate::State s = solver.solve(solver.rest_state(), {{0, 0, 0}});
-    AssertThrow(s.converged, dealii::ExcInternalError());
-    const auto                 r = solver.system().nodal_residual(s.solution);
-    const auto                &component = solver.system().dof_components();
-    palpate::Utilities::Point3 sum{{0, 0, 0}};
-    for (std::size_t d = 0; d < r.size(); ++d)
-      if (component[d] < 3)
-        sum[component[d]] += r[d];
-    return sum;
+    return force_and_reactions_at_rest(scene).second;
   }
 } // namespace
 

@@ -22,27 +22,6 @@
 
 #include "../tests.h"
 
-namespace
-{
-  /** The probe force at rest and the sum of the reactions (N). */
-  std::pair<palpate::Utilities::Point3, palpate::Utilities::Point3>
-  solve(const palpate::Scene &scene)
-  {
-    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
-    const palpate::NodeSelection nodes =
-      palpate::NodeSelection::create(scene, mesh);
-    palpate::StateSolver solver(mesh, nodes, scene.parameters);
-    const palpate::State s = solver.solve(solver.rest_state(), {{0, 0, 0}});
-    AssertThrow(s.converged, dealii::ExcInternalError());
-    const auto                 r = solver.system().nodal_residual(s.solution);
-    const auto                &component = solver.system().dof_components();
-    palpate::Utilities::Point3 sum{{0, 0, 0}};
-    for (std::size_t d = 0; d < r.size(); ++d)
-      if (component[d] < 3)
-        sum[component[d]] += r[d];
-    return {s.force, sum};
-  }
-} // namespace
 
 int
 main(int argc, char **argv)
@@ -56,11 +35,11 @@ main(int argc, char **argv)
   e.turn_on("Surface traction", true);
   e.set("Surface traction", "Traction boundary id", "1");
   e.set("Surface traction", "Traction", "0, 0, -1000");
-  const auto [f1, sum1] = solve(scene);
+  const auto [f1, sum1] = force_and_reactions_at_rest(scene);
   e.set("Surface traction", "Traction", "0, 0, -2000");
-  const auto [f2, sum2] = solve(scene);
+  const auto [f2, sum2] = force_and_reactions_at_rest(scene);
   e.turn_on("Surface traction", false);
-  const auto [f0, sum0] = solve(scene);
+  const auto [f0, sum0] = force_and_reactions_at_rest(scene);
   const double load     = 1000 * 4e-4;
 
   deallog << "reactions balance t A = 0.4 N: "

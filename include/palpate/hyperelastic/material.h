@@ -157,6 +157,11 @@ namespace palpate
   void
   check_poissons_ratio(const std::string &entry, const double nu);
 
+  /** The entries "Young's modulus" and "Poisson's ratio" of a compressible
+   * plug-in, checked with the two functions above. */
+  std::pair<double, double>
+  parse_young_poisson(const dealii::ParameterHandler &prm);
+
   /**
    * Entries and their parsing shared by the isochoric (incompressible)
    * plug-ins: Incompressibility (exact|penalty), Bulk modulus, Element
