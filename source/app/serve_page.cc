@@ -17,6 +17,8 @@ namespace palpate
   #info { position: absolute; top: 8px; left: 8px; color: #eee;
           background: rgba(0,0,0,0.5); padding: 8px; border-radius: 4px; }
   #warn { color: #ffb347; }
+  #message { color: #9fd0ff; }
+  #events { color: #ffb347; font-size: 12px; }
   #plot { position: absolute; bottom: 8px; left: 8px; background: rgba(0,0,0,0.5); }
 </style>
 </head>
@@ -26,7 +28,11 @@ namespace palpate
   force: <span id="force">-</span> N<br>
   HIP: <span id="hip">-</span> mm<br>
   states: <span id="states">-</span><br>
+  engine: <span id="engine">-</span><br>
+  view: <span id="rate">-</span><br>
   <span id="warn"></span><br>
+  <span id="message"></span><br>
+  <div id="events"></div>
   drag: move the probe &middot; wheel: depth &middot; a/d: attach/detach &middot; r: rest<br>
   m: change a material constant &middot; shift-click: another active node
 </div>
@@ -40,9 +46,13 @@ function showError(message) {
 }
 window.addEventListener("error", e => showError(e.message));
 window.addEventListener("unhandledrejection", e => showError(String(e.reason)));
-const state = { mesh: null, frame: null, forces: [], target: [0, 0, 0] };
+// window.palpate: what the page knows (for a browser test too): the mesh,
+// the last frame, the frames received and when.
+const state = { mesh: null, frame: null, forces: [], target: [0, 0, 0], received: 0,
+                times: [], events: [] };
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(0x20242b);
 document.body.insertBefore(renderer.domElement, document.body.firstChild);
 const scene = new THREE.Scene();
 const camera = new THREE.PerspectiveCamera(40, window.innerWidth / window.innerHeight, 0.001, 100);
@@ -51,7 +61,9 @@ const light = new THREE.DirectionalLight(0xffffff, 0.8);
 light.position.set(1, 2, 3);
 scene.add(light);
 let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1, cloudPoints = null;
-const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2]];
+// Cloud point colours by status: not computed, computed, failure point,
+// being computed.
+const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2], [1.0, 0.85, 0.2]];
 
 function post(path, body) {
   return fetch(path, { method: "POST", body: body || "" });
@@ -59,7 +71,7 @@ function post(path, body) {
 
 fetch("/mesh").then(r => r.json()).then(m => {
   state.mesh = m;
-  document.getElementById("scene").textContent = m.scene;
+  document.getElementById("scene").textContent = m.scene + " (" + m.engine + ")";
   rest = new Float32Array(m.vertices);
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(m.vertices), 3));
@@ -78,8 +90,9 @@ fetch("/mesh").then(r => r.json()).then(m => {
   probe = new THREE.Mesh(new THREE.SphereGeometry(m.diameter / 80, 16, 12),
                          new THREE.MeshPhongMaterial({ color: 0xffd040 }));
   scene.add(probe);
-  // The state cloud (the paper's Fig. 1): grey not computed yet, green
-  // computed, red failure points; it follows the probe.
+  // The state cloud (the paper's Fig. 1): grey not computed yet, yellow
+  // being computed, green computed, red failure points; it follows the
+  // probe.
   cloudPoints = new THREE.Points(new THREE.BufferGeometry(),
     new THREE.PointsMaterial({ size: m.diameter / 150, vertexColors: true }));
   scene.add(cloudPoints);
@@ -90,12 +103,43 @@ fetch("/mesh").then(r => r.json()).then(m => {
   camera.position.set(c.x, c.y - 0.2 * r, c.z + 3.2 * r);
   camera.up.set(0, 1, 0);
   camera.lookAt(c);
-  setInterval(poll, 33);
+  poll();
 });
 
+// A log of what happened (missing data, failure points, the server gone),
+// newest first, with the time since the page loaded.
+function logEvent(text) {
+  state.events.unshift((performance.now() / 1000).toFixed(1) + " s: " + text);
+  state.events.length = Math.min(state.events.length, 6);
+  document.getElementById("events").innerHTML = state.events.join("<br>");
+}
+
+// Frames at about 30 Hz: the next request 33 ms after the last one began,
+// never two at once; a server that stops answering is retried every 0.5 s.
 function poll() {
+  const began = performance.now();
   fetch("/frame").then(r => r.json()).then(f => {
+    if (state.lost) { logEvent("the server answers again"); state.lost = false; }
+    show(f);
+    setTimeout(poll, Math.max(0, 33 - (performance.now() - began)));
+  }).catch(e => {
+    if (!state.lost) logEvent("the server does not answer (" + e.message + "); retrying");
+    state.lost = true;
+    setTimeout(poll, 500);
+  });
+}
+
+function show(f) {
+    const previous = state.frame;
     state.frame = f;
+    state.received += 1;
+    state.times.push(performance.now());
+    if (state.times.length > 60) state.times.shift();
+    if (previous && f.missing !== previous.missing && f.missing !== "none")
+      logEvent("missing data: " + f.missing + (f.missing === "not computed yet" ?
+               " (the force fades to zero)" : " (the force is held)"));
+    if (previous && f.failed > previous.failed)
+      logEvent((f.failed - previous.failed) + " new failure point" + (f.failed - previous.failed > 1 ? "s" : ""));
     const m = state.mesh, p = organ.geometry.attributes.position;
     for (let i = 0; i < p.array.length; ++i) p.array[i] = rest[i] + f.displacement[i];
     p.needsUpdate = true;
@@ -130,10 +174,18 @@ function poll() {
       " failure points" + (f.cloud_complete ? "" : " (initial cloud in progress)");
     document.getElementById("warn").textContent =
       (f.attached ? "" : "detached ") + (f.missing !== "none" ? "missing data: " + f.missing : "");
+    const l = f.load;
+    document.getElementById("engine").textContent = l.busy + " of " + l.workers + " workers solving, " +
+      l.queued + " queued, " + l.states_per_second.toFixed(1) + " states/s, " +
+      (100 * l.utilisation).toFixed(0) + " % busy";
+    const t = state.times;
+    if (t.length > 1)
+      document.getElementById("rate").textContent =
+        ((t.length - 1) * 1000 / (t[t.length - 1] - t[0])).toFixed(0) + " frames/s";
     state.forces.push(magnitude);
     if (state.forces.length > 320) state.forces.shift();
     plot();
-  });
+    requestDraw();
 }
 
 function plot() {
@@ -152,12 +204,16 @@ function plot() {
 }
 
 // The mouse as a 3-DOF device: drag in the view plane, wheel in depth.
-let dragging = false, last = null, lastSent = 0;
+// Targets go at most every 16 ms; the last one of a burst always goes.
+let dragging = false, last = null, lastSent = 0, pending = null;
 function sendTarget() {
   const now = performance.now();
-  if (now - lastSent < 16) return;
+  if (now - lastSent < 16) {
+    if (!pending) pending = setTimeout(() => { pending = null; sendTarget(); }, 16 - (now - lastSent));
+    return;
+  }
   lastSent = now;
-  post("/hip", state.target.map(v => v.toFixed(6)).join(","));
+  post("/hip", state.target.map(v => v.toFixed(9)).join(","));
 }
 function move(dx, dy, dz) {
   const m = state.mesh;
@@ -193,14 +249,14 @@ renderer.domElement.addEventListener("click", e => {
   const v = 3 * hit.face.a;  // a vertex of the face hit, at rest
   state.target = [0, 0, 0];
   post("/active", [rest[v], rest[v + 1], rest[v + 2]].map(x => x.toFixed(6)).join(","))
-    .then(r => r.text()).then(t => { document.getElementById("warn").textContent = "active node: " + t; });
+    .then(r => r.text()).then(t => { document.getElementById("message").textContent = "active node: " + t; });
 });
 window.addEventListener("keydown", e => {
   if (e.key === "m") {
     // The paper's on-the-fly parameter change: a constant of the material.
     const change = window.prompt("Material constant (ENTRY=VALUE), e.g. Young's modulus=20000");
     if (change) post("/material", change).then(r => r.text())
-      .then(t => { document.getElementById("warn").textContent = t; });
+      .then(t => { document.getElementById("message").textContent = t; });
   }
   if (e.key === "a") post("/attach");
   if (e.key === "d") post("/detach");
@@ -210,9 +266,20 @@ window.addEventListener("resize", () => {
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
   renderer.setSize(window.innerWidth, window.innerHeight);
+  requestDraw();
 });
-(function animate() { requestAnimationFrame(animate); renderer.render(scene, camera); })();
+// Drawn when something changed (a frame came, the window was resized), not
+// at every animation frame: a software renderer (a machine without a GPU,
+// headless Chromium) would spend the page's time drawing the same picture.
+let redraw = true;
+function requestDraw() { redraw = true; }
+(function animate() {
+  requestAnimationFrame(animate);
+  if (redraw) { redraw = false; renderer.render(scene, camera); }
+})();
 window.palpate = state;
+// The view, for a browser test that clicks on the surface.
+window.palpateView = { camera: camera, organ: () => organ };
 </script>
 </body>
 </html>

@@ -757,6 +757,25 @@ namespace palpate
 
 
 
+  EngineLoad
+  MpiEngine::load() const
+  {
+    const Impl                 &s = *impl;
+    std::lock_guard<std::mutex> lock(s.mutex);
+    EngineLoad                  l;
+    l.workers   = s.servers.size() - 1;
+    l.busy      = s.busy;
+    l.computed  = s.stats.computed;
+    l.failed    = s.stats.failed;
+    l.busy_time = s.stats.busy_time;
+    for (unsigned int p = 0; p < s.in_progress.size(); ++p)
+      if (s.in_progress[p] != 0)
+        l.in_progress.push_back(p);
+    return l;
+  }
+
+
+
   unsigned int
   MpiEngine::n_workers() const
   {

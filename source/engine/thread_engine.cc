@@ -480,6 +480,26 @@ namespace palpate
 
 
 
+  EngineLoad
+  ThreadEngine::load() const
+  {
+    const Impl                 &s = *impl;
+    std::lock_guard<std::mutex> lock(s.mutex);
+    EngineLoad                  l;
+    l.workers   = s.solvers.size();
+    l.busy      = s.busy;
+    l.queued    = s.queue.size();
+    l.computed  = s.stats.computed;
+    l.failed    = s.stats.failed;
+    l.busy_time = s.stats.busy_time;
+    for (unsigned int p = 0; p < s.in_progress.size(); ++p)
+      if (s.in_progress[p] != 0)
+        l.in_progress.push_back(p);
+    return l;
+  }
+
+
+
   unsigned int
   ThreadEngine::n_workers() const
   {

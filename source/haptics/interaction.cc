@@ -586,6 +586,14 @@ namespace palpate
 
 
 
+  EngineLoad
+  Interaction::engine_load() const
+  {
+    return impl->engine->load();
+  }
+
+
+
   RunSummary
   Interaction::summary() const
   {

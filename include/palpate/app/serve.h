@@ -26,8 +26,10 @@ namespace palpate
    *
    * Endpoints: GET / (the page), GET /three.min.js (Debian's libjs-three),
    * GET /mesh (the surface: rest positions, triangles, fixed and active
-   * nodes, the state space's extent), GET /frame (HIP, target, force, the
-   * surface's displacement, the cloud's counts, the missing-data cause),
+   * nodes, the state space's extent, the engine), GET /frame (HIP, target,
+   * force, the surface's displacement, the cloud around the HIP with each
+   * point's status: not computed, computed, failed, being computed; the
+   * engine's load; the missing-data cause),
    * POST /hip with "x,y,z" (the target displacement from rest, m),
    * POST /attach, /detach, /reset.
    */

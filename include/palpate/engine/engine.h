@@ -68,6 +68,22 @@ namespace palpate
     std::vector<std::string> lost_servers;
   };
 
+  /** What the engine is doing now, for a live view (cheap: no task log). */
+  struct EngineLoad
+  {
+    /** Solver threads or servers, and how many are solving now. */
+    unsigned int workers = 0, busy = 0;
+    /** Tasks planned and waiting for a worker (the MPI engine dispatches
+     * straight to free servers: 0). */
+    unsigned int queued = 0;
+    /** States and failure points so far, and the seconds workers spent
+     * solving (for a rate and a busy fraction between two calls). */
+    unsigned int computed = 0, failed = 0;
+    double       busy_time = 0;
+    /** The grid points being computed now. */
+    std::vector<unsigned int> in_progress;
+  };
+
   /**
    * The on-line precomputation engine as the haptic side sees it: it keeps
    * the cloud of states around the HIP computed and publishes them in the
@@ -108,6 +124,10 @@ namespace palpate
     /** A copy of the counters and the task log. */
     virtual EngineStatistics
     statistics() const = 0;
+
+    /** What it is doing now (for a non-real-time thread). */
+    virtual EngineLoad
+    load() const = 0;
 
     /** How many states can be computed at once (solver threads or
      * servers). */

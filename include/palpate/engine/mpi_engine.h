@@ -70,6 +70,9 @@ namespace palpate
     EngineStatistics
     statistics() const override;
 
+    EngineLoad
+    load() const override;
+
     unsigned int
     n_workers() const override;
 

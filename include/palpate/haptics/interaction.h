@@ -20,6 +20,7 @@ namespace palpate
   class Scene;
   class StateCache;
   class StateGrid;
+  struct EngineLoad;
   struct NodeSelection;
 
   namespace Parameters
@@ -149,6 +150,11 @@ namespace palpate
      * how many. For a non-real-time thread. */
     unsigned int
     poll_events(std::ostream &log);
+
+    /** What the engine is doing now: workers busy, tasks queued, the points
+     * being computed. For a non-real-time thread (a live view). */
+    EngineLoad
+    engine_load() const;
 
     /** What happened so far (engine and haptic side; no loop timing). */
     RunSummary
