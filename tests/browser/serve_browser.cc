@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// palpate serve's page in a real browser (issue 16): Debian's headless
+// Chromium, driven by puppeteer-core (drive.js), loads the page served for
+// the small beam and is used as a person would use it. Checked here, against
+// the API:
+// - frames reach the page at 20 Hz or more while the mouse drags the probe;
+// - once the probe rests, the force the page holds is the force
+//   Interaction::force() returned at that HIP (the device thread's last
+//   call, 1e-9 relative), the force the page prints is it to its 3
+//   decimals, and the HIP is the target the drag sent;
+// - the cloud around the probe is computed (it followed the probe), and the
+//   engine's load is shown;
+// - the m key's prompt changes Young's modulus on the fly to twice its
+//   value: the force at the same HIP doubles (St.Venant-Kirchhoff, 1e-6);
+// - d and a detach and attach; shift-click picks another active node;
+// - a reloaded page (a client that leaves and comes back) is served;
+// - the view is drawn (more than 5 % of its pixels are not background) and
+//   a screenshot is kept: PALPATE_ARTEFACT_DIR/live-view.png.
+
+#include <palpate/app/serve.h>
+#include <palpate/haptics/interaction.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "../tests.h"
+
+namespace
+{
+  /** The numbers in @p text (commas, parentheses, "=" and words skipped). */
+  std::vector<double>
+  numbers_in(std::string text)
+  {
+    for (char &c : text)
+      if (c == ',' || c == '(' || c == ')' || c == '=' || c == '|')
+        c = ' ';
+    std::istringstream  s(text);
+    std::vector<double> v;
+    std::string         word;
+    while (s >> word)
+      try
+        {
+          std::size_t  used = 0;
+          const double x    = std::stod(word, &used);
+          if (used == word.size())
+            v.push_back(x);
+        }
+      catch (const std::exception &)
+        {}
+    return v;
+  }
+
+  palpate::Utilities::Point3
+  point(const std::vector<double> &v, const std::size_t first = 0)
+  {
+    return {{v.at(first), v.at(first + 1), v.at(first + 2)}};
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
+
+  const palpate::Scene scene = small_beam_scene();
+  palpate::LiveServer  server(scene, "127.0.0.1", 0, 0.05);
+
+  const std::filesystem::path artefacts(PALPATE_ARTEFACT_DIR);
+  std::filesystem::create_directories(artefacts);
+  const std::filesystem::path screenshot = artefacts / "live-view.png";
+  std::filesystem::remove(screenshot);
+  const std::string command =
+    "NODE_PATH='" PALPATE_NODE_MODULES "' '" PALPATE_NODE
+    "' '" PALPATE_SOURCE_DIR "/tests/browser/drive.js' '" PALPATE_CHROMIUM
+    "' " +
+    std::to_string(server.port()) + " '" + screenshot.string() + "' 2>&1";
+  FILE *browser = popen(command.c_str(), "r");
+  AssertThrow(browser != nullptr, dealii::ExcMessage("cannot run " + command));
+
+  // The browser's lines as they come: KEY value...; the check of the force
+  // against the API is made as soon as the page reports it, while the
+  // probe rests there.
+  std::map<std::string, std::string> seen;
+  std::string                        log;
+  palpate::Utilities::Point3         api_hip{{0, 0, 0}}, api_force{{0, 0, 0}};
+  char                               buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, browser) != nullptr)
+    {
+      std::string line(buffer);
+      log += line;
+      if (!line.empty() && line.back() == '\n')
+        line.pop_back();
+      const auto space = line.find(' ');
+      const auto key   = line.substr(0, space);
+      seen[key] = space == std::string::npos ? "" : line.substr(space + 1);
+      if (key == "TARGET")
+        server.last(api_hip, api_force);
+    }
+  const int status = pclose(browser);
+
+  const auto value = [&](const std::string &key) {
+    const auto it = seen.find(key);
+    return it == seen.end() ? std::string() : it->second;
+  };
+  const bool complete = status == 0 && seen.count("PAGE_ERRORS") > 0;
+  deallog << "the browser drove the page to the end: " << ok(complete)
+          << std::endl;
+  // What the browser saw, for the log (not compared: it varies).
+  std::cout << "drive.js said:\n" << log << std::endl;
+
+  const auto rate = numbers_in(value("RATE"));
+  deallog << "frames at 20 Hz or more during the drag: "
+          << ok(!rate.empty() && rate[0] >= 20) << std::endl;
+
+  const auto hip    = numbers_in(value("HIP"));
+  const auto target = numbers_in(value("TARGET"));
+  const auto force  = numbers_in(value("FORCE"));
+  const auto text   = numbers_in(value("FORCE_TEXT"));
+  const bool have = hip.size() == 3 && target.size() == 3 && force.size() == 3;
+  if (have)
+    {
+      const double f = palpate::Utilities::norm(api_force);
+      deallog << "the probe rests at the dragged target: "
+              << ok(palpate::Utilities::distance(point(hip), point(target)) <
+                      1e-9 &&
+                    palpate::Utilities::norm(point(target)) > 1e-4)
+              << ", the HIP is the API's: "
+              << ok(palpate::Utilities::distance(point(hip), api_hip) < 1e-12)
+              << ", the force the page holds is the API's there (1e-9): "
+              << ok(f > 1e-3 &&
+                    palpate::Utilities::distance(point(force), api_force) <
+                      1e-9 * f)
+              << std::endl;
+      bool printed = text.size() == 4;
+      for (unsigned int k = 0; printed && k < 3; ++k)
+        printed = std::abs(text[k] - api_force[k]) <= 0.0005 + 1e-12;
+      deallog << "the force printed is the API's to 3 decimals: " << ok(printed)
+              << ", and its magnitude: "
+              << ok(text.size() == 4 && std::abs(text[3] - f) <= 0.0005 + 1e-12)
+              << std::endl;
+    }
+  else
+    deallog << "the page reported its HIP and force: NO" << std::endl;
+
+  // Status counts: not computed, computed, failed, being computed.
+  const auto cloud = numbers_in(value("CLOUD"));
+  const auto load  = numbers_in(value("LOAD"));
+  deallog << "the cloud around the probe is computed: "
+          << ok(cloud.size() == 4 && cloud[1] > 10 && cloud[0] == 0 &&
+                cloud[3] == 0)
+          << ", the engine's load shown: "
+          << ok(load.size() == 3 && load[0] == 2 &&
+                value("ENGINE_TEXT").find("workers solving") !=
+                  std::string::npos)
+          << std::endl;
+
+  const auto after = numbers_in(value("FORCE_AFTER_MATERIAL"));
+  deallog << "m changed Young's modulus: "
+          << ok(value("MATERIAL_TEXT").find("Young's modulus") !=
+                  std::string::npos &&
+                value("MATERIAL_TEXT").rfind("refused", 0) != 0)
+          << ", the force at the same HIP doubled (1e-6): "
+          << ok(have && after.size() == 3 &&
+                std::abs(palpate::Utilities::norm(point(after)) /
+                           palpate::Utilities::norm(point(force)) -
+                         2) < 1e-6)
+          << std::endl;
+
+  const auto active = numbers_in(value("ACTIVE"));
+  deallog << "d and a detached and attached: "
+          << ok(value("DETACH_ATTACH") == "yes")
+          << ", shift-click picked another active node: "
+          << ok(active.size() >= 2 && active[0] != active[1] && active[1] >= 0)
+          << ", a reloaded page is served: "
+          << ok(value("RECONNECTED") == "yes") << std::endl;
+
+  const auto drawn = numbers_in(value("DRAWN"));
+  deallog << "the view is drawn: " << ok(!drawn.empty() && drawn[0] > 0.05)
+          << ", the screenshot is kept: "
+          << ok(std::filesystem::exists(screenshot) &&
+                std::filesystem::file_size(screenshot) > 10000)
+          << ", page errors: " << value("PAGE_ERRORS") << std::endl;
+  server.stop();
+}
