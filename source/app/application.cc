@@ -87,6 +87,29 @@ namespace palpate
              scene.parameters.run.mode == "interaction";
     }
 
+    /** Releases the MPI solver servers when it goes out of scope, however
+     * rank 0's work ended (an error before the engine started included). */
+    struct ReleaseServers
+    {
+      ReleaseServers()                       = default;
+      ReleaseServers(const ReleaseServers &) = delete;
+      ~ReleaseServers()
+      {
+        release_solver_servers();
+      }
+    };
+
+    /** With the MPI engine under mpirun, a guard that releases the solver
+     * servers however the rest ends. */
+    std::optional<ReleaseServers>
+    release_servers_at_end(const Scene &scene)
+    {
+      // A prvalue: the guard is never copied (nor released early).
+      return mpi_size() > 1 && scene.parameters.engine.type == "mpi" ?
+               std::optional<ReleaseServers>(std::in_place) :
+               std::nullopt;
+    }
+
     /**
      * A rank other than 0 of an MPI run: a solver server if the command
      * is an interaction with the MPI engine; otherwise nothing (rank 0
@@ -95,15 +118,18 @@ namespace palpate
     int
     run_server_rank(const std::vector<std::string> &args, std::ostream &err)
     {
-      // palpate precompute under mpirun: the servers compute, rank 0 writes.
-      const bool precompute = args.size() >= 2 && args[0] == "precompute";
-      if (!precompute && (args.size() != 1 || args[0].empty() ||
+      // palpate precompute and palpate serve under mpirun: the servers
+      // compute, rank 0 writes the store or serves the page, whatever the
+      // scene's Run / Mode.
+      const bool subcommand =
+        args.size() >= 2 && (args[0] == "precompute" || args[0] == "serve");
+      if (!subcommand && (args.size() != 1 || args[0].empty() ||
                           args[0][0] == '-' || args[0] == "solve"))
         return ExitStatus::success;
       try
         {
-          const Scene scene = Scene::read(precompute ? args[1] : args[0]);
-          if (precompute ?
+          const Scene scene = Scene::read(subcommand ? args[1] : args[0]);
+          if (subcommand ?
                 !(mpi_size() > 1 && scene.parameters.engine.type == "mpi") :
                 !serves(scene, false))
             return ExitStatus::success;
@@ -145,13 +171,6 @@ namespace palpate
       // Under mpirun the other ranks got this far too; with the MPI
       // engine they now wait as solver servers, and are released whatever
       // happens here (the engine releases them itself when it ends).
-      struct ReleaseServers
-      {
-        ~ReleaseServers()
-        {
-          release_solver_servers();
-        }
-      };
       std::optional<ReleaseServers> release;
       if (serves(scene, solve))
         release.emplace();
@@ -389,6 +408,8 @@ namespace palpate
             else
               throw unexpected(args[i]);
           const Scene scene = read_and_report(args[1], out);
+          // Under mpirun the servers now wait for this scene's engine.
+          const auto release = release_servers_at_end(scene);
           return run_serve(out, scene, host, port);
         }
       if (args[0] == "precompute")
@@ -407,6 +428,8 @@ namespace palpate
             else
               throw unexpected(args[i]);
           const Scene scene = read_and_report(args[1], out);
+          // Under mpirun the servers now wait for this scene's engine.
+          const auto release = release_servers_at_end(scene);
           return run_precompute(out, scene, radius);
         }
       if (args[0] == "study")

@@ -608,6 +608,9 @@ namespace palpate
     std::signal(SIGTERM, previous_term);
     server.stop();
     out << "Live view ended.\n";
+    RunSummary summary = server.interaction().summary();
+    summary.trajectory = "the browser's mouse (palpate serve)";
+    summary.print(out);
     return ExitStatus::success;
   }
 } // namespace palpate

@@ -277,15 +277,20 @@ namespace palpate
     std::array<double, 3> local;
     if (!grid.locate(x, lower, local))
       return false;
-    const auto                   corners = grid.corners(lower);
-    const auto                   w       = trilinear_weights(local);
+    const auto corners = grid.corners(lower);
+    const auto w       = trilinear_weights(local);
+    // Every corner is asked for, even after one is missing: with states
+    // held elsewhere (MPI servers) each one asked for is fetched, and the
+    // cell's 8 come in one round instead of one per call.
     std::shared_ptr<const State> states[8];
+    bool                         complete = true;
     for (unsigned int k = 0; k < 8; ++k)
       {
         states[k] = interaction.cache().state(corners[k]);
-        if (states[k] == nullptr)
-          return false;
+        complete  = complete && states[k] != nullptr;
       }
+    if (!complete)
+      return false;
     // The blended state: displacement (and pressure), multipliers, force.
     State blend               = *states[0];
     blend.active_displacement = x;
