@@ -50,7 +50,15 @@ window.addEventListener("unhandledrejection", e => showError(String(e.reason)));
 // the last frame, the frames received and when.
 const state = { mesh: null, frame: null, forces: [], target: [0, 0, 0], received: 0,
                 times: [], events: [] };
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// Antialiasing, unless the WebGL is a software renderer (no GPU: a VM,
+// headless Chromium), where it cost the page a third of its frame rate.
+function softwareRenderer() {
+  const gl = document.createElement("canvas").getContext("webgl");
+  const info = gl && gl.getExtension("WEBGL_debug_renderer_info");
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : "";
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+const renderer = new THREE.WebGLRenderer({ antialias: !softwareRenderer(), preserveDrawingBuffer: true });
 renderer.setSize(window.innerWidth, window.innerHeight);
 renderer.setClearColor(0x20242b);
 document.body.insertBefore(renderer.domElement, document.body.firstChild);
@@ -108,10 +116,20 @@ fetch("/mesh").then(r => r.json()).then(m => {
 
 // A log of what happened (missing data, failure points, the server gone),
 // newest first, with the time since the page loaded.
-function logEvent(text) {
-  state.events.unshift((performance.now() / 1000).toFixed(1) + " s: " + text);
-  state.events.length = Math.min(state.events.length, 6);
-  document.getElementById("events").innerHTML = state.events.join("<br>");
+// The same event again within 3 s adds to its line ("x 4") instead of
+// pushing the others out.
+function logEvent(text, count) {
+  const now = performance.now() / 1000, e = state.events[0];
+  if (e && e.text === text && now - e.last < 3) {
+    e.last = now;
+    e.count += count || 1;
+  } else {
+    state.events.unshift({ text: text, first: now, last: now, count: count || 1 });
+    state.events.length = Math.min(state.events.length, 5);
+  }
+  document.getElementById("events").innerHTML = state.events.map(e =>
+    e.first.toFixed(1) + (e.last > e.first ? "-" + e.last.toFixed(1) : "") + " s: " + e.text +
+    (e.count > 1 ? " (x " + e.count + ")" : "")).join("<br>");
 }
 
 // Frames at about 30 Hz: the next request 33 ms after the last one began,
@@ -139,7 +157,7 @@ function show(f) {
       logEvent("missing data: " + f.missing + (f.missing === "not computed yet" ?
                " (the force fades to zero)" : " (the force is held)"));
     if (previous && f.failed > previous.failed)
-      logEvent((f.failed - previous.failed) + " new failure point" + (f.failed - previous.failed > 1 ? "s" : ""));
+      logEvent("new failure points (no equilibrium found there)", f.failed - previous.failed);
     const m = state.mesh, p = organ.geometry.attributes.position;
     for (let i = 0; i < p.array.length; ++i) p.array[i] = rest[i] + f.displacement[i];
     p.needsUpdate = true;
@@ -279,7 +297,8 @@ function requestDraw() { redraw = true; }
 })();
 window.palpate = state;
 // The view, for a browser test that clicks on the surface.
-window.palpateView = { camera: camera, organ: () => organ };
+window.palpateView = { camera: camera, organ: () => organ, render: () => renderer.render(scene, camera) };
+window.show = show;
 </script>
 </body>
 </html>
