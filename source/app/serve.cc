@@ -507,6 +507,14 @@ namespace palpate
     // and the page's frames came at 20 Hz instead of 30 (measured in
     // headless Chromium: 44 ms per /frame, 2 ms with curl).
     server.set_tcp_nodelay(true);
+    // cpp-httplib's default also sets SO_REUSEPORT, with which a second
+    // palpate serve on the same port binds too and the kernel shares the
+    // connections between the two: only SO_REUSEADDR (a restart can bind
+    // at once), so a port in use is an error that says so.
+    server.set_socket_options([](const socket_t sock) {
+      const int yes = 1;
+      setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     s.bound = port == 0 ? server.bind_to_any_port(host) :
                           (server.bind_to_port(host, port) ? port : -1);
     if (s.bound <= 0)

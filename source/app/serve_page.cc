@@ -297,8 +297,7 @@ function requestDraw() { redraw = true; }
 })();
 window.palpate = state;
 // The view, for a browser test that clicks on the surface.
-window.palpateView = { camera: camera, organ: () => organ, render: () => renderer.render(scene, camera) };
-window.show = show;
+window.palpateView = { camera: camera, organ: () => organ };
 </script>
 </body>
 </html>

@@ -15,7 +15,8 @@
 //   the states be computed again: St.Venant-Kirchhoff's force at a fixed
 //   displacement is proportional to E, so it doubles (1e-6); a constant
 //   that describes no solid is refused with the reason, the old one kept;
-// - another active node can be picked; the frame names it.
+// - another active node can be picked; the frame names it;
+// - a second server cannot take the same port.
 
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
@@ -157,6 +158,22 @@ main(int argc, char **argv)
   deallog << "another active node picked: "
           << ok(picked && picked->status == 200 && last &&
                 last->body.find("\"active\":") != std::string::npos)
+          << std::endl;
+
+  // A second server on the same port is an error that says so (cpp-httplib's
+  // SO_REUSEPORT would have let it bind and share the connections).
+  std::string second;
+  try
+    {
+      palpate::LiveServer other(scene, "127.0.0.1", server.port(), 0.05);
+      second = "it bound";
+    }
+  catch (const palpate::InputError &e)
+    {
+      second = e.what();
+    }
+  deallog << "a second server on the port refused: "
+          << ok(second.find("cannot listen on 127.0.0.1:") != std::string::npos)
           << std::endl;
   server.stop();
 }
