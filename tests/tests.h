@@ -37,6 +37,14 @@ static const std::string palpate_source_dir = PALPATE_SOURCE_DIR;
 static const std::string palpate_shared_dir = PALPATE_SHARED_DIR;
 static const std::string palpate_executable = PALPATE_EXECUTABLE;
 
+/** A check's outcome as the .output files print it: "yes", or "NO" (which
+ * stands out in a diff). */
+inline const char *
+ok(const bool passed)
+{
+  return passed ? "yes" : "NO";
+}
+
 /** Send deallog to the file "output", with @p precision digits. */
 inline void
 initlog(const unsigned int precision = 6)

@@ -55,7 +55,6 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
   initlog();
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   const palpate::Scene scene = small_beam_scene();
   palpate::LiveServer  server(scene, "127.0.0.1", 0, 0.05);

@@ -38,7 +38,6 @@ main(int argc, char **argv)
       return palpate::run_solver_server(scene, body.mesh, body.nodes);
     }
   initlog();
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   palpate::LiveServer server(scene, "127.0.0.1", 0, 0.05);
   httplib::Client     client("127.0.0.1", server.port());

@@ -28,7 +28,6 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
   initlog();
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   const palpate::Scene  scene = shipped_scene("beam.prm");
   palpate::StudyOptions options;

@@ -33,7 +33,6 @@ main(int argc, char **argv)
   initlog();
   using palpate::Interpolation;
   using palpate::Utilities::Point3;
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   palpate::Scene scene        = small_beam_scene();
   auto          &p            = scene.parameters;

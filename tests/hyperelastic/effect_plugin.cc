@@ -99,7 +99,6 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
   initlog();
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   // The parameter reference lists the switch and the entry.
   {

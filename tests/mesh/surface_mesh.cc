@@ -87,12 +87,6 @@ namespace
       }
     return "NOT refused";
   }
-
-  const char *
-  ok(const bool b)
-  {
-    return b ? "yes" : "NO";
-  }
 } // namespace
 
 int

@@ -206,7 +206,6 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
   using palpate::Interpolation;
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   // Cubic fields: 5 mm grid of +-20 mm; points within 14 mm have all
   // neighbours of their cells.

@@ -76,7 +76,6 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
   initlog();
-  const auto ok = [](const bool b) { return b ? "yes" : "NO"; };
 
   palpate::Scene scene                                = small_beam_scene();
   scene.parameters.nonlinear_solver.compute_stiffness = true;
