@@ -217,8 +217,31 @@ namespace palpate
         s.store_wake.notify_all();
         s.store_writer.join();
       }
-    if (s.store)
-      s.append_to_store(); // what the engine finished last
+    if (!s.store)
+      return;
+    // What the engine finished last. States held elsewhere (MPI servers)
+    // are fetched when the store asks for them, a few ms later: append
+    // again while that brings more, until every finished point is stored
+    // (at most 10 s; half a second without progress ends it: a state the
+    // cache's budget dropped cannot come back).
+    using Clock           = std::chrono::steady_clock;
+    const auto start      = Clock::now();
+    auto       progressed = start;
+    for (;;)
+      {
+        const unsigned int before = s.stored.load();
+        s.append_to_store();
+        const auto now = Clock::now();
+        if (s.stored.load() > before)
+          progressed = now;
+        const auto counts = s.cache.counts();
+        if (s.loaded.states + s.loaded.failures + s.stored.load() >=
+              counts.first + counts.second ||
+            now - progressed > std::chrono::milliseconds(500) ||
+            now - start > std::chrono::seconds(10))
+          break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
   }
 
 
