@@ -246,9 +246,17 @@ function move(dx, dy, dz) {
   }
   sendTarget();
 }
-renderer.domElement.addEventListener("mousedown", e => { dragging = true; last = [e.clientX, e.clientY]; });
-window.addEventListener("mouseup", () => { dragging = false; });
-window.addEventListener("mousemove", e => {
+// Pointer events: a mouse, a touchpad, a pen or a finger on a touch screen
+// (touch-action none: the browser does not scroll or zoom the page).
+renderer.domElement.style.touchAction = "none";
+renderer.domElement.addEventListener("pointerdown", e => {
+  dragging = true;
+  last = [e.clientX, e.clientY];
+  renderer.domElement.setPointerCapture(e.pointerId);
+});
+renderer.domElement.addEventListener("pointerup", () => { dragging = false; });
+renderer.domElement.addEventListener("pointercancel", () => { dragging = false; });
+renderer.domElement.addEventListener("pointermove", e => {
   if (!dragging) return;
   move(e.clientX - last[0], e.clientY - last[1], 0);
   last = [e.clientX, e.clientY];
