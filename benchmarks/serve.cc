@@ -55,7 +55,7 @@ namespace
     double frame_p50_ms = 0, frame_max_ms = 0;
     // The cloud computed again (a material change) with the page closed
     // and with it open.
-    double cloud_s_closed = 0, cloud_s_open = 0;
+    double      cloud_s_closed = 0, cloud_s_open = 0;
     std::size_t frame_bytes = 0;
   };
 
@@ -64,8 +64,8 @@ namespace
   double
   recompute(LiveServer &server, httplib::Client &client, const Scene &scene)
   {
-    const auto  &m = scene.parameters.material_model;
-    const double E = m.get_double(m.model_name, "Young's modulus");
+    const auto        &m = scene.parameters.material_model;
+    const double       E = m.get_double(m.model_name, "Young's modulus");
     std::ostringstream body;
     body << std::setprecision(17) << "Young's modulus=" << E;
     const auto start = Clock::now();
@@ -84,8 +84,8 @@ namespace
             const std::string width,
             const std::string height)
   {
-    Result     r;
-    LiveServer server(scene, "127.0.0.1", 0);
+    Result          r;
+    LiveServer      server(scene, "127.0.0.1", 0);
     httplib::Client client("127.0.0.1", server.port());
     client.set_read_timeout(600, 0);
     while (!server.interaction().initial_cloud_complete())
@@ -149,7 +149,7 @@ main(int argc, char **argv)
   if (!std::filesystem::exists(PALPATE_BINARY_DIR
                                "/browser-test/node_modules/puppeteer-core") ||
       std::system("command -v chromium >/dev/null && command -v node "
-                   ">/dev/null") != 0)
+                  ">/dev/null") != 0)
     {
       std::cerr << "benchmarks/run serve needs headless Chromium, node and "
                    "puppeteer-core in build/browser-test: apt-get install "
@@ -173,18 +173,19 @@ main(int argc, char **argv)
                {"liver-stvk", "1200", "800", 16}};
 
   std::vector<std::string> results;
-  std::cout << std::left << std::setw(12) << "scene" << std::setw(10)
-            << "view" << std::right << std::setw(12) << "solving Hz"
-            << std::setw(10) << "idle Hz" << std::setw(12) << "frame ms"
-            << std::setw(10) << "max ms" << std::setw(10) << "bytes"
-            << std::setw(12) << "cloud s" << std::setw(14) << "page closed s"
-            << std::setw(10) << "cost %" << "\n";
+  std::cout << std::left << std::setw(12) << "scene" << std::setw(10) << "view"
+            << std::right << std::setw(12) << "solving Hz" << std::setw(10)
+            << "idle Hz" << std::setw(12) << "frame ms" << std::setw(10)
+            << "max ms" << std::setw(10) << "bytes" << std::setw(12)
+            << "cloud s" << std::setw(14) << "page closed s" << std::setw(10)
+            << "cost %"
+            << "\n";
   for (const auto &c : configs)
     {
-      const Scene scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
+      const Scene  scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
                                       "/parameters/" + c.scene + ".prm");
-      const Result r    = with_view(scene, c.seconds, c.width, c.height);
-      const double cost = 100 * (r.cloud_s_open / r.cloud_s_closed - 1);
+      const Result r     = with_view(scene, c.seconds, c.width, c.height);
+      const double cost  = 100 * (r.cloud_s_open / r.cloud_s_closed - 1);
       std::cout << std::left << std::setw(12) << c.scene << std::setw(10)
                 << (c.width + "x" + c.height) << std::right << std::fixed
                 << std::setprecision(1) << std::setw(12) << r.solving_hz
@@ -192,8 +193,8 @@ main(int argc, char **argv)
                 << std::setw(12) << r.frame_p50_ms << std::setw(10)
                 << r.frame_max_ms << std::setw(10) << r.frame_bytes
                 << std::setw(12) << r.cloud_s_open << std::setw(14)
-                << r.cloud_s_closed
-                << std::setprecision(1) << std::setw(10) << cost << "\n"
+                << r.cloud_s_closed << std::setprecision(1) << std::setw(10)
+                << cost << "\n"
                 << std::defaultfloat;
       std::ostringstream line;
       line << "RESULT serve scene=" << c.scene << " view=" << c.width << "x"
