@@ -397,8 +397,11 @@ namespace palpate
                              "serve",
                              "'serve' needs a scene file",
                              "run 'palpate serve SCENE.prm [--port P]'.");
-          int         port = 8080;
-          std::string host = "127.0.0.1";
+          // Under mpirun the servers read this scene too and now wait for
+          // its engine: released however this ends, a bad option included.
+          const auto  release = release_servers_at_end(Scene::read(args[1]));
+          int         port    = 8080;
+          std::string host    = "127.0.0.1";
           for (unsigned int i = 2; i < args.size(); ++i)
             if (args[i] == "--port" && i + 1 < args.size())
               port = static_cast<int>(
@@ -408,8 +411,6 @@ namespace palpate
             else
               throw unexpected(args[i]);
           const Scene scene = read_and_report(args[1], out);
-          // Under mpirun the servers now wait for this scene's engine.
-          const auto release = release_servers_at_end(scene);
           return run_serve(out, scene, host, port);
         }
       if (args[0] == "precompute")
@@ -421,15 +422,16 @@ namespace palpate
                              "'precompute' needs a scene file",
                              "run 'palpate precompute SCENE.prm [--radius "
                              "R]'.");
-          double radius = 0;
+          // Under mpirun the servers read this scene too and now wait for
+          // its engine: released however this ends, a bad option included.
+          const auto release = release_servers_at_end(Scene::read(args[1]));
+          double     radius  = 0;
           for (unsigned int i = 2; i < args.size(); ++i)
             if (args[i] == "--radius" && i + 1 < args.size())
               radius = number_argument("--radius", args[++i], 1e-4, 10, "0.05");
             else
               throw unexpected(args[i]);
           const Scene scene = read_and_report(args[1], out);
-          // Under mpirun the servers now wait for this scene's engine.
-          const auto release = release_servers_at_end(scene);
           return run_precompute(out, scene, radius);
         }
       if (args[0] == "study")

@@ -763,11 +763,19 @@ namespace palpate
     const Impl                 &s = *impl;
     std::lock_guard<std::mutex> lock(s.mutex);
     EngineLoad                  l;
-    l.workers   = s.servers.size() - 1;
+    for (std::size_t r = 1; r < s.servers.size(); ++r) // servers not lost
+      l.workers += !s.servers[r].lost;
     l.busy      = s.busy;
     l.computed  = s.stats.computed;
     l.failed    = s.stats.failed;
     l.busy_time = s.stats.busy_time;
+    // With the running tasks' time so far: a task longer than a live view's
+    // sampling interval still shows as busy.
+    const auto now = Clock::now();
+    for (std::size_t r = 1; r < s.servers.size(); ++r)
+      if (!s.servers[r].lost && !s.servers[r].tasks.empty())
+        l.busy_time +=
+          std::chrono::duration<double>(now - s.servers[r].task_start).count();
     for (unsigned int p = 0; p < s.in_progress.size(); ++p)
       if (s.in_progress[p] != 0)
         l.in_progress.push_back(p);

@@ -106,6 +106,10 @@ namespace palpate
     std::vector<std::uint8_t> in_progress;
     unsigned int              busy            = 0;
     bool                      nothing_to_plan = false;
+    // The solves running now: how many, and the sum of their start times
+    // (now()), for the time spent on them so far (load()).
+    unsigned int running       = 0;
+    double       running_since = 0;
     // Tasks finished so far, and how many had finished when the last plan
     // was made: the engine is idle only if that plan saw all of them.
     std::uint64_t finished = 0, finished_at_plan = 0;
@@ -258,9 +262,14 @@ namespace palpate
         // take the process down while a device renders forces: it becomes
         // a failure point too, and is counted and reported.
         const double start = now();
-        State        result;
-        bool         solved = false;
-        std::string  error;
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          ++running;
+          running_since += start;
+        }
+        State       result;
+        bool        solved = false;
+        std::string error;
         try
           {
             if (faults.workers_throw)
@@ -322,6 +331,8 @@ namespace palpate
           std::lock_guard<std::mutex> lock(mutex);
           in_progress[task.target] = 0;
           --busy;
+          --running;
+          running_since -= start;
           ++finished;
           replan = true;
           if (solved)
@@ -486,12 +497,15 @@ namespace palpate
     const Impl                 &s = *impl;
     std::lock_guard<std::mutex> lock(s.mutex);
     EngineLoad                  l;
-    l.workers   = s.solvers.size();
-    l.busy      = s.busy;
-    l.queued    = s.queue.size();
-    l.computed  = s.stats.computed;
-    l.failed    = s.stats.failed;
-    l.busy_time = s.stats.busy_time;
+    l.workers  = s.solvers.size();
+    l.busy     = s.busy;
+    l.queued   = s.queue.size();
+    l.computed = s.stats.computed;
+    l.failed   = s.stats.failed;
+    // With the running solves' time so far: a task longer than a live
+    // view's sampling interval still shows as busy.
+    l.busy_time =
+      s.stats.busy_time + std::max(0.0, s.running * s.now() - s.running_since);
     for (unsigned int p = 0; p < s.in_progress.size(); ++p)
       if (s.in_progress[p] != 0)
         l.in_progress.push_back(p);

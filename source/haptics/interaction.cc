@@ -140,9 +140,11 @@ namespace palpate
     std::thread                 store_writer;
     std::atomic<bool>           store_running{false};
     std::mutex                  store_mutex, store_append_mutex;
-    std::condition_variable     store_wake;
-    std::atomic<unsigned int>   stored{0};
-    std::string                 store_error;
+    // attach(), detach() and change_parameters() take turns.
+    std::mutex                control_mutex;
+    std::condition_variable   store_wake;
+    std::atomic<unsigned int> stored{0};
+    std::string               store_error;
 
     // Real-time state (touched by force() only).
     ForceFilter           filter;
@@ -188,7 +190,8 @@ namespace palpate
   void
   Interaction::attach()
   {
-    Impl &s = *impl;
+    Impl                       &s = *impl;
+    std::lock_guard<std::mutex> lock(s.control_mutex);
     if (s.is_attached.load())
       return;
     // The HIP channel has one writer, force(): the cloud is computed around
@@ -209,7 +212,8 @@ namespace palpate
   void
   Interaction::detach()
   {
-    Impl &s = *impl;
+    Impl                       &s = *impl;
+    std::lock_guard<std::mutex> lock(s.control_mutex);
     s.is_attached.store(false);
     s.engine->stop();
     if (s.store_running.exchange(false))
@@ -221,9 +225,10 @@ namespace palpate
       return;
     // What the engine finished last. States held elsewhere (MPI servers)
     // are fetched when the store asks for them, a few ms later: append
-    // again while that brings more, until every finished point is stored
-    // (at most 10 s; half a second without progress ends it: a state the
-    // cache's budget dropped cannot come back).
+    // again while that brings more, until every finished point that can be
+    // stored is (a state the cache's budget dropped cannot come back); at
+    // most 10 s, and half a second without progress ends it (a lost
+    // server).
     using Clock           = std::chrono::steady_clock;
     const auto start      = Clock::now();
     auto       progressed = start;
@@ -234,9 +239,7 @@ namespace palpate
         const auto now = Clock::now();
         if (s.stored.load() > before)
           progressed = now;
-        const auto counts = s.cache.counts();
-        if (s.loaded.states + s.loaded.failures + s.stored.load() >=
-              counts.first + counts.second ||
+        if (!s.store || s.store->missing(s.cache, s.grid) == 0 ||
             now - progressed > std::chrono::milliseconds(500) ||
             now - start > std::chrono::seconds(10))
           break;
@@ -449,7 +452,8 @@ namespace palpate
   void
   Interaction::change_parameters(const Parameters::AllParameters &parameters)
   {
-    Impl &s = *impl;
+    Impl                       &s = *impl;
+    std::lock_guard<std::mutex> lock(s.control_mutex);
     if (s.is_attached.load())
       throw std::logic_error(
         "Interaction::change_parameters: detach first (parameters can "

@@ -28,6 +28,8 @@ namespace palpate
     std::atomic<double>        cross[12] = {};
     /** Whether the whole state is held (written under the mutex). */
     std::atomic<bool> held{false};
+    /** Whether it was dropped for the budget (written under the mutex). */
+    std::atomic<bool> dropped{false};
   };
 
   static_assert(std::atomic<double>::is_always_lock_free &&
@@ -170,6 +172,7 @@ namespace palpate
       {
         states[p].reset();
         entries[p].held.store(false, std::memory_order_relaxed);
+        entries[p].dropped.store(false, std::memory_order_relaxed);
       }
     bytes = 0;
     held  = 0;
@@ -235,6 +238,7 @@ namespace palpate
     bytes += size_of(*state);
     states[point] = std::move(state);
     e.held.store(true, std::memory_order_release);
+    e.dropped.store(false, std::memory_order_relaxed);
 
     // Over budget: drop the states farthest from the focus (their forces
     // stay available to the real-time side), down to 90 % of the budget so
@@ -256,6 +260,7 @@ namespace palpate
             bytes -= size_of(*states[p]);
             states[p].reset();
             entries[p].held.store(false, std::memory_order_release);
+            entries[p].dropped.store(true, std::memory_order_relaxed);
             --held;
             ++evicted;
           }
@@ -494,6 +499,14 @@ namespace palpate
   StateCache::has_state(const unsigned int point) const
   {
     return entries[point].held.load(std::memory_order_acquire);
+  }
+
+
+
+  bool
+  StateCache::dropped(const unsigned int point) const
+  {
+    return entries[point].dropped.load(std::memory_order_relaxed);
   }
 
 

@@ -656,6 +656,23 @@ namespace palpate
 
 
 
+  unsigned int
+  StateStore::missing(const StateCache &cache, const StateGrid &grid) const
+  {
+    const Impl  &s = *impl;
+    unsigned int n = 0;
+    for (unsigned int p = 0; p < grid.size(); ++p)
+      if (s.stored.count(p) == 0)
+        {
+          const PointStatus status = cache.status(p);
+          n += status == PointStatus::failed ||
+               (status == PointStatus::available && !cache.dropped(p));
+        }
+    return n;
+  }
+
+
+
   void
   StateStore::export_vtk(const StateGrid   &grid,
                          const std::string &filename) const

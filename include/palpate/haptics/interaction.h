@@ -52,7 +52,9 @@ namespace palpate
    *
    * force() may be called from exactly one thread at a time. It never
    * blocks, never allocates and never returns NaN. Everything else is for
-   * the host's other threads.
+   * the host's other threads; attach(), detach() and change_parameters()
+   * may come from several of them (a live view's requests): they take
+   * turns.
    */
   class Interaction
   {

@@ -173,6 +173,12 @@ namespace palpate
     unsigned int
     n_evicted() const;
 
+    /** Whether the whole state at @p point was dropped to respect the
+     * budget (and not published again since): an engine that held it only
+     * here cannot give it back. */
+    bool
+    dropped(const unsigned int point) const;
+
   private:
     struct Entry;
 

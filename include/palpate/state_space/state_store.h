@@ -84,6 +84,14 @@ namespace palpate
     unsigned int
     append(const StateCache &cache, const StateGrid &grid);
 
+    /**
+     * The number of points @p cache finished (states and failure points)
+     * that the store does not hold yet and still can: a state the cache
+     * dropped for its budget is not counted (nothing gives it back).
+     */
+    unsigned int
+    missing(const StateCache &cache, const StateGrid &grid) const;
+
     /** Append one state (converged or not) at grid point @p point. */
     void
     append(const unsigned int point, const State &state);
