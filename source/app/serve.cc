@@ -26,7 +26,9 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <string_view>
 #include <thread>
+#include <utility>
 
 namespace palpate
 {
@@ -34,6 +36,15 @@ namespace palpate
    * force; the mouse drags the HIP in the view plane, the wheel moves it
    * in depth. */
   extern const char *const live_view_page;
+
+  /** three.js, compiled in (live_view_assets.cc). */
+  namespace live_view_assets
+  {
+    std::string_view
+    three_core();
+    std::string_view
+    three_module();
+  } // namespace live_view_assets
 
   namespace
   {
@@ -166,14 +177,13 @@ namespace palpate
       mesh_json = m.str();
       displacement.assign(3 * surface.size(), 0.0);
 
-      std::ifstream     three("/usr/share/javascript/three/three.min.js");
-      std::stringstream s;
-      s << three.rdbuf();
-      three_js = s.str();
-      if (three_js.empty())
-        throw NotAvailableError("the live view's 3-D rendering (three.js)",
-                                "/usr/share/javascript/three/three.min.js: "
-                                "install Debian's libjs-three");
+      if (live_view_assets::three_module().empty())
+        throw NotAvailableError(
+          "the live view's 3-D rendering (three.js)",
+          "this palpate was built without it: npm was missing (or failed) "
+          "when cmake ran. Install npm (apt-get install npm), then run cmake "
+          "and make again: cmake installs three.js from npm into the build "
+          "tree and builds it in");
     }
 
     /** The device: at the loop rate, move the HIP toward the target at
@@ -188,7 +198,9 @@ namespace palpate
       auto              next = Clock::now();
       while (running.load())
         {
-          next += period;
+          // After a stall (a parameter change holds the device), on from
+          // now: no burst of steps that would outrun the speed limit.
+          next = std::max(next + period, Clock::now());
           std::this_thread::sleep_until(next);
           Utilities::Point3 d;
           for (unsigned int k = 0; k < 3; ++k)
@@ -307,7 +319,7 @@ namespace palpate
     const double                             max_speed, rate;
     std::vector<unsigned int>                surface;
     std::vector<std::array<unsigned int, 3>> triangles, dofs;
-    std::string                              mesh_json, three_js;
+    std::string                              mesh_json;
     std::vector<double>                      displacement;
     std::atomic<double>                      target[3], hip[3], force[3];
     std::atomic<std::uint8_t>                cause{0};
@@ -320,7 +332,8 @@ namespace palpate
     } load_sample{Clock::now(), 0, 0.0};
     double            states_per_second = 0, utilisation = 0;
     std::atomic<bool> running{true};
-    std::mutex        mutex, device_mutex;
+    // Locked in this order: control_mutex, device_mutex, mutex.
+    std::mutex control_mutex, mutex, device_mutex;
     // Mesh vertex -> its index among the surface's vertices.
     std::map<unsigned int, unsigned int> surface_index;
 
@@ -330,13 +343,16 @@ namespace palpate
     std::string
     change(const std::function<void(Parameters::AllParameters &)> &edit)
     {
-      std::lock_guard<std::mutex> lock(device_mutex), frame_lock(mutex);
+      // One change, attach or detach at a time (the HTTP pool has 8
+      // threads); the device runs on while detaching (the force fades).
+      std::lock_guard<std::mutex> control(control_mutex);
       Parameters::AllParameters   p = interaction.scene().parameters;
       edit(p);
       interaction.detach();
       std::string refused;
       try
         {
+          std::lock_guard<std::mutex> lock(device_mutex), frame_lock(mutex);
           interaction.change_parameters(p);
         }
       catch (const InputError &e)
@@ -373,10 +389,16 @@ namespace palpate
                [](const httplib::Request &, httplib::Response &res) {
                  res.status = 204;
                });
-    server.Get("/three.min.js",
-               [&s](const httplib::Request &, httplib::Response &res) {
-                 res.set_content(s.three_js, "application/javascript");
-               });
+    // three.js's modules: the page imports three.module.js, which imports
+    // ./three.core.js.
+    for (const auto &[path, module] :
+         {std::make_pair("/three.module.js", live_view_assets::three_module()),
+          std::make_pair("/three.core.js", live_view_assets::three_core())})
+      server.Get(
+        path,
+        [module = module](const httplib::Request &, httplib::Response &res) {
+          res.set_content(module.data(), module.size(), "text/javascript");
+        });
     server.Get("/mesh", [&s](const httplib::Request &, httplib::Response &res) {
       res.set_content(s.mesh_json, "application/json");
     });
@@ -450,6 +472,27 @@ namespace palpate
         try
           {
             const auto point = Utilities::parse_point(req.body);
+            // A point on the organ: within its bounding box, enlarged by a
+            // tenth of its diameter (a huge or NaN point would select no
+            // node).
+            const auto  &vertices = s.interaction.mesh().vertices();
+            const double margin   = 0.1 * s.interaction.mesh().diameter();
+            for (unsigned int k = 0; k < 3; ++k)
+              {
+                double low = vertices[0][k], high = vertices[0][k];
+                for (const auto &v : vertices)
+                  {
+                    low  = std::min(low, double(v[k]));
+                    high = std::max(high, double(v[k]));
+                  }
+                if (!(point[k] >= low - margin && point[k] <= high + margin))
+                  throw std::invalid_argument(
+                    "the point (" + Utilities::to_string(point, 6) +
+                    ") m is not on the organ (its bounding box is " +
+                    Utilities::to_string(low, 6) + " to " +
+                    Utilities::to_string(high, 6) + " m along axis " +
+                    std::to_string(k) + ")");
+              }
             for (auto &t : s.target) // the new node, at rest
               t.store(0);
             refused = s.change([&](Parameters::AllParameters &p) {
@@ -482,11 +525,13 @@ namespace palpate
       });
     server.Post("/attach",
                 [&s](const httplib::Request &, httplib::Response &res) {
+                  std::lock_guard<std::mutex> lock(s.control_mutex);
                   s.interaction.attach();
                   res.set_content("ok", "text/plain");
                 });
     server.Post("/detach",
                 [&s](const httplib::Request &, httplib::Response &res) {
+                  std::lock_guard<std::mutex> lock(s.control_mutex);
                   s.interaction.detach();
                   res.set_content("ok", "text/plain");
                 });

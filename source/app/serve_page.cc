@@ -2,7 +2,8 @@
 // Copyright (C) 2026 the palpate authors
 
 // The live view's page (palpate serve): HTML and JavaScript, drawn with
-// three.js (Debian's libjs-three, served by palpate as /three.min.js).
+// three.js (from npm, compiled into palpate and served as /three.module.js
+// and /three.core.js: live_view_assets.cc).
 
 namespace palpate
 {
@@ -37,9 +38,8 @@ namespace palpate
   m: change a material constant &middot; shift-click: another active node
 </div>
 <canvas id="plot" width="320" height="100"></canvas>
-<script src="/three.min.js"></script>
-<script>
-"use strict";
+<script type="module">
+import * as THREE from "/three.module.js";
 // Errors show on the page (and to a browser test reading it).
 function showError(message) {
   document.getElementById("warn").textContent = "page error: " + message;
@@ -64,8 +64,9 @@ renderer.setClearColor(0x20242b);
 document.body.insertBefore(renderer.domElement, document.body.firstChild);
 const scene = new THREE.Scene();
 const camera = new THREE.PerspectiveCamera(40, window.innerWidth / window.innerHeight, 0.001, 100);
-scene.add(new THREE.AmbientLight(0x606060));
-const light = new THREE.DirectionalLight(0xffffff, 0.8);
+// Intensities times pi: three.js's lights are physical since r155.
+scene.add(new THREE.AmbientLight(0x606060, Math.PI));
+const light = new THREE.DirectionalLight(0xffffff, 0.8 * Math.PI);
 light.position.set(1, 2, 3);
 scene.add(light);
 let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1, cloudPoints = null;
@@ -73,11 +74,27 @@ let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1, clo
 // being computed.
 const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2], [1.0, 0.85, 0.2]];
 
+// A request to the server: its answer as text, or (logged) why there is
+// none; never an unhandled rejection.
 function post(path, body) {
-  return fetch(path, { method: "POST", body: body || "" });
+  return fetch(path, { method: "POST", body: body || "" }).then(r => r.text()).catch(e => {
+    const text = path + ": the server does not answer (" + e.message + ")";
+    logEvent(text);
+    return text;
+  });
 }
 
-fetch("/mesh").then(r => r.json()).then(m => {
+// The surface, then the frames; a server not up yet is asked again.
+function loadMesh() {
+  fetch("/mesh").then(r => {
+    if (!r.ok) throw new Error("the server answers " + r.status);
+    return r.json();
+  }).then(start, e => {
+    logEvent("the surface did not come (" + e.message + "); retrying");
+    setTimeout(loadMesh, 1000);
+  });
+}
+function start(m) {
   state.mesh = m;
   document.getElementById("scene").textContent = m.scene + " (" + m.engine + ")";
   rest = new Float32Array(m.vertices);
@@ -103,6 +120,7 @@ fetch("/mesh").then(r => r.json()).then(m => {
   // probe.
   cloudPoints = new THREE.Points(new THREE.BufferGeometry(),
     new THREE.PointsMaterial({ size: m.diameter / 150, vertexColors: true }));
+  cloudPoints.frustumCulled = false;  // its points change every frame
   scene.add(cloudPoints);
   arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.01, 0x40ff80);
   scene.add(arrow);
@@ -112,7 +130,7 @@ fetch("/mesh").then(r => r.json()).then(m => {
   camera.up.set(0, 1, 0);
   camera.lookAt(c);
   poll();
-});
+}
 
 // A log of what happened (missing data, failure points, the server gone),
 // newest first, with the time since the page loaded.
@@ -136,7 +154,10 @@ function logEvent(text, count) {
 // never two at once; a server that stops answering is retried every 0.5 s.
 function poll() {
   const began = performance.now();
-  fetch("/frame").then(r => r.text()).then(text => {
+  fetch("/frame").then(r => {
+    if (!r.ok) throw new Error("it answers " + r.status);
+    return r.text();
+  }).then(text => {
     if (state.lost) { logEvent("the server answers again"); state.lost = false; }
     // A frame like the last (nothing moved, nothing computed) is counted
     // but not drawn again: a software renderer's time goes to the solvers.
@@ -145,11 +166,15 @@ function poll() {
       state.times.push(performance.now());
       if (state.times.length > 60) state.times.shift();
     } else {
-      state.lastText = text;
-      show(JSON.parse(text));
+      try {
+        show(JSON.parse(text));
+        state.lastText = text;
+      } catch (e) {
+        logEvent("a frame could not be shown: " + e.message);
+      }
     }
     setTimeout(poll, Math.max(0, 33 - (performance.now() - began)));
-  }).catch(e => {
+  }, e => {
     if (!state.lost) logEvent("the server does not answer (" + e.message + "); retrying");
     state.lost = true;
     setTimeout(poll, 500);
@@ -231,16 +256,19 @@ function plot() {
 }
 
 // The mouse as a 3-DOF device: drag in the view plane, wheel in depth.
-// Targets go at most every 16 ms; the last one of a burst always goes.
-let dragging = false, last = null, lastSent = 0, pending = null;
+// Targets go one at a time (so they arrive in order), at most every 16 ms;
+// what moved meanwhile goes next, so the last target always arrives.
+let dragging = false, last = null, sending = false, again = false;
 function sendTarget() {
-  const now = performance.now();
-  if (now - lastSent < 16) {
-    if (!pending) pending = setTimeout(() => { pending = null; sendTarget(); }, 16 - (now - lastSent));
-    return;
-  }
-  lastSent = now;
-  post("/hip", state.target.map(v => v.toFixed(9)).join(","));
+  if (sending) { again = true; return; }
+  sending = true;
+  const began = performance.now();
+  post("/hip", state.target.map(v => v.toFixed(9)).join(",")).then(() => {
+    setTimeout(() => {
+      sending = false;
+      if (again) { again = false; sendTarget(); }
+    }, Math.max(0, 16 - (performance.now() - began)));
+  });
 }
 function move(dx, dy, dz) {
   const m = state.mesh;
@@ -284,18 +312,19 @@ renderer.domElement.addEventListener("click", e => {
   const v = 3 * hit.face.a;  // a vertex of the face hit, at rest
   state.target = [0, 0, 0];
   post("/active", [rest[v], rest[v + 1], rest[v + 2]].map(x => x.toFixed(6)).join(","))
-    .then(r => r.text()).then(t => { document.getElementById("message").textContent = "active node: " + t; });
+    .then(t => { document.getElementById("message").textContent = "active node: " + t; });
 });
 window.addEventListener("keydown", e => {
   if (e.key === "m") {
     // The paper's on-the-fly parameter change: a constant of the material.
     const change = window.prompt("Material constant (ENTRY=VALUE), e.g. Young's modulus=20000");
-    if (change) post("/material", change).then(r => r.text())
+    if (change) post("/material", change)
       .then(t => { document.getElementById("message").textContent = t; });
   }
   if (e.key === "a") post("/attach");
   if (e.key === "d") post("/detach");
-  if (e.key === "r") { state.target = [0, 0, 0]; post("/reset"); }
+  // Rest: the target goes after any sent before it.
+  if (e.key === "r") { state.target = [0, 0, 0]; sendTarget(); }
 });
 window.addEventListener("resize", () => {
   camera.aspect = window.innerWidth / window.innerHeight;
@@ -313,8 +342,10 @@ function requestDraw() { redraw = true; }
   if (redraw) { redraw = false; renderer.render(scene, camera); }
 })();
 window.palpate = state;
-// The view, for a browser test that clicks on the surface.
-window.palpateView = { camera: camera, organ: () => organ };
+loadMesh();
+// The view, for a browser test that clicks on the surface (three.js is a
+// module here, not a global).
+window.palpateView = { THREE: THREE, camera: camera, organ: () => organ };
 </script>
 </body>
 </html>

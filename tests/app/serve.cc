@@ -3,7 +3,9 @@
 
 // palpate serve's server (issue 16), driven over HTTP as the page drives it,
 // on the small beam:
-// - the page, three.js and the surface are served; the surface has the
+// - the page, three.js and the surface are served (three.js's two modules,
+//   the core the revision source/app/web/package.json pins); the surface
+//   has the
 //   mesh's surface vertices, the fixed and active nodes;
 // - a target sent with POST /hip is reached by the device thread, and the
 //   force /frame shows equals the state's force at that grid point (the
@@ -15,7 +17,11 @@
 //   the states be computed again: St.Venant-Kirchhoff's force at a fixed
 //   displacement is proportional to E, so it doubles (1e-6); a constant
 //   that describes no solid is refused with the reason, the old one kept;
-// - another active node can be picked; the frame names it;
+// - another active node can be picked; the frame names it; a point far off
+//   the organ is refused;
+// - attach, detach and changes sent at once from several clients take
+//   turns: every change is made (none refused because another request
+//   attached in between), and it still serves;
 // - a second server cannot take the same port.
 
 #include <palpate/app/serve.h>
@@ -25,8 +31,10 @@
 
 #include <httplib.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
+#include <vector>
 
 #include "../tests.h"
 
@@ -61,14 +69,30 @@ main(int argc, char **argv)
   httplib::Client      client("127.0.0.1", server.port());
   client.set_read_timeout(10, 0);
 
-  const auto  page  = client.Get("/");
-  const auto  three = client.Get("/three.min.js");
-  const auto  mesh  = client.Get("/mesh");
-  const auto &body  = server.interaction().mesh();
+  const auto  page   = client.Get("/");
+  const auto  module = client.Get("/three.module.js");
+  const auto  core   = client.Get("/three.core.js");
+  const auto  mesh   = client.Get("/mesh");
+  const auto &body   = server.interaction().mesh();
+  // "three": "0.187.0" -> revision '187'.
+  const std::string pinned =
+    read_file(palpate_source_dir + "/source/app/web/package.json");
+  const auto        at = pinned.find("\"three\": \"0.");
+  const std::string revision =
+    at == std::string::npos ?
+      "?" :
+      pinned.substr(at + 12, pinned.find('.', at + 12) - (at + 12));
   deallog << "page served: "
           << ok(page && page->status == 200 &&
-                page->body.find("/three.min.js") != std::string::npos)
-          << ", three.js: " << ok(three && three->body.size() > 100000)
+                page->body.find("from \"/three.module.js\"") !=
+                  std::string::npos)
+          << ", three.js: "
+          << ok(module && module->status == 200 &&
+                module->body.find("from './three.core.js'") !=
+                  std::string::npos &&
+                core && core->status == 200 &&
+                core->body.find("const REVISION = '" + revision + "'") !=
+                  std::string::npos)
           << ", surface: "
           << ok(mesh && numbers(mesh->body, "vertices").size() ==
                           3 * body.n_surface_vertices())
@@ -154,9 +178,51 @@ main(int argc, char **argv)
           << std::endl;
   const auto picked = client.Post("/active", "0.1,0.01,0.01", "text/plain");
   const auto last   = client.Get("/frame");
+  const auto off    = client.Post("/active", "1e200,0,0", "text/plain");
   deallog << "another active node picked: "
           << ok(picked && picked->status == 200 && last &&
                 last->body.find("\"active\":") != std::string::npos)
+          << ", a point off the organ refused: "
+          << ok(off && off->status == 400 &&
+                off->body.find("is not on the organ") != std::string::npos)
+          << std::endl;
+
+  // Several clients at once, as a page's keys and clicks can come: d, a,
+  // shift-click and m from four threads, three times each.
+  std::atomic<unsigned int> changes_made{0}, answered{0};
+  {
+    std::vector<std::thread> clients;
+    for (unsigned int c = 0; c < 4; ++c)
+      clients.emplace_back([&, c] {
+        httplib::Client each("127.0.0.1", server.port());
+        each.set_read_timeout(60, 0);
+        for (unsigned int round = 0; round < 3; ++round)
+          {
+            const char *const paths[] = {"/detach",
+                                         "/attach",
+                                         "/active",
+                                         "/material"};
+            const std::string body =
+              c == 2 ? (round % 2 == 0 ? "0.1,0.01,0.01" : "0.09,0,0.01") :
+              c == 3 ? "Young's modulus=" + std::to_string(1 + round) + "e5" :
+                       "";
+            const auto r = each.Post(paths[c], body, "text/plain");
+            answered += r ? 1 : 0;
+            if (r && c >= 2 && r->status == 200)
+              ++changes_made;
+          }
+      });
+    for (auto &t : clients)
+      t.join();
+  }
+  client.Post("/attach", "", "text/plain");
+  const auto still = client.Get("/frame");
+  deallog << "requests from 4 clients at once answered: "
+          << ok(answered.load() == 12)
+          << ", every change made: " << ok(changes_made.load() == 6)
+          << ", still serving: "
+          << ok(still && still->status == 200 &&
+                still->body.find("\"hip\":") != std::string::npos)
           << std::endl;
 
   // A second server on the same port is an error that says so (cpp-httplib's

@@ -136,6 +136,7 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await until(() => Math.hypot(...window.palpate.frame.hip) < 1e-9, 10000);
   const pick = await page.evaluate(() => {
     const s = window.palpate, v = s.mesh.vertices, a = s.frame.active;
+    const THREE = window.palpateView.THREE;
     const camera = window.palpateView.camera, organ = window.palpateView.organ();
     const at = i => new THREE.Vector3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
     const order = [...Array(v.length / 3).keys()].sort((i, j) => at(j).distanceTo(at(a)) - at(i).distanceTo(at(a)));

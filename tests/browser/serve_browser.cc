@@ -8,8 +8,9 @@
 // - frames reach the page at 20 Hz or more while the mouse drags the probe;
 // - once the probe rests, the force the page holds is the force
 //   Interaction::force() returned at that HIP (the device thread's last
-//   call, 1e-9 relative), the force the page prints is it to its 3
-//   decimals, and the HIP is the target the drag sent;
+//   call, 1e-9 relative) and the trilinear blend of the 8 corner states
+//   computed here (1e-9 relative), the force the page prints is it to its
+//   3 decimals, and the HIP is the target the drag sent;
 // - the cloud around the probe is computed (it followed the probe), and the
 //   engine's load is shown;
 // - the m key's prompt changes Young's modulus on the fly to twice its
@@ -21,7 +22,10 @@
 
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -59,6 +63,45 @@ namespace
   {
     return {{v.at(first), v.at(first + 1), v.at(first + 2)}};
   }
+
+  /** The force at @p x blended from the states at the 8 corners of its
+   * grid cell, with trilinear weights computed here (not by palpate's
+   * interpolation): false if a corner is not computed. */
+  bool
+  blend_corners(const palpate::Interaction       &interaction,
+                const palpate::Utilities::Point3 &x,
+                palpate::Utilities::Point3       &f)
+  {
+    const auto        &grid = interaction.grid();
+    const double       h    = grid.spacing();
+    palpate::GridIndex lower;
+    double             t[3];
+    for (unsigned int k = 0; k < 3; ++k)
+      {
+        lower[k] = static_cast<int>(std::floor(x[k] / h));
+        t[k]     = x[k] / h - lower[k];
+      }
+    f = {{0, 0, 0}};
+    for (unsigned int c = 0; c < 8; ++c)
+      {
+        palpate::GridIndex g = lower;
+        double             w = 1;
+        for (unsigned int k = 0; k < 3; ++k)
+          {
+            const bool up = (c >> k) & 1;
+            g[k] += up;
+            w *= up ? t[k] : 1 - t[k];
+          }
+        if (!grid.contains(g))
+          return false;
+        const auto state = interaction.cache().state(grid.linear(g));
+        if (!state || !state->converged)
+          return false;
+        for (unsigned int k = 0; k < 3; ++k)
+          f[k] += w * state->force[k];
+      }
+    return true;
+  }
 } // namespace
 
 int
@@ -88,6 +131,8 @@ main(int argc, char **argv)
   std::map<std::string, std::string> seen;
   std::string                        log;
   palpate::Utilities::Point3         api_hip{{0, 0, 0}}, api_force{{0, 0, 0}};
+  palpate::Utilities::Point3         blended{{0, 0, 0}};
+  bool                               have_blend = false;
   char                               buffer[4096];
   while (std::fgets(buffer, sizeof buffer, browser) != nullptr)
     {
@@ -99,7 +144,10 @@ main(int argc, char **argv)
       const auto key   = line.substr(0, space);
       seen[key] = space == std::string::npos ? "" : line.substr(space + 1);
       if (key == "TARGET")
-        server.last(api_hip, api_force);
+        {
+          server.last(api_hip, api_force);
+          have_blend = blend_corners(server.interaction(), api_hip, blended);
+        }
     }
   const int status = pclose(browser);
 
@@ -125,17 +173,19 @@ main(int argc, char **argv)
   if (have)
     {
       const double f = palpate::Utilities::norm(api_force);
-      deallog << "the probe rests at the dragged target: "
-              << ok(palpate::Utilities::distance(point(hip), point(target)) <
-                      1e-9 &&
-                    palpate::Utilities::norm(point(target)) > 1e-4)
-              << ", the HIP is the API's: "
-              << ok(palpate::Utilities::distance(point(hip), api_hip) < 1e-12)
-              << ", the force the page holds is the API's there (1e-9): "
-              << ok(f > 1e-3 &&
-                    palpate::Utilities::distance(point(force), api_force) <
-                      1e-9 * f)
-              << std::endl;
+      deallog
+        << "the probe rests at the dragged target: "
+        << ok(palpate::Utilities::distance(point(hip), point(target)) < 1e-9 &&
+              palpate::Utilities::norm(point(target)) > 1e-4)
+        << ", the HIP is the API's: "
+        << ok(palpate::Utilities::distance(point(hip), api_hip) < 1e-12)
+        << ", the force the page holds is the API's there (1e-9): "
+        << ok(f > 1e-3 &&
+              palpate::Utilities::distance(point(force), api_force) < 1e-9 * f)
+        << ", and the blend of its cell's corner states (1e-9): "
+        << ok(have_blend &&
+              palpate::Utilities::distance(point(force), blended) < 1e-9 * f)
+        << std::endl;
       bool printed = text.size() == 4;
       for (unsigned int k = 0; printed && k < 3; ++k)
         printed = std::abs(text[k] - api_force[k]) <= 0.0005 + 1e-12;

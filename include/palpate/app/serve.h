@@ -24,7 +24,8 @@ namespace palpate
    * moves the HIP toward the target at most at Maximum speed and calls
    * Interaction::force() like a real device.
    *
-   * Endpoints: GET / (the page), GET /three.min.js (Debian's libjs-three),
+   * Endpoints: GET / (the page), GET /three.module.js and /three.core.js
+   * (three.js from npm, built in: live_view_assets.cc),
    * GET /mesh (the surface: rest positions, triangles, fixed and active
    * nodes, the state space's extent, the engine), GET /frame (HIP, target,
    * force, the surface's displacement, the cloud around the HIP with each
