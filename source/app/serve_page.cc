@@ -71,8 +71,12 @@ light.position.set(1, 2, 3);
 scene.add(light);
 let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1, cloudPoints = null;
 // Cloud point colours by status: not computed, computed, failure point,
-// being computed.
-const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2], [1.0, 0.85, 0.2]];
+// being computed, given in sRGB as the hex colours are. Vertex colours
+// are linear: converted.
+const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2], [1.0, 0.85, 0.2]].map(c => {
+  const linear = new THREE.Color().setRGB(c[0], c[1], c[2], THREE.SRGBColorSpace);
+  return [linear.r, linear.g, linear.b];
+});
 
 // A request to the server: its answer as text, or (logged) why there is
 // none; never an unhandled rejection.
@@ -123,6 +127,10 @@ function start(m) {
   cloudPoints.frustumCulled = false;  // its points change every frame
   scene.add(cloudPoints);
   arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.01, 0x40ff80);
+  // Drawn over the organ: the force often points into it, behind its
+  // surface as the camera sees it.
+  for (const part of [arrow.line, arrow.cone]) part.material.depthTest = false;
+  arrow.renderOrder = 1;
   scene.add(arrow);
   geometry.computeBoundingSphere();
   const c = geometry.boundingSphere.center, r = geometry.boundingSphere.radius;
