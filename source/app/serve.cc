@@ -15,6 +15,7 @@
 #include <palpate/state_space/state_grid.h>
 
 #include <httplib.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -186,15 +187,18 @@ namespace palpate
           "tree and builds it in");
     }
 
-    /** The device: at the loop rate, move the HIP toward the target at
-     * most at max_speed, and ask the interaction for the force. */
+    /** The device: at the loop rate, move the HIP toward the target as a
+     * hand moves a device, at most at max_speed and speeding up and
+     * slowing down at most at max_acceleration (the mouse's jumps
+     * smoothed: the velocity the scheduler looks ahead with has no jumps),
+     * stopping on the target; and ask the interaction for the force. */
     void
     run_device()
     {
       const auto period = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / rate));
-      const double      step = max_speed / rate;
-      Utilities::Point3 x{{0, 0, 0}};
+      const double      dt = 1.0 / rate, dv_max = max_acceleration * dt;
+      Utilities::Point3 x{{0, 0, 0}}, v{{0, 0, 0}};
       auto              next = Clock::now();
       while (running.load())
         {
@@ -206,9 +210,29 @@ namespace palpate
           for (unsigned int k = 0; k < 3; ++k)
             d[k] = target[k].load() - x[k];
           const double n = Utilities::norm(d);
-          const double s = n > step ? step / n : 1.0;
+          // Toward the target at the speed from which it can still stop
+          // there (at most max_speed); the velocity changes by at most
+          // dv_max per tick.
+          const double reach =
+            std::min(max_speed, std::sqrt(2 * max_acceleration * n));
+          Utilities::Point3 dv;
           for (unsigned int k = 0; k < 3; ++k)
-            x[k] += s * d[k];
+            dv[k] = (n > 0 ? reach * d[k] / n : 0.0) - v[k];
+          const double change = Utilities::norm(dv);
+          for (unsigned int k = 0; k < 3; ++k)
+            v[k] += change > dv_max ? dv[k] * dv_max / change : dv[k];
+          if (Utilities::norm(v) * dt >= n)
+            {
+              // Within this tick's step: on the target, at rest.
+              for (unsigned int k = 0; k < 3; ++k)
+                {
+                  x[k] += d[k];
+                  v[k] = 0;
+                }
+            }
+          else
+            for (unsigned int k = 0; k < 3; ++k)
+              x[k] += v[k] * dt;
           Utilities::Point3 f;
           {
             // Held while the parameters change (the interaction is
@@ -315,8 +339,11 @@ namespace palpate
       return s.str();
     }
 
-    Interaction                              interaction;
-    const double                             max_speed, rate;
+    Interaction  interaction;
+    const double max_speed, rate;
+    /** How fast the device speeds up and slows down (m/s^2): from rest to
+     * 5 cm/s in 50 ms, a stop from it within 1.25 mm. */
+    static constexpr double                  max_acceleration = 1.0;
     std::vector<unsigned int>                surface;
     std::vector<std::array<unsigned int, 3>> triangles, dofs;
     std::string                              mesh_json;
@@ -647,10 +674,21 @@ namespace palpate
             const int          port)
   {
     LiveServer server(scene, host, port);
-    out << "Live view: open http://" << host << ":" << server.port()
-        << "/ in a browser. Drag with the mouse to move the probe in the "
-           "view plane, the wheel moves it in depth; keys: a attach, d "
-           "detach, r back to rest. Ctrl-C ends.\n"
+    // Listening on every interface: the address to open is this machine's.
+    std::string where = host;
+    if (host == "0.0.0.0" || host == "::")
+      {
+        char name[256] = {};
+        where = gethostname(name, sizeof name - 1) == 0 && name[0] != 0 ?
+                  std::string(name) :
+                  "THIS-MACHINE";
+      }
+    out << "Live view: open http://" << where << ":" << server.port() << "/"
+        << (where != host ? " (listening on every interface)" : "")
+        << " in a browser. Drag with the mouse to move the probe in the "
+           "view plane, the wheel (or a drag with Alt held) moves it in "
+           "depth; keys: a attach, d detach, r back to rest, m a material "
+           "constant, shift-click another active node. Ctrl-C ends.\n"
         << std::flush;
     stop_serving.store(false);
     auto *const previous_int  = std::signal(SIGINT, on_stop);

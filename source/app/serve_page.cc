@@ -34,7 +34,7 @@ namespace palpate
   <span id="warn"></span><br>
   <span id="message"></span><br>
   <div id="events"></div>
-  drag: move the probe &middot; wheel: depth &middot; a/d: attach/detach &middot; r: rest<br>
+  drag: move the probe &middot; wheel or alt-drag: depth &middot; a/d: attach/detach &middot; r: rest<br>
   m: change a material constant &middot; shift-click: another active node
 </div>
 <canvas id="plot" width="320" height="100"></canvas>
@@ -301,9 +301,12 @@ renderer.domElement.addEventListener("pointerdown", e => {
 });
 renderer.domElement.addEventListener("pointerup", () => { dragging = false; });
 renderer.domElement.addEventListener("pointercancel", () => { dragging = false; });
+// With Alt held (a touch screen or a touchpad without a wheel), a drag up
+// moves the probe away from the viewer, down toward.
 renderer.domElement.addEventListener("pointermove", e => {
   if (!dragging) return;
-  move(e.clientX - last[0], e.clientY - last[1], 0);
+  if (e.altKey) move(0, 0, e.clientY - last[1]);
+  else move(e.clientX - last[0], e.clientY - last[1], 0);
   last = [e.clientX, e.clientY];
 });
 renderer.domElement.addEventListener("wheel", e => { e.preventDefault(); move(0, 0, 0.2 * e.deltaY); },

@@ -7,7 +7,8 @@
 //   the core the revision source/app/web/package.json pins); the surface
 //   has the
 //   mesh's surface vertices, the fixed and active nodes;
-// - a target sent with POST /hip is reached by the device thread, and the
+// - a target sent with POST /hip is reached by the device thread, smoothly
+//   (from rest at most at 1 m/s^2) and at most at 5 cm/s, and the
 //   force /frame shows equals the state's force at that grid point (the
 //   interpolation's exact value there, 1e-9 relative);
 // - the shape /frame shows is that state's displacement;
@@ -106,21 +107,41 @@ main(int argc, char **argv)
   const auto                &grid   = server.interaction().grid();
   const auto                 point  = grid.linear({{0, 0, -1}});
   const auto                 target = grid.position(point);
-  const auto                 sent   = client.Post("/hip",
+  palpate::Utilities::Point3 hip, force;
+  server.last(hip, force);
+  const auto from    = hip;
+  const auto sent_at = std::chrono::steady_clock::now();
+  const auto sent    = client.Post("/hip",
                                 palpate::Utilities::to_string(target, 17),
                                 "text/plain");
-  palpate::Utilities::Point3 hip, force;
+  // The motion, sampled: smooth (from rest, at most 1 m/s^2: within t of
+  // sending, at most a t^2 / 2, with 2 ms for the request and 20 um to
+  // spare; without the smoothing 5 cm/s at once) and at most 5 cm/s.
+  bool smooth = true, limited = true;
+  auto previous = std::make_pair(sent_at, from);
   for (unsigned int k = 0; k < 200; ++k)
     {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
       server.last(hip, force);
+      const auto   now = std::chrono::steady_clock::now();
+      const double t   = std::chrono::duration<double>(now - sent_at).count();
+      const double dt =
+        std::chrono::duration<double>(now - previous.first).count();
+      if (t < 0.03)
+        smooth = smooth && palpate::Utilities::distance(hip, from) <=
+                             0.5 * 1.0 * (t + 0.002) * (t + 0.002) + 2e-5;
+      limited = limited && palpate::Utilities::distance(hip, previous.second) <=
+                             0.05 * (dt + 0.002) + 1e-9;
+      previous = {now, hip};
       if (palpate::Utilities::distance(hip, target) < 1e-12 && k > 50)
         break;
     }
   const auto frame = client.Get("/frame");
   const auto shown = numbers(frame->body, "force");
   const auto state = server.interaction().cache().state(point);
-  deallog << "target sent: " << ok(sent && sent->status == 200) << ", reached: "
+  deallog << "target sent: " << ok(sent && sent->status == 200)
+          << ", the probe moves smoothly: " << ok(smooth)
+          << ", at most 5 cm/s: " << ok(limited) << ", reached: "
           << ok(palpate::Utilities::distance(hip, target) < 1e-12)
           << ", force shown = the state's force (1e-9): "
           << ok(state && shown.size() == 3 &&

@@ -129,6 +129,23 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await until(() => window.palpate.frame.attached, 10000);
   out("DETACH_ATTACH", "yes");
 
+  // A drag down with Alt held moves the probe toward the viewer (the
+  // camera's back axis, about +z here), not in the view plane.
+  const t0 = await page.evaluate(() => window.palpate.target.slice());
+  await page.keyboard.down("Alt");
+  await page.mouse.move(480, 320);
+  await page.mouse.down();
+  for (let i = 1; i <= 10; ++i) {
+    await page.mouse.move(480, 320 + Math.round(pixels * i / 10));
+    await sleep(20);
+  }
+  await page.mouse.up();
+  await page.keyboard.up("Alt");
+  const t1 = await page.evaluate(() => window.palpate.target.slice());
+  const moved = t1.map((x, k) => x - t0[k]);
+  out("DEPTH", moved[2] > 0.8 * Math.hypot(...moved) && Math.hypot(...moved) > 0.2 * m.extent ? "yes" : "no",
+      ...moved.map(x => x.toPrecision(6)));
+
   // r: back to rest; then shift-click on the surface where a vertex far
   // from the active node shows (the ray through that pixel must hit the
   // surface there): another active node.

@@ -21,7 +21,9 @@ namespace palpate
    * organ deforming, the HIP and the force (three.js), and takes the
    * mouse as a 3-DOF device. The page polls the state at about 30 Hz; its
    * mouse positions are targets: a device thread at the scene's loop rate
-   * moves the HIP toward the target at most at Maximum speed and calls
+   * moves the HIP toward the target as a hand moves a device, at most at
+   * @p max_speed and with at most 1 m/s^2 of acceleration (smooth: the
+   * mouse's jumps become bounded accelerations), and calls
    * Interaction::force() like a real device.
    *
    * Endpoints: GET / (the page), GET /three.module.js and /three.core.js
