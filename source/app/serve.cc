@@ -174,7 +174,24 @@ namespace palpate
         << ",\"extent\":" << grid.spacing() * grid.half_width()
         << ",\"diameter\":" << mesh.diameter()
         << ",\"scene\":" << json_string(interaction.scene().file())
-        << ",\"engine\":" << json_string(interaction.summary().engine) << "}";
+        << ",\"engine\":" << json_string(interaction.summary().engine);
+      // The material's constants as the scene set them, for the m key's
+      // prompt.
+      const auto &material = interaction.scene().parameters.material_model;
+      m << ",\"material\":{\"model\":" << json_string(material.model_name)
+        << ",\"constants\":{";
+      const auto found = material.models.find(material.model_name);
+      if (found != material.models.end())
+        {
+          bool first = true;
+          for (const auto &[entry, value] : found->second)
+            {
+              m << (first ? "" : ",") << json_string(entry) << ":"
+                << json_string(value);
+              first = false;
+            }
+        }
+      m << "}}}";
       mesh_json = m.str();
       displacement.assign(3 * surface.size(), 0.0);
 

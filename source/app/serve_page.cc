@@ -328,7 +328,13 @@ renderer.domElement.addEventListener("click", e => {
 window.addEventListener("keydown", e => {
   if (e.key === "m") {
     // The paper's on-the-fly parameter change: a constant of the material.
-    const change = window.prompt("Material constant (ENTRY=VALUE), e.g. Young's modulus=20000");
+    // The scene's constants as the example (the server answers with the
+    // current state of things).
+    const mat = state.mesh ? state.mesh.material : { model: "?", constants: {} };
+    const example = Object.entries(mat.constants).map(([k, v]) => k + "=" + v).join(", ");
+    const change = window.prompt("A constant of " + mat.model + " as ENTRY=VALUE (the scene's: " +
+                                 example + ")", Object.keys(mat.constants).length ?
+                                 Object.entries(mat.constants)[0].join("=") : "");
     if (change) post("/material", change)
       .then(t => { document.getElementById("message").textContent = t; });
   }

@@ -9,6 +9,7 @@
 
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 namespace palpate
 {
@@ -380,9 +381,16 @@ namespace palpate
       auto &entries = models[model];
       if (entries.empty())
         entries = Plugins::declared_entries(plugin->declare_parameters);
-      AssertThrow(entries.count(entry) == 1,
-                  ExcMessage("material model " + model + " has no entry " +
-                             entry));
+      if (entries.count(entry) != 1)
+        {
+          // Said to a person (palpate serve's m key): which entries there are.
+          std::string names;
+          for (const auto &[name, v] : entries)
+            names += (names.empty() ? "" : ", ") + name;
+          throw std::invalid_argument("material model " + model +
+                                      " has no entry '" + entry +
+                                      "'; its entries are: " + names);
+        }
       entries[entry] = value;
     }
 

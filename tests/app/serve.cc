@@ -18,6 +18,7 @@
 //   the states be computed again: St.Venant-Kirchhoff's force at a fixed
 //   displacement is proportional to E, so it doubles (1e-6); a constant
 //   that describes no solid is refused with the reason, the old one kept;
+//   an entry the model does not have is refused, naming those it has;
 // - another active node can be picked; the frame names it; a point far off
 //   the organ is refused;
 // - attach, detach and changes sent at once from several clients take
@@ -180,6 +181,8 @@ main(int argc, char **argv)
     client.Post("/material", "Young's modulus=2e5", "text/plain");
   const auto refused =
     client.Post("/material", "Young's modulus=-1", "text/plain");
+  const auto unknown =
+    client.Post("/material", "Youngs modulus=3", "text/plain");
   client.Post("/hip", palpate::Utilities::to_string(target, 17), "text/plain");
   std::shared_ptr<const palpate::State> again;
   for (unsigned int k = 0; k < 1200 && !again; ++k)
@@ -196,6 +199,10 @@ main(int argc, char **argv)
           << "; a negative modulus refused: "
           << ok(refused && refused->status == 400 &&
                 refused->body.rfind("refused", 0) == 0)
+          << ", an entry the model does not have refused with its entries: "
+          << ok(unknown && unknown->status == 400 &&
+                unknown->body.find("its entries are: Poisson's ratio, "
+                                   "Young's modulus") != std::string::npos)
           << std::endl;
   const auto picked = client.Post("/active", "0.1,0.01,0.01", "text/plain");
   const auto last   = client.Get("/frame");

@@ -34,7 +34,8 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   const errors = [];
   page.on("pageerror", e => errors.push(e.message));
   page.on("console", m => { if (m.type() === "error") errors.push(m.text()); });
-  page.on("dialog", d => d.accept("Young's modulus=2e5"));
+  let promptText = "";
+  page.on("dialog", d => { promptText = d.message(); d.accept("Young's modulus=2e5"); });
 
   // Wait until fn() (run in the page) is true, at most ms.
   // If not, say what the page showed then.
@@ -114,6 +115,7 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await page.keyboard.press("m");
   await until(() => document.getElementById("message").textContent !== "", 10000);
   out("MATERIAL_TEXT", await page.evaluate(() => document.getElementById("message").textContent));
+  out("PROMPT", promptText);
   const f0 = shown.frame.force;
   await until(f => {
     const g = window.palpate.frame.force;

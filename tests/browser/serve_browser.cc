@@ -211,6 +211,11 @@ main(int argc, char **argv)
           << std::endl;
 
   const auto after = numbers_in(value("FORCE_AFTER_MATERIAL"));
+  deallog << "m's prompt names the model and its constants: "
+          << ok(value("PROMPT").find("St.Venant-Kirchhoff") !=
+                  std::string::npos &&
+                value("PROMPT").find("Young's modulus=") != std::string::npos)
+          << std::endl;
   deallog << "m changed Young's modulus: "
           << ok(value("MATERIAL_TEXT").find("Young's modulus") !=
                   std::string::npos &&
