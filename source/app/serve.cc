@@ -175,23 +175,7 @@ namespace palpate
         << ",\"diameter\":" << mesh.diameter()
         << ",\"scene\":" << json_string(interaction.scene().file())
         << ",\"engine\":" << json_string(interaction.summary().engine);
-      // The material's constants as the scene set them, for the m key's
-      // prompt.
-      const auto &material = interaction.scene().parameters.material_model;
-      m << ",\"material\":{\"model\":" << json_string(material.model_name)
-        << ",\"constants\":{";
-      const auto found = material.models.find(material.model_name);
-      if (found != material.models.end())
-        {
-          bool first = true;
-          for (const auto &[entry, value] : found->second)
-            {
-              m << (first ? "" : ",") << json_string(entry) << ":"
-                << json_string(value);
-              first = false;
-            }
-        }
-      m << "}}}";
+      m << "}";
       mesh_json = m.str();
       displacement.assign(3 * surface.size(), 0.0);
 
@@ -214,16 +198,20 @@ namespace palpate
     {
       const auto period = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / rate));
-      const double      dt = 1.0 / rate, dv_max = max_acceleration * dt;
-      Utilities::Point3 x{{0, 0, 0}}, v{{0, 0, 0}};
-      auto              next = Clock::now();
+      const double dt = 1.0 / rate, dv_max = max_acceleration * dt;
+      auto         next = Clock::now();
       while (running.load())
         {
           // After a stall (a parameter change holds the device), on from
           // now: no burst of steps that would outrun the speed limit.
           next = std::max(next + period, Clock::now());
           std::this_thread::sleep_until(next);
-          Utilities::Point3 d;
+          // Held while the parameters change (the interaction is detached
+          // and its scene replaced then, and another active node starts
+          // at rest).
+          std::lock_guard<std::mutex> lock(device_mutex);
+          auto                       &x = device_position, &v = device_velocity;
+          Utilities::Point3           d;
           for (unsigned int k = 0; k < 3; ++k)
             d[k] = target[k].load() - x[k];
           const double n = Utilities::norm(d);
@@ -238,9 +226,17 @@ namespace palpate
           const double change = Utilities::norm(dv);
           for (unsigned int k = 0; k < 3; ++k)
             v[k] += change > dv_max ? dv[k] * dv_max / change : dv[k];
-          if (Utilities::norm(v) * dt >= n)
+          // Within this tick's step, slow (as the approach leaves it: at
+          // most 2 mm/s at 1 kHz) and heading for it: on the target, at
+          // rest. Moving away or fast, as when the target came back toward
+          // the probe, it brakes at max_acceleration instead.
+          const double speed   = Utilities::norm(v);
+          double       heading = 0;
+          for (unsigned int k = 0; k < 3; ++k)
+            heading += v[k] * d[k];
+          if (speed * dt >= n && speed <= 2 * dv_max * (1 + 1e-9) &&
+              (n == 0 || heading > 0))
             {
-              // Within this tick's step: on the target, at rest.
               for (unsigned int k = 0; k < 3; ++k)
                 {
                   x[k] += d[k];
@@ -250,13 +246,7 @@ namespace palpate
           else
             for (unsigned int k = 0; k < 3; ++k)
               x[k] += v[k] * dt;
-          Utilities::Point3 f;
-          {
-            // Held while the parameters change (the interaction is
-            // detached and its scene replaced then).
-            std::lock_guard<std::mutex> lock(device_mutex);
-            f = interaction.force(x);
-          }
+          const Utilities::Point3 f = interaction.force(x);
           for (unsigned int k = 0; k < 3; ++k)
             {
               hip[k].store(x[k]);
@@ -366,7 +356,9 @@ namespace palpate
     std::string                              mesh_json;
     std::vector<double>                      displacement;
     std::atomic<double>                      target[3], hip[3], force[3];
-    std::atomic<std::uint8_t>                cause{0};
+    // The device's HIP and velocity (device_mutex).
+    Utilities::Point3 device_position{{0, 0, 0}}, device_velocity{{0, 0, 0}};
+    std::atomic<std::uint8_t> cause{0};
     // The engine's counters at the last load sample (frame()).
     struct
     {
@@ -384,8 +376,34 @@ namespace palpate
     /** Change the scene's parameters on the fly: detach, change (the
      * cache is invalidated and the states are computed again), attach.
      * Returns "" or the reason the change was refused. */
+    /** The material model and its constants as they are now (the m key's
+     * prompt). */
     std::string
-    change(const std::function<void(Parameters::AllParameters &)> &edit)
+    material_json()
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      const auto &material = interaction.scene().parameters.material_model;
+      std::ostringstream m;
+      m << "{\"model\":" << json_string(material.model_name)
+        << ",\"constants\":{";
+      const auto found = material.models.find(material.model_name);
+      if (found != material.models.end())
+        {
+          bool first = true;
+          for (const auto &[entry, value] : found->second)
+            {
+              m << (first ? "" : ",") << json_string(entry) << ":"
+                << json_string(value);
+              first = false;
+            }
+        }
+      m << "}}";
+      return m.str();
+    }
+
+    std::string
+    change(const std::function<void(Parameters::AllParameters &)> &edit,
+           const bool                                              rest = false)
     {
       // One change, attach or detach at a time (the HTTP pool has 8
       // threads); the device runs on while detaching (the force fades).
@@ -398,6 +416,15 @@ namespace palpate
         {
           std::lock_guard<std::mutex> lock(device_mutex), frame_lock(mutex);
           interaction.change_parameters(p);
+          // Another active node: the device at rest on it (a target sent
+          // meanwhile was for the old one).
+          if (rest)
+            {
+              for (auto &t : target)
+                t.store(0);
+              device_position = {{0, 0, 0}};
+              device_velocity = {{0, 0, 0}};
+            }
         }
       catch (const InputError &e)
         {
@@ -446,6 +473,10 @@ namespace palpate
     server.Get("/mesh", [&s](const httplib::Request &, httplib::Response &res) {
       res.set_content(s.mesh_json, "application/json");
     });
+    server.Get("/material",
+               [&s](const httplib::Request &, httplib::Response &res) {
+                 res.set_content(s.material_json(), "application/json");
+               });
     server.Get("/frame",
                [&s](const httplib::Request &, httplib::Response &res) {
                  res.set_content(s.frame(), "application/json");
@@ -537,13 +568,13 @@ namespace palpate
                     Utilities::to_string(high, 6) + " m along axis " +
                     std::to_string(k) + ")");
               }
-            for (auto &t : s.target) // the new node, at rest
-              t.store(0);
-            refused = s.change([&](Parameters::AllParameters &p) {
-              p.boundary_conditions.active_node.selection =
-                "nearest surface node";
-              p.boundary_conditions.active_node.point = point;
-            });
+            refused = s.change(
+              [&](Parameters::AllParameters &p) {
+                p.boundary_conditions.active_node.selection =
+                  "nearest surface node";
+                p.boundary_conditions.active_node.point = point;
+              },
+              true);
           }
         catch (const std::exception &e)
           {

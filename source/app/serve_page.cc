@@ -34,8 +34,8 @@ namespace palpate
   <span id="warn"></span><br>
   <span id="message"></span><br>
   <div id="events"></div>
-  drag: move the probe &middot; wheel or alt-drag: depth &middot; a/d: attach/detach &middot; r: rest<br>
-  m: change a material constant &middot; shift-click: another active node
+  drag: move the probe &middot; depth: wheel, alt-drag or <button id="depth">drag in depth: off</button> (z)<br>
+  a/d: attach/detach &middot; r: rest &middot; m: change a material constant &middot; shift-click: another active node
 </div>
 <canvas id="plot" width="320" height="100"></canvas>
 <script type="module">
@@ -129,8 +129,10 @@ function start(m) {
   arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.01, 0x40ff80);
   // Drawn over the organ: the force often points into it, behind its
   // surface as the camera sees it.
-  for (const part of [arrow.line, arrow.cone]) part.material.depthTest = false;
-  arrow.renderOrder = 1;
+  for (const part of [arrow.line, arrow.cone]) {
+    part.material.depthTest = false;
+    part.renderOrder = 1;
+  }
   scene.add(arrow);
   geometry.computeBoundingSphere();
   const c = geometry.boundingSphere.center, r = geometry.boundingSphere.radius;
@@ -301,11 +303,19 @@ renderer.domElement.addEventListener("pointerdown", e => {
 });
 renderer.domElement.addEventListener("pointerup", () => { dragging = false; });
 renderer.domElement.addEventListener("pointercancel", () => { dragging = false; });
-// With Alt held (a touch screen or a touchpad without a wheel), a drag up
-// moves the probe away from the viewer, down toward.
+// With Alt held (a touchpad without a wheel), a drag up moves the probe
+// away from the viewer, down toward. Desktops that take Alt-drag to move
+// windows, and touch screens, have the button (or z): while it is on,
+// every drag moves in depth.
+let depthDrag = false;
+function toggleDepth() {
+  depthDrag = !depthDrag;
+  document.getElementById("depth").textContent = "drag in depth: " + (depthDrag ? "on" : "off");
+}
+document.getElementById("depth").addEventListener("click", toggleDepth);
 renderer.domElement.addEventListener("pointermove", e => {
   if (!dragging) return;
-  if (e.altKey) move(0, 0, e.clientY - last[1]);
+  if (e.altKey || depthDrag) move(0, 0, e.clientY - last[1]);
   else move(e.clientX - last[0], e.clientY - last[1], 0);
   last = [e.clientX, e.clientY];
 });
@@ -328,20 +338,20 @@ renderer.domElement.addEventListener("click", e => {
 window.addEventListener("keydown", e => {
   if (e.key === "m") {
     // The paper's on-the-fly parameter change: a constant of the material.
-    // The scene's constants as the example (the server answers with the
-    // current state of things).
-    const mat = state.mesh ? state.mesh.material : { model: "?", constants: {} };
-    const example = Object.entries(mat.constants).map(([k, v]) => k + "=" + v).join(", ");
-    const change = window.prompt("A constant of " + mat.model + " as ENTRY=VALUE (the scene's: " +
-                                 example + ")", Object.keys(mat.constants).length ?
-                                 Object.entries(mat.constants)[0].join("=") : "");
-    if (change) post("/material", change)
-      .then(t => { document.getElementById("message").textContent = t; });
+    // The model's constants as they are now, as the example.
+    fetch("/material").then(r => r.json()).then(mat => {
+      const now = Object.entries(mat.constants).map(([k, v]) => k + "=" + v);
+      const change = window.prompt("A constant of " + mat.model + " as ENTRY=VALUE (now: " +
+                                   now.join(", ") + ")", now.length ? now[0] : "");
+      if (change) post("/material", change)
+        .then(t => { document.getElementById("message").textContent = t; });
+    }).catch(e => logEvent("the material's constants did not come (" + e.message + ")"));
   }
   if (e.key === "a") post("/attach");
   if (e.key === "d") post("/detach");
   // Rest: the target goes after any sent before it.
   if (e.key === "r") { state.target = [0, 0, 0]; sendTarget(); }
+  if (e.key === "z") toggleDepth();
 });
 window.addEventListener("resize", () => {
   camera.aspect = window.innerWidth / window.innerHeight;

@@ -317,6 +317,10 @@ namespace palpate
           break;
         case Kind::dropped:
           holders[h.point] &= ~bit(from);
+          // No server holds it any more: unless this process does, it is
+          // gone (a store waiting for it stops waiting).
+          if (holders[h.point] == 0)
+            cache.mark_dropped(h.point);
           break;
         case Kind::result:
           {

@@ -512,6 +512,16 @@ namespace palpate
 
 
   void
+  StateCache::mark_dropped(const unsigned int point)
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!states[point])
+      entries[point].dropped.store(true, std::memory_order_relaxed);
+  }
+
+
+
+  void
   StateCache::set_focus(const Utilities::Point3 &hip)
   {
     std::lock_guard<std::mutex> lock(mutex);

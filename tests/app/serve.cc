@@ -117,12 +117,15 @@ main(int argc, char **argv)
                                 "text/plain");
   // The motion, sampled: smooth (from rest, at most 1 m/s^2: within t of
   // sending, at most a t^2 / 2, with 2 ms for the request and 20 um to
-  // spare; without the smoothing 5 cm/s at once) and at most 5 cm/s.
+  // spare; without the smoothing 5 cm/s at once) and at most 5 cm/s. Each
+  // sample is taken between two clock readings: the bounds use the widest
+  // interval it can stand for, so a preempted test thread cannot fail it.
   bool smooth = true, limited = true;
   auto previous = std::make_pair(sent_at, from);
   for (unsigned int k = 0; k < 200; ++k)
     {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      const auto before = std::chrono::steady_clock::now();
       server.last(hip, force);
       const auto   now = std::chrono::steady_clock::now();
       const double t   = std::chrono::duration<double>(now - sent_at).count();
@@ -133,7 +136,7 @@ main(int argc, char **argv)
                              0.5 * 1.0 * (t + 0.002) * (t + 0.002) + 2e-5;
       limited = limited && palpate::Utilities::distance(hip, previous.second) <=
                              0.05 * (dt + 0.002) + 1e-9;
-      previous = {now, hip};
+      previous = {before, hip};
       if (palpate::Utilities::distance(hip, target) < 1e-12 && k > 50)
         break;
     }

@@ -147,6 +147,23 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   const moved = t1.map((x, k) => x - t0[k]);
   out("DEPTH", moved[2] > 0.8 * Math.hypot(...moved) && Math.hypot(...moved) > 0.2 * m.extent ? "yes" : "no",
       ...moved.map(x => x.toPrecision(6)));
+  // The same with the page's depth button (touch screens, desktops that
+  // take Alt-drag): a drag up, away from the viewer.
+  await page.click("#depth");
+  const t2 = await page.evaluate(() => window.palpate.target.slice());
+  await page.mouse.move(480, 320);
+  await page.mouse.down();
+  for (let i = 1; i <= 10; ++i) {
+    await page.mouse.move(480, 320 - Math.round(pixels * i / 10));
+    await sleep(20);
+  }
+  await page.mouse.up();
+  await page.click("#depth");
+  const t3 = await page.evaluate(() => window.palpate.target.slice());
+  const away = t3.map((x, k) => x - t2[k]);
+  out("DEPTH_BUTTON", -away[2] > 0.8 * Math.hypot(...away) && Math.hypot(...away) > 0.2 * m.extent ? "yes" : "no",
+      ...away.map(x => x.toPrecision(6)),
+      await page.evaluate(() => document.getElementById("depth").textContent));
 
   // r: back to rest; then shift-click on the surface where a vertex far
   // from the active node shows (the ray through that pixel must hit the

@@ -15,8 +15,9 @@
 //   engine's load is shown;
 // - the m key's prompt changes Young's modulus on the fly to twice its
 //   value: the force at the same HIP doubles (St.Venant-Kirchhoff, 1e-6);
-// - d and a detach and attach; a drag with Alt held moves the probe in
-//   depth; shift-click picks another active node;
+// - d and a detach and attach; a drag with Alt held, or with the page's
+//   depth button on, moves the probe in depth; shift-click picks another
+//   active node;
 // - a reloaded page (a client that leaves and comes back) is served;
 // - the view is drawn (more than 5 % of its pixels are not background) and
 //   a screenshot is kept: PALPATE_ARTEFACT_DIR/live-view.png.
@@ -232,6 +233,10 @@ main(int argc, char **argv)
           << ok(value("DETACH_ATTACH") == "yes")
           << ", a drag with Alt moved the probe in depth: "
           << ok(value("DEPTH").rfind("yes", 0) == 0)
+          << ", and with the depth button: "
+          << ok(value("DEPTH_BUTTON").rfind("yes", 0) == 0 &&
+                value("DEPTH_BUTTON").find("drag in depth: off") !=
+                  std::string::npos)
           << ", shift-click picked another active node: "
           << ok(active.size() >= 2 && active[0] != active[1] && active[1] >= 0)
           << ", a reloaded page is served: "

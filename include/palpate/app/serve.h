@@ -33,7 +33,9 @@ namespace palpate
    * force, the surface's displacement, the cloud around the HIP with each
    * point's status: not computed, computed, failed, being computed; the
    * engine's load; the missing-data cause),
+   * GET /material (the model and its constants now),
    * POST /hip with "x,y,z" (the target displacement from rest, m),
+   * POST /material with "ENTRY=VALUE", POST /active with "x,y,z" (m),
    * POST /attach, /detach, /reset.
    */
   class LiveServer

@@ -179,6 +179,11 @@ namespace palpate
     bool
     dropped(const unsigned int point) const;
 
+    /** Record that the whole state at @p point, held elsewhere (an MPI
+     * server), was dropped there: unless it is held here, dropped(). */
+    void
+    mark_dropped(const unsigned int point);
+
   private:
     struct Entry;
 
