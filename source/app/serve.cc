@@ -22,7 +22,6 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
