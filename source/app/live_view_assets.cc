@@ -45,6 +45,17 @@ namespace palpate
 {
   namespace live_view_assets
   {
+#ifdef PALPATE_THREE_DIR
+    namespace
+    {
+      std::string_view
+      between(const char *begin, const char *end)
+      {
+        return {begin, static_cast<std::size_t>(end - begin)};
+      }
+    } // namespace
+#endif
+
     std::string_view
     three_core();
     std::string_view
@@ -55,9 +66,7 @@ namespace palpate
     three_core()
     {
 #ifdef PALPATE_THREE_DIR
-      return {palpate_three_core_begin,
-              static_cast<std::size_t>(palpate_three_core_end -
-                                       palpate_three_core_begin)};
+      return between(palpate_three_core_begin, palpate_three_core_end);
 #else
       return {};
 #endif
@@ -69,9 +78,7 @@ namespace palpate
     three_module()
     {
 #ifdef PALPATE_THREE_DIR
-      return {palpate_three_module_begin,
-              static_cast<std::size_t>(palpate_three_module_end -
-                                       palpate_three_module_begin)};
+      return between(palpate_three_module_begin, palpate_three_module_end);
 #else
       return {};
 #endif

@@ -549,24 +549,16 @@ namespace palpate
             // A point on the organ: within its bounding box, enlarged by a
             // tenth of its diameter (a huge or NaN point would select no
             // node).
-            const auto  &vertices = s.interaction.mesh().vertices();
-            const double margin   = 0.1 * s.interaction.mesh().diameter();
+            const auto [low, high] = s.interaction.mesh().bounding_box();
+            const double margin    = 0.1 * s.interaction.mesh().diameter();
             for (unsigned int k = 0; k < 3; ++k)
-              {
-                double low = vertices[0][k], high = vertices[0][k];
-                for (const auto &v : vertices)
-                  {
-                    low  = std::min(low, double(v[k]));
-                    high = std::max(high, double(v[k]));
-                  }
-                if (!(point[k] >= low - margin && point[k] <= high + margin))
-                  throw std::invalid_argument(
-                    "the point (" + Utilities::to_string(point, 6) +
-                    ") m is not on the organ (its bounding box is " +
-                    Utilities::to_string(low, 6) + " to " +
-                    Utilities::to_string(high, 6) + " m along axis " +
-                    std::to_string(k) + ")");
-              }
+              if (!(point[k] >= low[k] - margin &&
+                    point[k] <= high[k] + margin))
+                throw std::invalid_argument(
+                  "the point (" + Utilities::to_string(point, 6) +
+                  ") m is not on the organ (its bounding box is (" +
+                  Utilities::to_string(low, 6) + ") to (" +
+                  Utilities::to_string(high, 6) + ") m)");
             refused = s.change(
               [&](Parameters::AllParameters &p) {
                 p.boundary_conditions.active_node.selection =

@@ -106,10 +106,9 @@ namespace palpate
     std::vector<std::uint8_t> in_progress;
     unsigned int              busy            = 0;
     bool                      nothing_to_plan = false;
-    // The solves running now: how many, and the sum of their start times
-    // (now()), for the time spent on them so far (load()).
-    unsigned int running       = 0;
-    double       running_since = 0;
+    // The sum of the running solves' start times (now()): with busy, the
+    // time spent on them so far (load()).
+    double running_since = 0;
     // Tasks finished so far, and how many had finished when the last plan
     // was made: the engine is idle only if that plan saw all of them.
     std::uint64_t finished = 0, finished_at_plan = 0;
@@ -240,6 +239,7 @@ namespace palpate
       {
         Task          task;
         std::uint64_t generation;
+        double        start = 0;
         {
           std::unique_lock<std::mutex> lock(mutex);
           work_available.wait(lock,
@@ -255,18 +255,14 @@ namespace palpate
           in_progress[task.target] = 1;
           ++busy;
           generation = cache.generation();
+          start      = now();
+          running_since += start;
         }
 
         // solve() reports numerical failures as failure points; anything
         // else that goes wrong (out of memory, a library error) must not
         // take the process down while a device renders forces: it becomes
         // a failure point too, and is counted and reported.
-        const double start = now();
-        {
-          std::lock_guard<std::mutex> lock(mutex);
-          ++running;
-          running_since += start;
-        }
         State       result;
         bool        solved = false;
         std::string error;
@@ -331,7 +327,6 @@ namespace palpate
           std::lock_guard<std::mutex> lock(mutex);
           in_progress[task.target] = 0;
           --busy;
-          --running;
           running_since -= start;
           ++finished;
           replan = true;
@@ -505,7 +500,7 @@ namespace palpate
     // With the running solves' time so far: a task longer than a live
     // view's sampling interval still shows as busy.
     l.busy_time =
-      s.stats.busy_time + std::max(0.0, s.running * s.now() - s.running_since);
+      s.stats.busy_time + std::max(0.0, s.busy * s.now() - s.running_since);
     for (unsigned int p = 0; p < s.in_progress.size(); ++p)
       if (s.in_progress[p] != 0)
         l.in_progress.push_back(p);
