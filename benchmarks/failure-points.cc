@@ -81,8 +81,11 @@ namespace
     if (c.material == "nh")
       p.material_model.model_name = "Neo-Hookean";
     p.boundary_conditions.active_node.tip_radius = c.tip_mm / 1000;
-    p.nonlinear_solver.reuse_factorization       = false;
-    p.nonlinear_solver.max_increment_length      = 0.01;
+    p.boundary_conditions.active_node.tip =
+      c.tip_mm > 0 ? Parameters::ActiveNode::Tip::glued_nodes :
+                     Parameters::ActiveNode::Tip::point;
+    p.nonlinear_solver.reuse_factorization  = false;
+    p.nonlinear_solver.max_increment_length = 0.01;
     return scene;
   }
 

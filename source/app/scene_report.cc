@@ -113,8 +113,19 @@ namespace palpate
         << 100 * nodes.active_distance / mesh.diameter()
         << " % of its size): is it in the mesh's scaled coordinates (metres, "
            "after Scale factor)? The mesh's bounding box is above.";
-    if (!nodes.tip_vertices.empty() ||
-        p.boundary_conditions.active_node.tip_radius > 0)
+    using Tip = Parameters::ActiveNode::Tip;
+    if (a.tip == Tip::sphere)
+      s << "\n  probe tip:     a rigid sphere of radius " << 1000 * a.tip_radius
+        << " mm in frictionless contact with the surface; at HIP = 0 it "
+           "touches the surface from outside, its centre at ("
+        << Utilities::to_string(nodes.sphere_center, 4) << ") m, normal ("
+        << Utilities::to_string(nodes.active_normal, 3) << ")"
+        << (nodes.sphere_lift > 0 ?
+              ", lifted " + Utilities::to_string(1000 * nodes.sphere_lift, 3) +
+                " mm along the normal so that it presses on no other node "
+                "(the surface is concave there)" :
+              std::string());
+    else if (a.tip == Tip::glued_nodes)
       s << "\n  probe tip:     radius "
         << 1000 * p.boundary_conditions.active_node.tip_radius
         << " mm: " << nodes.tip_vertices.size()
@@ -157,9 +168,11 @@ namespace palpate
         }
     for (const auto &effect : Effect::create_enabled(p.effects))
       on.push_back(effect->description(mesh, p));
-    if (p.boundary_conditions.active_node.tip_radius > 0)
+    if (a.tip == Tip::glued_nodes)
       on.push_back("probe tip (" +
                    std::to_string(1 + nodes.tip_vertices.size()) + " nodes)");
+    if (a.tip == Tip::sphere)
+      on.push_back("contact with a rigid sphere");
     (p.effects.shape_output ? on : off).push_back("shape output");
     (p.effects.vtu_export ? on : off).push_back("VTU export");
     (p.effects.force_log ? on : off).push_back("force log");

@@ -860,8 +860,17 @@ namespace palpate
           std::vector<std::vector<double>> times(variants.size());
           for (unsigned int v = 0; v < variants.size(); ++v)
             {
-              Scene s = variants[v];
-              s.parameters.boundary_conditions.active_node.tip_radius = radius;
+              Scene s           = variants[v];
+              auto &active      = s.parameters.boundary_conditions.active_node;
+              active.tip_radius = radius;
+              // The scene's sphere stays a sphere; otherwise a finite
+              // radius is a glued tip.
+              if (active.tip != Parameters::ActiveNode::Tip::sphere)
+                active.tip = radius > 0 ?
+                               Parameters::ActiveNode::Tip::glued_nodes :
+                               Parameters::ActiveNode::Tip::point;
+              else if (!(radius > 0))
+                active.tip = Parameters::ActiveNode::Tip::point;
               const Body body(s);
               forces.push_back(direct_solves(
                 body,

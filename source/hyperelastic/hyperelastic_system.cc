@@ -25,6 +25,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 
 namespace palpate
@@ -100,6 +101,25 @@ namespace palpate
     void
     subtract_dead_loads(double *f, const Keep &keep) const;
 
+    /**
+     * The contact of the sphere with candidate @p k at unknowns @p x and
+     * HIP displacement @p target: the unit normal n from the sphere's
+     * centre to the node's current position, the distance rho to the
+     * centre, the gap g = rho - R (m), and the contact force's magnitude
+     * lambda_hat = beta max(0, x_lambda - g) (N), which is positive exactly
+     * when the node is in the active set.
+     */
+    struct Contact
+    {
+      Utilities::Point3 n;
+      double            rho, gap, x_lambda, lambda_hat;
+    };
+    Contact
+    contact_at(const unsigned int         k,
+               const std::vector<double> &u,
+               const std::vector<double> &x,
+               const Utilities::Point3   &target) const;
+
     const Mesh                  &mesh;
     NodeSelection                nodes;
     std::unique_ptr<Material>    material;
@@ -127,8 +147,25 @@ namespace palpate
     std::vector<long>   matrix_position;    // [cell * dpc^2 + i * dpc + j]
     std::vector<std::vector<unsigned int>> colors;
 
-    std::vector<int>               eq_of_dof;
-    unsigned int                   n_free = 0, n_active_multipliers = 0;
+    std::vector<int> eq_of_dof;
+    unsigned int     n_free = 0, n_active_multipliers = 0;
+    // Tip = sphere: one multiplier per surface node that the sphere may
+    // touch (the contact candidates), equations n_free ... n_free +
+    // n_contact - 1, before those of multiplier_dof.
+    struct ContactNode
+    {
+      std::array<unsigned int, 3> dof;         // x, y, z DoFs of the node
+      std::array<int, 3>          eq;          // their equations
+      Utilities::Point3           position;    // reference position (m)
+      std::array<long, 3>         position_lu; // CSR entries (lambda, u_a)
+      std::array<long, 3>         position_ul; // (u_a, lambda)
+      std::array<long, 9>         position_uu; // (u_a, u_b)
+      long                        position_ll; // (lambda, lambda)
+    };
+    std::vector<ContactNode>       contact;
+    unsigned int                   n_contact          = 0;
+    double                         sphere_radius      = 0;
+    Utilities::Point3              sphere_rest_center = {{0, 0, 0}};
     std::vector<unsigned int>      multiplier_dof;
     std::vector<long>              position_lambda_u, position_u_lambda;
     std::vector<double>            fixed_value;
@@ -257,6 +294,68 @@ namespace palpate
         fixed.push_back(d);
     fixed_value.assign(n_dofs, 0.0);
 
+    // --- Tip = sphere: the contact candidates are the free surface nodes,
+    // the vertices and (P2) the midpoints of the surface triangles' edges.
+    // All of them, not only those near the probe's rest position: the
+    // probe may go anywhere (palpate solve --to, the live view), a
+    // candidate that is not touched costs one trivial row, and the
+    // residual's loop over them is nothing next to the cells'.
+    const bool sphere = has_active && p.boundary_conditions.active_node.tip ==
+                                        Parameters::ActiveNode::Tip::sphere;
+    if (sphere)
+      {
+        sphere_radius      = p.boundary_conditions.active_node.tip_radius;
+        sphere_rest_center = nodes.sphere_center;
+        std::set<std::pair<unsigned int, unsigned int>> surface_edges;
+        for (const auto &face : mesh.surface_faces())
+          for (unsigned int i = 0; i < 3; ++i)
+            surface_edges.insert(
+              std::minmax(face.vertices[i], face.vertices[(i + 1) % 3]));
+        // Node key: vertex v -> v, edge -> n_vertices + line index.
+        std::map<unsigned int, std::array<unsigned int, 3>> node_dofs;
+        std::map<unsigned int, Utilities::Point3>           node_position;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          {
+            cell->get_dof_indices(dofs);
+            for (unsigned int i = 0; i < first_quad && i < dofs_per_cell; ++i)
+              {
+                const unsigned int component =
+                  fe->system_to_component_index(i).first;
+                if (component >= 3)
+                  continue;
+                unsigned int key;
+                if (i < first_line)
+                  {
+                    key = cell->vertex_index(i / fe->n_dofs_per_vertex());
+                    if (!mesh.on_surface()[key])
+                      continue;
+                  }
+                else
+                  {
+                    const auto line =
+                      cell->line((i - first_line) / fe->n_dofs_per_line());
+                    if (!surface_edges.count(std::minmax(
+                          line->vertex_index(0), line->vertex_index(1))))
+                      continue;
+                    key = mesh.n_vertices() + line->index();
+                  }
+                node_dofs[key][component] = dofs[i];
+                node_position[key]        = dof_position[dofs[i]];
+              }
+          }
+        // A node with some components fixed (a symmetry plane) slides on
+        // its plane and may touch; one fixed entirely cannot move.
+        for (const auto &[key, d] : node_dofs)
+          if (!dof_fixed[d[0]] || !dof_fixed[d[1]] || !dof_fixed[d[2]])
+            {
+              ContactNode c;
+              c.dof      = d;
+              c.position = node_position[key];
+              contact.push_back(c);
+            }
+        n_contact = contact.size();
+      }
+
     // --- Equations: free DoFs first (in DoF order), then multipliers: the
     // active node's three, then the fixed DoFs' if they use multipliers.
     const bool eliminate =
@@ -265,7 +364,9 @@ namespace palpate
     for (unsigned int d = 0; d < n_dofs; ++d)
       if (!(eliminate && dof_fixed[d]))
         eq_of_dof[d] = n_free++;
-    if (has_active)
+    if (sphere)
+      n_active_multipliers = n_contact;
+    else if (has_active)
       {
         multiplier_dof.assign(active.begin(), active.end());
         multiplier_dof.insert(multiplier_dof.end(),
@@ -275,7 +376,10 @@ namespace palpate
       }
     if (!eliminate)
       multiplier_dof.insert(multiplier_dof.end(), fixed.begin(), fixed.end());
-    const unsigned int n_eq = n_free + multiplier_dof.size();
+    for (auto &c : contact)
+      for (unsigned int a = 0; a < 3; ++a)
+        c.eq[a] = eq_of_dof[c.dof[a]];
+    const unsigned int n_eq = n_free + n_contact + multiplier_dof.size();
 
     // --- Geometry, cached once: shape gradients, JxW, DoF indices; the
     // pressure shape values (the same on every cell of an affine simplex
@@ -362,8 +466,21 @@ namespace palpate
     for (unsigned int m = 0; m < multiplier_dof.size(); ++m)
       {
         const int e = eq_of_dof[multiplier_dof[m]];
-        rows[e].push_back(n_free + m);
-        rows[n_free + m].push_back(e);
+        rows[e].push_back(n_free + n_contact + m);
+        rows[n_free + n_contact + m].push_back(e);
+      }
+    // A contact multiplier couples with its node's three displacements,
+    // and has a diagonal entry (its row while the node is not in
+    // contact). The node's own 3 x 3 block is there from its cells.
+    for (unsigned int k = 0; k < n_contact; ++k)
+      {
+        rows[n_free + k].push_back(n_free + k);
+        for (const int e : contact[k].eq)
+          if (e >= 0)
+            {
+              rows[e].push_back(n_free + k);
+              rows[n_free + k].push_back(e);
+            }
       }
     pattern.n_rows = n_eq;
     pattern.row_start.assign(1, 0);
@@ -387,8 +504,27 @@ namespace palpate
     for (unsigned int m = 0; m < multiplier_dof.size(); ++m)
       {
         const int e = eq_of_dof[multiplier_dof[m]];
-        position_lambda_u.push_back(pattern.position(n_free + m, e));
-        position_u_lambda.push_back(pattern.position(e, n_free + m));
+        position_lambda_u.push_back(
+          pattern.position(n_free + n_contact + m, e));
+        position_u_lambda.push_back(
+          pattern.position(e, n_free + n_contact + m));
+      }
+    for (unsigned int k = 0; k < n_contact; ++k)
+      {
+        auto &c       = contact[k];
+        c.position_ll = pattern.position(n_free + k, n_free + k);
+        // -1: an eliminated (fixed) component, which has no equation.
+        for (unsigned int a = 0; a < 3; ++a)
+          {
+            c.position_lu[a] =
+              c.eq[a] >= 0 ? pattern.position(n_free + k, c.eq[a]) : -1;
+            c.position_ul[a] =
+              c.eq[a] >= 0 ? pattern.position(c.eq[a], n_free + k) : -1;
+            for (unsigned int b = 0; b < 3; ++b)
+              c.position_uu[3 * a + b] = c.eq[a] >= 0 && c.eq[b] >= 0 ?
+                                           pattern.position(c.eq[a], c.eq[b]) :
+                                           -1;
+          }
       }
 
     // --- Scales: the constraint rows by a typical diagonal stiffness E h,
@@ -439,6 +575,27 @@ namespace palpate
     u.resize(eq_of_dof.size());
     for (unsigned int d = 0; d < eq_of_dof.size(); ++d)
       u[d] = eq_of_dof[d] >= 0 ? x[eq_of_dof[d]] : fixed_value[d];
+  }
+
+
+
+  HyperelasticSystem::Impl::Contact
+  HyperelasticSystem::Impl::contact_at(const unsigned int         k,
+                                       const std::vector<double> &u,
+                                       const std::vector<double> &x,
+                                       const Utilities::Point3   &target) const
+  {
+    const ContactNode &c = contact[k];
+    Contact            r;
+    for (unsigned int a = 0; a < 3; ++a)
+      r.n[a] = c.position[a] + u[c.dof[a]] - sphere_rest_center[a] - target[a];
+    r.rho = Utilities::norm(r.n);
+    for (unsigned int a = 0; a < 3; ++a)
+      r.n[a] /= r.rho;
+    r.gap        = r.rho - sphere_radius;
+    r.x_lambda   = x[n_free + k];
+    r.lambda_hat = beta * std::max(0.0, r.x_lambda - r.gap);
+    return r;
   }
 
 
@@ -704,7 +861,7 @@ namespace palpate
   unsigned int
   HyperelasticSystem::n_multipliers() const
   {
-    return impl->multiplier_dof.size();
+    return impl->n_contact + impl->multiplier_dof.size();
   }
 
 
@@ -745,6 +902,148 @@ namespace palpate
   HyperelasticSystem::constraint_scale() const
   {
     return impl->beta;
+  }
+
+
+
+  bool
+  HyperelasticSystem::has_contact() const
+  {
+    return impl->sphere_radius > 0;
+  }
+
+
+
+  double
+  HyperelasticSystem::sphere_radius() const
+  {
+    return impl->sphere_radius;
+  }
+
+
+
+  Utilities::Point3
+  HyperelasticSystem::sphere_center(const Utilities::Point3 &target) const
+  {
+    const auto &c = impl->sphere_rest_center;
+    return {{c[0] + target[0], c[1] + target[1], c[2] + target[2]}};
+  }
+
+
+
+  std::vector<HyperelasticSystem::ContactPoint>
+  HyperelasticSystem::contact(const State &state) const
+  {
+    const Impl               &s = *impl;
+    const std::vector<double> x = from_state(state);
+    std::vector<ContactPoint> points(s.n_contact);
+    for (unsigned int k = 0; k < s.n_contact; ++k)
+      {
+        const Impl::Contact c =
+          s.contact_at(k, state.solution, x, state.active_displacement);
+        points[k] = {s.contact[k].dof, c.gap, c.lambda_hat};
+      }
+    return points;
+  }
+
+
+
+  Utilities::Point3
+  HyperelasticSystem::probe_force(const std::vector<double> &x,
+                                  const Utilities::Point3   &target) const
+  {
+    const Impl       &s     = *impl;
+    Utilities::Point3 force = {{0, 0, 0}};
+    if (!has_contact())
+      {
+        // The sum over the tip's nodes (one for a point probe).
+        for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+          force[m % 3] += s.beta * x[s.n_free + m];
+        return force;
+      }
+    s.expand(x, s.u_work);
+    for (unsigned int k = 0; k < s.n_contact; ++k)
+      {
+        const Impl::Contact c = s.contact_at(k, s.u_work, x, target);
+        for (unsigned int a = 0; a < 3; ++a)
+          force[a] -= c.lambda_hat * c.n[a];
+      }
+    return force;
+  }
+
+
+
+  void
+  HyperelasticSystem::probe_load(const std::vector<double> &x,
+                                 const Utilities::Point3   &target,
+                                 const unsigned int         j,
+                                 std::vector<double>       &rhs) const
+  {
+    const Impl &s = *impl;
+    rhs.assign(n_equations(), 0.0);
+    if (!has_contact())
+      {
+        // R_lambda = beta (u - target) at the probe's rows of component j.
+        for (unsigned int m = j; m < s.n_active_multipliers; m += 3)
+          rhs[s.n_free + m] = s.beta;
+        return;
+      }
+    // The contact terms depend on x_k - c only, so d/dc = -d/du_k of the
+    // active nodes' terms (assemble()): -dR_u/dc_j = (beta + lambda/rho)
+    // n n_j - lambda/rho e_j, and -dR_lambda/dc_j = -beta n_j.
+    s.expand(x, s.u_work);
+    for (unsigned int k = 0; k < s.n_contact; ++k)
+      {
+        const Impl::Contact c = s.contact_at(k, s.u_work, x, target);
+        if (!(c.lambda_hat > 0))
+          continue;
+        const double curvature = c.lambda_hat / c.rho;
+        for (unsigned int a = 0; a < 3; ++a)
+          if (const int e = s.contact[k].eq[a]; e >= 0)
+            rhs[e] = (s.beta + curvature) * c.n[a] * c.n[j] -
+                     (a == j ? curvature : 0.0);
+        rhs[s.n_free + k] = -s.beta * c.n[j];
+      }
+  }
+
+
+
+  Utilities::Point3
+  HyperelasticSystem::probe_force_change(const std::vector<double> &x,
+                                         const Utilities::Point3   &target,
+                                         const std::vector<double> &dx,
+                                         const unsigned int         j) const
+  {
+    const Impl       &s  = *impl;
+    Utilities::Point3 df = {{0, 0, 0}};
+    if (!has_contact())
+      {
+        for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+          df[m % 3] += s.beta * dx[s.n_free + m];
+        return df;
+      }
+    // f = -sum lambda n with lambda = beta (x_lambda - g), g = rho - R:
+    // with dr = du_k - e_j (the node relative to the centre),
+    // dg = n . dr, dn = (dr - n (n . dr)) / rho.
+    s.expand(x, s.u_work);
+    for (unsigned int k = 0; k < s.n_contact; ++k)
+      {
+        const Impl::Contact c = s.contact_at(k, s.u_work, x, target);
+        if (!(c.lambda_hat > 0))
+          continue;
+        Utilities::Point3 dr;
+        for (unsigned int a = 0; a < 3; ++a)
+          {
+            const int e = s.contact[k].eq[a];
+            dr[a]       = (e >= 0 ? dx[e] : 0.0) - (a == j ? 1.0 : 0.0);
+          }
+        const double dg      = Utilities::dot(c.n, dr);
+        const double dlambda = s.beta * (dx[s.n_free + k] - dg);
+        for (unsigned int a = 0; a < 3; ++a)
+          df[a] -=
+            dlambda * c.n[a] + c.lambda_hat * (dr[a] - c.n[a] * dg) / c.rho;
+      }
+    return df;
   }
 
 
@@ -961,9 +1260,10 @@ namespace palpate
         const unsigned int d = s.multiplier_dof[m];
         const double       value =
           m < s.n_active_multipliers ? target[m % 3] : s.fixed_value[d];
-        const double lambda = s.beta * x[s.n_free + m];
+        const unsigned int e      = s.n_free + s.n_contact + m;
+        const double       lambda = s.beta * x[e];
         residual[s.eq_of_dof[d]] += lambda;
-        residual[s.n_free + m] = s.beta * (s.u_work[d] - value);
+        residual[e] = s.beta * (s.u_work[d] - value);
         lambda_norm += lambda * lambda;
         if (matrix != nullptr)
           {
@@ -971,6 +1271,67 @@ namespace palpate
             (*matrix)[s.position_u_lambda[m]] = s.beta;
           }
       }
+    // The sphere's contact, as an augmented Lagrangian (Alart and
+    // Curnier's semi-smooth form): with the gap g = |x_k - c| - R of
+    // candidate k, its multiplier x_lambda (scaled like the others, a
+    // length) and lambda_hat = beta max(0, x_lambda - g), the node gets the
+    // contact force lambda_hat n along the normal n from the centre c, and
+    // the multiplier's row is
+    //   -beta (x_lambda - max(0, x_lambda - g)),
+    // i.e. -beta g while in contact (x_lambda > g: the node lies on the
+    // sphere) and -beta x_lambda otherwise (no force). At a solution this
+    // is exactly the complementarity g >= 0, lambda >= 0, g lambda = 0;
+    // the residual is continuous, and its Jacobian (taken on either side
+    // of the kink) is symmetric, so the symmetric LDL^T factorisation
+    // serves: the augmentation beta n n^T stiffens the node's block, and
+    // -lambda_hat (I - n n^T)/rho is the sphere's curvature.
+    for (unsigned int k = 0; k < s.n_contact; ++k)
+      {
+        const auto         &node = s.contact[k];
+        const Impl::Contact c    = s.contact_at(k, s.u_work, x, target);
+        if (!(c.rho > 1e-9 * s.sphere_radius))
+          return false; // a node at the centre: far beyond any contact
+        const unsigned int e = s.n_free + k;
+        lambda_norm += c.lambda_hat * c.lambda_hat;
+        if (c.lambda_hat > 0)
+          {
+            for (unsigned int a = 0; a < 3; ++a)
+              if (node.eq[a] >= 0)
+                residual[node.eq[a]] -= c.lambda_hat * c.n[a];
+            residual[e] = -s.beta * c.gap;
+            if (matrix != nullptr)
+              {
+                (*matrix)[node.position_ll] = 0;
+                const double curvature      = c.lambda_hat / c.rho;
+                for (unsigned int a = 0; a < 3; ++a)
+                  if (node.eq[a] >= 0)
+                    {
+                      (*matrix)[node.position_lu[a]] = -s.beta * c.n[a];
+                      (*matrix)[node.position_ul[a]] = -s.beta * c.n[a];
+                      for (unsigned int b = 0; b < 3; ++b)
+                        if (node.eq[b] >= 0)
+                          (*matrix)[node.position_uu[3 * a + b]] +=
+                            (s.beta + curvature) * c.n[a] * c.n[b] -
+                            (a == b ? curvature : 0.0);
+                    }
+              }
+          }
+        else
+          {
+            residual[e] = -s.beta * c.x_lambda;
+            if (matrix != nullptr)
+              {
+                (*matrix)[node.position_ll] = -s.beta;
+                for (unsigned int a = 0; a < 3; ++a)
+                  if (node.eq[a] >= 0)
+                    {
+                      (*matrix)[node.position_lu[a]] = 0;
+                      (*matrix)[node.position_ul[a]] = 0;
+                    }
+              }
+          }
+      }
+
     for (const double r : residual)
       if (!std::isfinite(r))
         return false;
@@ -1028,14 +1389,10 @@ namespace palpate
       for (unsigned int d = 0; d < state.solution.size(); ++d)
         if (s.dof_component[d] == 3)
           state.solution[d] *= s.pressure_scale;
-    state.multipliers.resize(s.multiplier_dof.size());
-    for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
+    state.multipliers.resize(n_multipliers());
+    for (unsigned int m = 0; m < n_multipliers(); ++m)
       state.multipliers[m] = s.beta * x[s.n_free + m];
-    // The force on the probe: the sum over the tip's nodes (one for a
-    // point probe).
-    state.force = {{0, 0, 0}};
-    for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
-      state.force[m % 3] += state.multipliers[m];
+    state.force = probe_force(x, state.active_displacement);
   }
 
 
@@ -1050,7 +1407,7 @@ namespace palpate
         x[s.eq_of_dof[d]] = s.dof_component[d] == 3 ?
                               state.solution[d] / s.pressure_scale :
                               state.solution[d];
-    for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
+    for (unsigned int m = 0; m < n_multipliers(); ++m)
       x[s.n_free + m] = state.multipliers[m] / s.beta;
     return x;
   }

@@ -272,9 +272,11 @@ namespace palpate
      * against finite differences on liver501: 1.4e-4 StVK, 3.8e-4
      * neo-Hookean): far below what interpolation on a grid can resolve,
      * for no assembly and, after an exact Newton step, no factorisation.
-     * Moving the probe's target by dg changes the constraint residual by
-     * -beta dg, so K dx = beta dg at the probe's constraint rows gives the
-     * change of the multipliers, and -df/dg is the stiffness: three solves
+     * Moving the probe by dg changes the residual by dR = -probe_load dg
+     * (for a point probe -beta dg at its constraint rows; for a sphere the
+     * rows of the nodes in contact), so K dx = probe_load dg gives the
+     * change of the state, probe_force_change() turns it into df, and
+     * -df/dg is the stiffness: three solves
      * with the factorisation (direct if it is of this tangent, else GMRES
      * to 1e-6 preconditioned by it, else - when GMRES needs more than
      * Maximum Krylov iterations - a new factorisation, which then also
@@ -289,21 +291,13 @@ namespace palpate
   bool
   StateSolver::Impl::active_stiffness(State &state)
   {
-    const unsigned int n_eq  = system->n_equations();
-    const unsigned int first = n_eq - system->n_multipliers();
-    const unsigned int n_act = system->n_active_multipliers();
-    const double       beta  = system->constraint_scale();
-    if (n_act == 0 || matrix.empty())
+    if (system->n_active_multipliers() == 0 || matrix.empty())
       return false;
-    std::vector<double> rhs;
-    const auto          fill = [&](const unsigned int j) {
-      rhs.assign(n_eq, 0.0);
-      for (unsigned int m = j; m < n_act; m += 3)
-        rhs[first + m] = beta;
-    };
+    const std::vector<double> x = system->from_state(state);
+    std::vector<double>       rhs;
     for (unsigned int j = 0; j < 3; ++j)
       {
-        fill(j);
+        system->probe_load(x, state.active_displacement, j, rhs);
         bool solved = false;
         if (factorized_current)
           solved = linear_solver->solve(rhs);
@@ -321,7 +315,7 @@ namespace palpate
                        krylov_v,
                        krylov_z) > 0;
             if (!solved)
-              fill(j);
+              system->probe_load(x, state.active_displacement, j, rhs);
           }
         if (!solved)
           {
@@ -333,13 +327,10 @@ namespace palpate
           }
         if (!solved)
           return false;
+        const Utilities::Point3 df =
+          system->probe_force_change(x, state.active_displacement, rhs, j);
         for (unsigned int i = 0; i < 3; ++i)
-          {
-            double df = 0;
-            for (unsigned int m = i; m < n_act; m += 3)
-              df += beta * rhs[first + m];
-            state.stiffness[3 * i + j] = -df;
-          }
+          state.stiffness[3 * i + j] = -df[i];
       }
     for (const double k : state.stiffness)
       if (!std::isfinite(k))
@@ -487,9 +478,12 @@ namespace palpate
         const double s0 = directional_derivative(residual, step);
         // The energy of the mixed u-p formulation has a saddle in p, so
         // there the residual norm is the merit function.
-        const bool energy = !predictor && s0 < 0 && !system->has_pressure();
-        double     alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
-        double     lower = 0, s_lower = s0, upper = -1, s_upper = 0;
+        // So it is with contact, whose active set may change under the
+        // step (the energy is then not smooth along it).
+        const bool energy = !predictor && s0 < 0 && !system->has_pressure() &&
+                            !system->has_contact();
+        double alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
+        double lower = 0, s_lower = s0, upper = -1, s_upper = 0;
         const unsigned int steps =
           settings.line_search ? settings.max_line_search_steps : 1;
         for (unsigned int k = 0; k < steps; ++k)
@@ -826,8 +820,8 @@ namespace palpate
             if (impl->observer)
               {
                 State at;
-                impl->system->to_state(x, at);
                 at.active_displacement = point(t1);
+                impl->system->to_state(x, at);
                 impl->observer(at, t1);
               }
             previous   = saved;

@@ -143,4 +143,88 @@ namespace palpate
           cell->face(f)->set_boundary_id(0);
     return to_mesh_data(tria, "blob generator");
   }
+
+
+
+  MeshData
+  generate_tensor_block(const std::vector<double> &x,
+                        const std::vector<double> &y,
+                        const std::vector<double> &z)
+  {
+    MeshData           data;
+    const unsigned int nx = x.size(), ny = y.size(), nz = z.size();
+    data.format     = "tensor block generator";
+    const auto node = [&](unsigned int i, unsigned int j, unsigned int k) {
+      return (k * ny + j) * nx + i;
+    };
+    for (unsigned int k = 0; k < nz; ++k)
+      for (unsigned int j = 0; j < ny; ++j)
+        for (unsigned int i = 0; i < nx; ++i)
+          {
+            data.nodes.push_back({{x[i], y[j], z[k]}});
+            data.node_ids.push_back(data.node_ids.size());
+          }
+    // Kuhn: the six paths from corner 000 to 111 along the edges, one per
+    // order of the three axes.
+    static const unsigned int order[6][3] = {
+      {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    for (unsigned int k = 0; k + 1 < nz; ++k)
+      for (unsigned int j = 0; j + 1 < ny; ++j)
+        for (unsigned int i = 0; i + 1 < nx; ++i)
+          for (const auto &o : order)
+            {
+              std::array<unsigned int, 3> at = {{i, j, k}};
+              std::array<unsigned int, 4> t;
+              t[0] = node(i, j, k);
+              for (unsigned int step = 0; step < 3; ++step)
+                {
+                  ++at[o[step]];
+                  t[step + 1] = node(at[0], at[1], at[2]);
+                }
+              const auto &p = data.nodes;
+              const auto  e = [&](unsigned int a, unsigned int d) {
+                return p[t[a]][d] - p[t[0]][d];
+              };
+              const double det =
+                e(1, 0) * (e(2, 1) * e(3, 2) - e(2, 2) * e(3, 1)) -
+                e(1, 1) * (e(2, 0) * e(3, 2) - e(2, 2) * e(3, 0)) +
+                e(1, 2) * (e(2, 0) * e(3, 1) - e(2, 1) * e(3, 0));
+              if (det < 0)
+                std::swap(t[2], t[3]);
+              data.tetrahedra.push_back(t);
+              data.tetrahedron_material_ids.push_back(0);
+              data.tetrahedron_lines.push_back(0);
+              data.tetrahedron_ids.push_back(data.tetrahedron_ids.size());
+            }
+    return data;
+  }
+
+
+
+  std::vector<double>
+  graded_coordinates(const double       length,
+                     const double       h,
+                     const double       fine_length,
+                     const double       growth,
+                     const unsigned int split)
+  {
+    std::vector<double> coarse = {0};
+    double              step   = h;
+    while (coarse.back() + step < length * (1 - 1e-9))
+      {
+        // The last interval would be less than half a step: stretch the
+        // one before to the end instead.
+        if (length - (coarse.back() + step) < 0.5 * step)
+          break;
+        coarse.push_back(coarse.back() + step);
+        if (coarse.back() >= fine_length * (1 - 1e-9))
+          step *= growth;
+      }
+    coarse.push_back(length);
+    std::vector<double> t = {0};
+    for (unsigned int i = 0; i + 1 < coarse.size(); ++i)
+      for (unsigned int s = 1; s <= split; ++s)
+        t.push_back(coarse[i] + (coarse[i + 1] - coarse[i]) * s / split);
+    return t;
+  }
 } // namespace palpate

@@ -59,6 +59,134 @@ namespace palpate
           return true;
       return false;
     }
+
+    /** The point of triangle (a, b, c) closest to p (Ericson, Real-Time
+     * Collision Detection, 5.1.5). */
+    Utilities::Point3
+    closest_on_triangle(const Utilities::Point3 &p,
+                        const Utilities::Point3 &a,
+                        const Utilities::Point3 &b,
+                        const Utilities::Point3 &c)
+    {
+      using namespace Utilities;
+      const auto at = [&](const double v, const double w) {
+        return Point3{{a[0] + v * (b[0] - a[0]) + w * (c[0] - a[0]),
+                       a[1] + v * (b[1] - a[1]) + w * (c[1] - a[1]),
+                       a[2] + v * (b[2] - a[2]) + w * (c[2] - a[2])}};
+      };
+      const Point3 ab = minus(b, a), ac = minus(c, a), ap = minus(p, a);
+      const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+      if (d1 <= 0 && d2 <= 0)
+        return a;
+      const Point3 bp = minus(p, b);
+      const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+      if (d3 >= 0 && d4 <= d3)
+        return b;
+      const double vc = d1 * d4 - d3 * d2;
+      if (vc <= 0 && d1 >= 0 && d3 <= 0)
+        return at(d1 / (d1 - d3), 0);
+      const Point3 cp = minus(p, c);
+      const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+      if (d6 >= 0 && d5 <= d6)
+        return c;
+      const double vb = d5 * d2 - d1 * d6;
+      if (vb <= 0 && d2 >= 0 && d6 <= 0)
+        return at(0, d2 / (d2 - d6));
+      const double va = d3 * d6 - d5 * d4;
+      if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        {
+          const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+          return at(1 - w, w);
+        }
+      const double denominator = 1 / (va + vb + vc);
+      return at(vb * denominator, vc * denominator);
+    }
+
+
+
+    /**
+     * The sphere's rest placement (Tip = sphere). It touches the surface
+     * at the anchor: the point of the surface nearest to the scene's Point
+     * (Selection = nearest surface node), or the active node (Selection =
+     * node id). Touching a point of the surface rather than its nearest
+     * node puts the sphere at the same place on every mesh of the organ,
+     * which a study of the force's convergence needs. The normal is the
+     * area-weighted mean of the outward normals of the surface triangles
+     * within one radius of the anchor (and of the anchor's own): on a
+     * coarse mesh one triangle's normal would tilt the sphere by its
+     * facet. The centre is one radius out along the normal, then lifted
+     * further along it until no surface node (vertex, or edge midpoint of
+     * a surface triangle: the nodes a P2 contact sees) is inside the
+     * sphere. For a node X at d = X - P from the unlifted centre P,
+     * |d - t n| >= R holds for t >= d.n + sqrt((d.n)^2 - |d|^2 + R^2).
+     */
+    void
+    place_sphere(const Mesh              &mesh,
+                 const double             R,
+                 const Utilities::Point3 *point,
+                 NodeSelection           &selection)
+    {
+      using namespace Utilities;
+      const auto  &x            = mesh.vertices();
+      const auto  &faces        = mesh.surface_faces();
+      Point3       anchor       = x[selection.active_vertex];
+      unsigned int nearest_face = 0;
+      double       best         = std::numeric_limits<double>::max();
+      for (unsigned int f = 0; f < faces.size(); ++f)
+        {
+          const auto  &v = faces[f].vertices;
+          const Point3 q = closest_on_triangle(
+            point != nullptr ? *point : anchor, x[v[0]], x[v[1]], x[v[2]]);
+          const double d = distance(q, point != nullptr ? *point : anchor);
+          if (d < best)
+            {
+              best         = d;
+              nearest_face = f;
+              if (point != nullptr)
+                anchor = q;
+            }
+        }
+      Point3 n = {{0, 0, 0}};
+      for (unsigned int f = 0; f < faces.size(); ++f)
+        {
+          const auto  &v        = faces[f].vertices;
+          const Point3 centroid = {
+            {(x[v[0]][0] + x[v[1]][0] + x[v[2]][0]) / 3,
+             (x[v[0]][1] + x[v[1]][1] + x[v[2]][1]) / 3,
+             (x[v[0]][2] + x[v[1]][2] + x[v[2]][2]) / 3}};
+          if (f != nearest_face && distance(centroid, anchor) > R)
+            continue;
+          // Surface faces are oriented outward (Mesh): the cross product
+          // is twice the area times the normal.
+          const Point3 c =
+            cross(minus(x[v[1]], x[v[0]]), minus(x[v[2]], x[v[0]]));
+          for (unsigned int d = 0; d < 3; ++d)
+            n[d] += c[d];
+        }
+      n                       = scaled(n, 1 / std::max(norm(n), 1e-300));
+      selection.active_normal = n;
+      const Point3 P          = {
+                 {anchor[0] + R * n[0], anchor[1] + R * n[1], anchor[2] + R * n[2]}};
+      double     lift  = 0;
+      const auto clear = [&](const Point3 &X) {
+        const Point3 d  = minus(X, P);
+        const double dn = dot(d, n);
+        const double q  = dn * dn - dot(d, d) + R * R;
+        if (dot(d, d) < R * R && q > 0)
+          lift = std::max(lift, dn + std::sqrt(q));
+      };
+      for (const auto &face : faces)
+        for (unsigned int i = 0; i < 3; ++i)
+          {
+            const Point3 &A = x[face.vertices[i]],
+                         &B = x[face.vertices[(i + 1) % 3]];
+            clear(A);
+            clear({{(A[0] + B[0]) / 2, (A[1] + B[1]) / 2, (A[2] + B[2]) / 2}});
+          }
+      selection.sphere_lift   = lift;
+      selection.sphere_center = {
+        {P[0] + lift * n[0], P[1] + lift * n[1], P[2] + lift * n[2]}};
+    }
   } // namespace
 
 
@@ -230,7 +358,12 @@ namespace palpate
           " m) is also a fixed node, so it cannot move",
         "choose an active node outside the fixed region, or "
         "shrink the region.");
-    if (a.tip_radius > 0)
+    if (a.tip == Parameters::ActiveNode::Tip::sphere)
+      place_sphere(mesh,
+                   a.tip_radius,
+                   a.selection == "node id" ? nullptr : &a.point,
+                   selection);
+    if (a.tip == Parameters::ActiveNode::Tip::glued_nodes)
       {
         selection.tip_neighbour_distance = std::numeric_limits<double>::max();
         for (unsigned int v = 0; v < x.size(); ++v)

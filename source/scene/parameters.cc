@@ -313,15 +313,29 @@ namespace palpate
           "static solve (`palpate solve`, or `palpate scene.prm` when it is "
           "non-zero), in metres; `palpate solve --to x,y,z` overrides it.");
         prm.declare_entry(
+          "Tip",
+          "point",
+          Patterns::Selection("point|glued nodes|sphere"),
+          "What touches the organ. point: the paper's probe, the active node "
+          "follows the haptic interaction point (HIP) and the force is its "
+          "multiplier; the force of a point load is a property of the mesh "
+          "(it tends to zero as the mesh is refined). glued nodes: every "
+          "free surface node within Tip radius of the active node follows "
+          "the HIP, and the force is the sum of their multipliers. sphere: "
+          "a rigid sphere of radius Tip radius, whose centre moves with the "
+          "HIP, in frictionless unilateral contact with the surface (no "
+          "node is glued to it; the force is the resultant of the contact "
+          "pressure, zero off the surface). At HIP = 0 the sphere touches "
+          "the surface from outside, along the outward normal, at the point "
+          "of the surface nearest to Point (Selection = nearest surface "
+          "node) or at the node (Selection = node id); palpate solve --to X "
+          "moves it by X.");
+        prm.declare_entry(
           "Tip radius",
           "0",
           Patterns::Double(0.),
-          "Radius of a rigid probe tip (m). Every surface node within this "
-          "distance of the active node (and not fixed) moves with the probe, "
-          "each held by its own multipliers; the force on the device is "
-          "their sum. A finite tip spreads the load over several elements, "
-          "where the paper's point probe (0, the default) concentrates it in "
-          "the elements around one node.");
+          "Radius (m) of the glued tip (Tip = glued nodes) or of the "
+          "sphere (Tip = sphere). Must be 0 for Tip = point.");
       }
       prm.leave_subsection();
     }
@@ -338,6 +352,10 @@ namespace palpate
         node_id                 = prm.get_integer("Node id");
         prescribed_displacement = get_point(prm, "Prescribed displacement");
         tip_radius              = prm.get_double("Tip radius");
+        const std::string t     = prm.get("Tip");
+        tip                     = t == "sphere"      ? Tip::sphere :
+                                  t == "glued nodes" ? Tip::glued_nodes :
+                                                       Tip::point;
       }
       prm.leave_subsection();
     }

@@ -849,6 +849,35 @@ namespace palpate
                     " / Element chooses the degree), or choose the "
                     "element pair with the degree you want.");
 
+    // The probe's tip: a radius means something only for a glued tip or a
+    // sphere (before Tip existed, Tip radius > 0 meant glued nodes).
+    {
+      using Tip     = Parameters::ActiveNode::Tip;
+      const auto &a = p.boundary_conditions.active_node;
+      if (a.tip == Tip::point && a.tip_radius > 0)
+        throw error("Boundary conditions/Active node/Tip radius",
+                    "Tip radius = " + Utilities::to_string(a.tip_radius, 4) +
+                      " m, but Tip = point has no radius",
+                    "set Tip = sphere (a rigid sphere in contact with the "
+                    "surface: a force that converges with the mesh) or Tip "
+                    "= glued nodes (the surface nodes within the radius "
+                    "follow the probe), or remove Tip radius.");
+      if (a.tip != Tip::point && !(a.tip_radius > 0))
+        throw error("Boundary conditions/Active node/Tip radius",
+                    "Tip = " +
+                      std::string(a.tip == Tip::sphere ? "sphere" :
+                                                         "glued nodes") +
+                      " needs a positive Tip radius",
+                    "set Tip radius in metres, e.g. 0.01 for a probe of "
+                    "1 cm radius.");
+      if (a.tip == Tip::sphere && a.tip_radius > max_sphere_radius)
+        throw error("Boundary conditions/Active node/Tip radius",
+                    "a sphere of " + Utilities::to_string(a.tip_radius, 3) +
+                      " m radius is no probe (at most " +
+                      Utilities::to_string(max_sphere_radius, 3) + " m)",
+                    "give the radius in metres (a 1 cm probe: 0.01).");
+    }
+
     // Mesh.
     if (p.mesh.source == "file" && p.mesh.file_name.empty())
       throw error("Mesh/File name",

@@ -150,6 +150,12 @@ namespace palpate
       if (!nodes.tip_vertices.empty())
         a += ", tip of " + std::to_string(nodes.tip_vertices.size() + 1) +
              " nodes";
+      if (p.boundary_conditions.active_node.tip ==
+          Parameters::ActiveNode::Tip::sphere)
+        a += ", sphere of radius " +
+             Utilities::to_string(p.boundary_conditions.active_node.tip_radius,
+                                  9) +
+             " m at (" + Utilities::to_string(nodes.sphere_center, 9) + ")";
       f.fields.emplace_back("active node", a);
     }
     f.fields.emplace_back("element",

@@ -8,12 +8,13 @@
 // far below the tolerance). On liver501, 1 cm into the liver from rest,
 // for StVK, neo-Hookean and Mooney-Rivlin (P1-P1, pressure multipliers),
 // with exact Newton steps and with factorisation reuse (GMRES), and at
-// rest; and for a rigid tip of three nodes on the beam. K must agree with
-// the differences to 1e-3 of its largest entry (it comes from the tangent
-// of the last Newton step, one iterate behind the state: measured 1e-4) and be
-// symmetric to 1e-5 (the force is the gradient of the strain energy; GMRES
-// solves to 1e-6 with factorisation reuse), and
-// positive definite.
+// rest; for a rigid tip of three nodes on the beam; and for a sphere of
+// 1 cm radius in contact with liver501 (pressed 1 cm, moved 3.6 mm aside). K
+// must agree with the differences to 1e-3 of its largest entry (it comes from
+// the tangent of the last Newton step, one iterate behind the state: measured
+// 1e-4) and be symmetric to 1e-5 (the force is the gradient of the strain
+// energy; GMRES solves to 1e-6 with factorisation reuse), and positive
+// definite.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -77,8 +78,24 @@ namespace
     deallog << ", |K| = " << palpate::Utilities::to_string(largest, 2)
             << " N/m; against differences "
             << (diff <= 1e-3 * largest ? "ok" : "WRONG") << ", symmetric "
-            << (asym <= 1e-5 * largest ? "ok" : "NO") << ", positive definite "
-            << (m1 > 0 && m2 > 0 && m3 > 0 ? "yes" : "NO") << std::endl;
+            << (asym <= 1e-5 * largest ? "ok" : "NO");
+    if (!solver.system().has_contact())
+      deallog << ", positive definite "
+              << (m1 > 0 && m2 > 0 && m3 > 0 ? "yes" : "NO") << std::endl;
+    else
+      {
+        // A frictionless sphere may slide off a convex surface: sideways
+        // its stiffness may be negative (on a flat one it is 0). Along the
+        // force, pressing harder, it is positive.
+        const auto  &f   = s.force;
+        const double ff  = palpate::Utilities::dot(f, f);
+        double       kff = 0;
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = 0; j < 3; ++j)
+            kff += f[i] * K[3 * i + j] * f[j];
+        deallog << ", along the force "
+                << (kff / ff > 0 ? "positive" : "NOT positive") << std::endl;
+      }
   }
 } // namespace
 
@@ -107,5 +124,20 @@ main(int argc, char **argv)
         false);
   palpate::Scene tip = shipped_scene("beam.prm");
   tip.parameters.boundary_conditions.active_node.tip_radius = 0.011;
+  tip.parameters.boundary_conditions.active_node.tip =
+    palpate::Parameters::ActiveNode::Tip::glued_nodes;
   check("beam, tip", tip, {{0.004, 0.002, -0.003}}, false);
+
+  // A sphere in contact: the stiffness is d(contact resultant)/d(centre),
+  // through the nodes in contact (HyperelasticSystem::probe_load and
+  // probe_force_change). Pressed 1 cm into liver501 and moved sideways,
+  // so that the sphere slides and K has off-diagonal terms.
+  for (const bool reuse : {false, true})
+    {
+      palpate::Scene sphere = shipped_scene("liver-stvk.prm");
+      auto          &a      = sphere.parameters.boundary_conditions.active_node;
+      a.tip                 = palpate::Parameters::ActiveNode::Tip::sphere;
+      a.tip_radius          = 0.01;
+      check("liver501 StVK, sphere", sphere, {{0.003, -0.002, -0.01}}, reuse);
+    }
 }

@@ -42,6 +42,9 @@ main(int argc, char **argv)
   for (const double radius : {0.008, 0.0})
     {
       p.boundary_conditions.active_node.tip_radius = radius;
+      p.boundary_conditions.active_node.tip =
+        radius > 0 ? palpate::Parameters::ActiveNode::Tip::glued_nodes :
+                     palpate::Parameters::ActiveNode::Tip::point;
       const palpate::NodeSelection nodes =
         palpate::NodeSelection::create(scene, mesh);
       palpate::StateSolver solver(mesh, nodes, p);

@@ -90,8 +90,9 @@ namespace palpate
     unsigned int
     n_multipliers() const;
 
-    /** Number of the probe's multipliers (3 per tip node; the first
-     * multipliers; 0 without an active node). */
+    /** Number of the probe's multipliers (the first multipliers): 3 per
+     * node of a point probe or glued tip, one per contact candidate of a
+     * sphere; 0 without an active node. */
     unsigned int
     n_active_multipliers() const;
 
@@ -122,6 +123,71 @@ namespace palpate
     /** Whether the body has an active node (its three multipliers). */
     bool
     has_active_node() const;
+
+    /**
+     * Whether the probe is a rigid sphere in frictionless contact with the
+     * surface (Tip = sphere). Its multipliers are then one per contact
+     * candidate (every free surface node): the contact force on that node
+     * (N) while it touches the sphere, zero otherwise.
+     */
+    bool
+    has_contact() const;
+
+    /** With a sphere: its radius (m) and its centre (m) at HIP
+     * displacement @p target. */
+    double
+    sphere_radius() const;
+    Utilities::Point3
+    sphere_center(const Utilities::Point3 &target) const;
+
+    /** One contact candidate of the sphere in a state. */
+    struct ContactPoint
+    {
+      /** The node's x, y, z DoFs. */
+      std::array<unsigned int, 3> dofs;
+      /** Its distance from the sphere's surface (m; negative: inside). */
+      double gap;
+      /** The contact force on it, pushing it away from the centre (N;
+       * zero when not in contact, never negative at an equilibrium). */
+      double force;
+    };
+
+    /** Every contact candidate's gap and contact force in @p state
+     * (empty without a sphere). */
+    std::vector<ContactPoint>
+    contact(const State &state) const;
+
+    /**
+     * The force the body exerts on the probe (N) at unknowns @p x with the
+     * HIP displaced by @p target: the sum of the probe's multipliers for a
+     * point probe or glued tip, the resultant of the contact forces,
+     * -sum lambda_k n_k, for a sphere.
+     */
+    Utilities::Point3
+    probe_force(const std::vector<double> &x,
+                const Utilities::Point3   &target) const;
+
+    /**
+     * The load of moving the probe: -dR/d target_j at unknowns @p x (the
+     * right-hand side whose solution with the tangent is dx/d target_j),
+     * into @p rhs.
+     */
+    void
+    probe_load(const std::vector<double> &x,
+               const Utilities::Point3   &target,
+               const unsigned int         j,
+               std::vector<double>       &rhs) const;
+
+    /**
+     * The change of probe_force() when the unknowns change by @p dx and the
+     * HIP by the unit vector e_j: with dx = dx/d target_j this is the
+     * column j of d force / d target, i.e. of minus the probe's stiffness.
+     */
+    Utilities::Point3
+    probe_force_change(const std::vector<double> &x,
+                       const Utilities::Point3   &target,
+                       const std::vector<double> &dx,
+                       const unsigned int         j) const;
 
     /** The DoFs of the active node (x, y, z components). */
     const std::array<unsigned int, 3> &

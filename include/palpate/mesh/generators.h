@@ -7,6 +7,8 @@
 #include <palpate/mesh/mesh_file.h>
 #include <palpate/scene/parameters.h>
 
+#include <vector>
+
 namespace palpate
 {
   /**
@@ -27,6 +29,35 @@ namespace palpate
    */
   MeshData
   generate_blob(const Parameters::Mesh &parameters);
+
+  /**
+   * A block of tetrahedra on the tensor grid of the node coordinates
+   * @p x, @p y, @p z (m, increasing), each grid brick split into six
+   * tetrahedra along its main diagonal (Kuhn's subdivision, conforming
+   * because every brick is split alike). Graded coordinates make a mesh
+   * fine where something happens (under an indenter) and coarse far from
+   * it; graded_coordinates() makes such a grid. All boundary faces get
+   * id 0.
+   */
+  MeshData
+  generate_tensor_block(const std::vector<double> &x,
+                        const std::vector<double> &y,
+                        const std::vector<double> &z);
+
+  /**
+   * Node coordinates 0 = t_0 < t_1 < ... = @p length (m): spacing @p h
+   * up to @p fine_length, then growing by the factor @p growth per
+   * interval (the last interval is stretched to end at @p length), and
+   * then every interval split into @p split equal parts, so that
+   * split = 1, 2, 3, ... is a sequence of nested meshes whose every
+   * element shrinks alike: what a convergence study needs.
+   */
+  std::vector<double>
+  graded_coordinates(const double       length,
+                     const double       h,
+                     const double       fine_length,
+                     const double       growth,
+                     const unsigned int split);
 } // namespace palpate
 
 #endif

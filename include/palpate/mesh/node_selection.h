@@ -4,6 +4,8 @@
 #ifndef palpate_mesh_node_selection_h
 #define palpate_mesh_node_selection_h
 
+#include <palpate/base/utilities.h>
+
 #include <string>
 #include <vector>
 
@@ -43,6 +45,22 @@ namespace palpate
     /** With a tip: the distance (m) from the active vertex to the nearest
      * other free surface vertex, the smallest radius that makes a tip. */
     double tip_neighbour_distance = 0;
+
+    /**
+     * With Tip = sphere: the outward unit normal of the surface where the
+     * sphere touches it at HIP = 0 (the area-weighted mean over the
+     * surface triangles within one radius), and the sphere's centre at
+     * HIP = 0 (m). The sphere touches the surface at the point of it
+     * nearest to the scene's Point (Selection = nearest surface node; the
+     * same place on every mesh of the organ) or at the active node
+     * (Selection = node id); its centre is one radius out along the
+     * normal, and further out by sphere_lift if a surface node (a concave
+     * surface) would otherwise be inside it, so that at HIP = 0 it
+     * touches the surface and presses on nothing.
+     */
+    Utilities::Point3 active_normal = {{0, 0, 0}};
+    Utilities::Point3 sphere_center = {{0, 0, 0}};
+    double            sphere_lift   = 0;
 
     /** One line describing how the fixed nodes were chosen. */
     std::string fixed_description;

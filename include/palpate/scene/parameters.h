@@ -95,7 +95,20 @@ namespace palpate
       long node_id;
       /** Displacement of the active node for a static solve, metres. */
       Point3 prescribed_displacement;
-      /** Radius of a rigid probe tip (m); 0: a point probe at one node. */
+      /** What touches the organ (`Tip`). */
+      enum class Tip
+      {
+        /** The paper's probe: the active node follows the HIP. */
+        point,
+        /** Every free surface node within Tip radius of the active node is
+         * glued to the probe and follows the HIP. */
+        glued_nodes,
+        /** A rigid sphere of radius Tip radius whose centre follows the
+         * HIP, in frictionless unilateral contact with the surface. */
+        sphere
+      };
+      Tip tip;
+      /** Radius of the glued tip or of the sphere (m). */
       double tip_radius;
 
       static void

@@ -33,6 +33,8 @@ namespace palpate
     constexpr double max_modulus = 1e13;
     /** Nodes of a generated mesh (beam). */
     constexpr double max_generated_nodes = 1e5;
+    /** Active node / Tip radius of a sphere (m): a probe, not a wall. */
+    constexpr double max_sphere_radius = 0.1;
   } // namespace Limits
 
   /**

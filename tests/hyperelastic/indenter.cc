@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The rigid indenter (Boundary conditions / Active node / Tip = sphere):
+// a sphere whose centre follows the HIP, in frictionless unilateral
+// contact with the surface. On the shipped beam (10 x 2 x 2 cm, meshed
+// 40 x 8 x 8) lying clamped on its bottom face, a sphere of 1 cm radius
+// touching the middle of the top face:
+// - pressed 2 mm in: the contact conditions hold at every candidate node
+//   (no penetration beyond the tolerance, no tensile contact force, a
+//   force only where the gap is closed), and the force on the sphere is
+//   the sum of the contact reactions, -sum (f_int - f_ext) over the
+//   contact nodes, to 1e-9 (the state solved to a residual of 1e-12);
+// - moved 5 mm off the surface (from the pressed state): no force at all,
+//   and the body back at rest;
+// - a closed loop of positions sliding over the surface at 2 mm depth
+//   (a circle of 4 mm radius, 48 steps): frictionless contact keeps the
+//   state path-independent, so the loop does no net work (the trapezoidal
+//   sum of f . dc is below 1e-3 of the sum of |f . dc|), and the state at
+//   the end of the loop is the state computed directly (1e-8 of the
+//   depth).
+
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/state_solver.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+
+#include <cmath>
+
+#include "../tests.h"
+
+using palpate::Utilities::Point3;
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+
+  palpate::Scene scene                           = shipped_scene("beam.prm");
+  auto          &p                               = scene.parameters;
+  p.mesh.beam_subdivisions_length                = 40;
+  p.mesh.beam_subdivisions_width                 = 8;
+  p.mesh.beam_subdivisions_height                = 8;
+  p.boundary_conditions.fixed_nodes.boundary_ids = {4}; // the bottom face
+  p.boundary_conditions.active_node.point        = {{0.05, 0, 0.01}};
+  p.boundary_conditions.active_node.tip =
+    palpate::Parameters::ActiveNode::Tip::sphere;
+  p.boundary_conditions.active_node.tip_radius = 0.01;
+  p.nonlinear_solver.residual_tolerance        = 1e-12;
+  p.nonlinear_solver.increment_tolerance       = 1e-12;
+  const Body           body(scene);
+  palpate::StateSolver solver(body.mesh, body.nodes, p);
+  const auto          &system = solver.system();
+  deallog << "sphere centre at rest: "
+          << palpate::Utilities::to_string(body.nodes.sphere_center, 4)
+          << " m, normal "
+          << palpate::Utilities::to_string(body.nodes.active_normal, 3) << ", "
+          << system.n_active_multipliers() << " contact candidates"
+          << std::endl;
+
+  // --- Pressed 2 mm in.
+  const double         depth   = 0.002;
+  const Point3         pressed = {{0, 0, -depth}};
+  const palpate::State s       = solver.solve(solver.rest_state(), pressed);
+  deallog << "pressed 2 mm: " << (s.converged ? "converged" : s.message)
+          << ", force " << palpate::Utilities::to_string(s.force, 4) << " N"
+          << std::endl;
+  const double tolerance = 1e-9 * system.length_scale();
+  unsigned int touching  = 0;
+  double       worst_gap = 0, worst_tension = 0, worst_open = 0;
+  for (const auto &c : system.contact(s))
+    {
+      worst_gap     = std::min(worst_gap, c.gap);
+      worst_tension = std::min(worst_tension, c.force);
+      if (c.force > 0)
+        {
+          ++touching;
+          worst_open = std::max(worst_open, std::abs(c.gap));
+        }
+    }
+  deallog << "  nodes in contact: " << touching
+          << "; no penetration: " << ok(worst_gap >= -tolerance)
+          << ", no tensile contact force: " << ok(worst_tension >= 0)
+          << ", force only where the gap is closed: "
+          << ok(worst_open <= tolerance) << std::endl;
+
+  // The force on the sphere is what the contact nodes' reactions sum to.
+  const auto reactions = system.nodal_residual(s.solution);
+  Point3     sum       = {{0, 0, 0}};
+  for (const auto &c : system.contact(s))
+    if (c.force > 0)
+      for (unsigned int a = 0; a < 3; ++a)
+        sum[a] -= reactions[c.dofs[a]];
+  const double f = palpate::Utilities::norm(s.force);
+  deallog << "  force = sum of the contact reactions to 1e-9: "
+          << ok(palpate::Utilities::distance(sum, s.force) <= 1e-9 * f)
+          << "; pushes the sphere out of the body: " << ok(s.force[2] > 0)
+          << std::endl;
+
+  // --- Off the surface. From here on the scene's tolerances: at rest the
+  // force scale is the floor 1e-12 E L^2, against which a residual of
+  // 1e-12 is below round-off.
+  solver.settings().residual_tolerance  = 1e-8;
+  solver.settings().increment_tolerance = 1e-8;
+  const palpate::State off              = solver.solve(s, {{0, 0, 0.005}});
+
+  double largest = 0;
+  for (const double u : off.solution)
+    largest = std::max(largest, std::abs(u));
+  deallog << "5 mm off the surface: "
+          << (off.converged ? "converged" : off.message)
+          << ", force exactly 0: "
+          << ok(off.force[0] == 0 && off.force[1] == 0 && off.force[2] == 0)
+          << ", at rest: " << ok(largest <= 1e-8 * depth) << std::endl;
+
+  // --- A closed loop over the surface at 2 mm depth.
+  const unsigned int n = 48;
+  const double       r = 0.004, pi = std::acos(-1.0);
+  const auto         at = [&](const unsigned int i) {
+    return Point3{
+      {r * std::cos(2 * pi * i / n) - r, r * std::sin(2 * pi * i / n), -depth}};
+  };
+  palpate::State state = s, previous;
+  double         work = 0, total = 0;
+  bool           all = true;
+  for (unsigned int i = 1; i <= n; ++i)
+    {
+      previous  = state;
+      state     = solver.solve(previous, at(i));
+      all       = all && state.converged;
+      double dw = 0;
+      for (unsigned int a = 0; a < 3; ++a)
+        dw += 0.5 * (state.force[a] + previous.force[a]) *
+              (at(i)[a] - at(i - 1)[a]);
+      work += dw;
+      total += std::abs(dw);
+    }
+  double change = 0;
+  for (unsigned int d = 0; d < s.solution.size(); ++d)
+    if (system.dof_components()[d] < 3)
+      change = std::max(change, std::abs(state.solution[d] - s.solution[d]));
+  deallog << "a closed loop of " << n << " positions sliding at 2 mm depth: "
+          << (all ? "all converged" : "FAILED") << "; net work below 1e-3 of "
+          << "the work done: " << ok(std::abs(work) <= 1e-3 * total)
+          << "; back to the same state: " << ok(change <= 1e-8 * depth)
+          << std::endl;
+}
