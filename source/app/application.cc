@@ -47,13 +47,18 @@ namespace palpate
       "                                  against direct solves; recommends a\n"
       "                                  setting (doc/accuracy-vs-time.md)\n"
       "  palpate mesh SURFACE OUT.msh [--nodes N] [--scale S]\n"
-      "               [--time-limit T]\n"
+      "               [--time-limit T] [--refine X,Y,Z --fine-size H\n"
+      "               [--fine-radius R]]\n"
       "                                  make a tetrahedral mesh of an organ's\n"
       "                                  closed surface (.stl, .obj, .ply, .vtk,\n"
       "                                  .vtp; S metres per file unit, 0.001\n"
       "                                  for millimetres; N nodes, 1500 by\n"
       "                                  default): repairs, checks, meshes with\n"
-      "                                  Gmsh, reports the quality\n"
+      "                                  Gmsh, reports the quality; --refine\n"
+      "                                  grades it to elements of H metres\n"
+      "                                  within R metres (default 2 H) of the\n"
+      "                                  point X,Y,Z (metres), where the\n"
+      "                                  probe works\n"
       "                                  (doc/your-organ.md)\n"
       "  palpate precompute SCENE.prm [--radius R]\n"
       "                                  compute every state within R metres\n"
@@ -274,6 +279,8 @@ namespace palpate
                          "0.001' (for a surface in millimetres).");
       double       scale = 1, time_limit = 60;
       unsigned int nodes = 1500;
+      MeshGrading  grading;
+      bool         refine = false, radius_given = false;
       for (unsigned int i = 3; i < args.size(); ++i)
         {
           const bool has_value = i + 1 < args.size();
@@ -285,9 +292,46 @@ namespace palpate
           else if (args[i] == "--time-limit" && has_value)
             time_limit =
               number_argument("--time-limit", args[++i], 0.01, 86400, "60");
+          else if (args[i] == "--refine" && has_value)
+            {
+              const std::string value = args[++i];
+              try
+                {
+                  grading.center = Utilities::parse_point(value);
+                }
+              catch (const std::exception &)
+                {
+                  throw InputError("command line",
+                                   0,
+                                   "--refine " + value,
+                                   "expected a point x,y,z in metres (after "
+                                   "--scale)",
+                                   "e.g. --refine -0.0936,0.1107,0.0994.");
+                }
+              refine = true;
+            }
+          else if (args[i] == "--fine-size" && has_value)
+            grading.fine_size =
+              number_argument("--fine-size", args[++i], 1e-5, 1, "0.003");
+          else if (args[i] == "--fine-radius" && has_value)
+            {
+              grading.radius =
+                number_argument("--fine-radius", args[++i], 0, 10, "0.02");
+              radius_given = true;
+            }
           else
             throw unexpected(args[i]);
         }
+      if (refine != (grading.fine_size > 0))
+        throw InputError("command line",
+                         0,
+                         refine ? "--refine" : "--fine-size",
+                         "--refine and --fine-size go together: where to "
+                         "refine and to what element size",
+                         "e.g. --refine -0.0936,0.1107,0.0994 --fine-size "
+                         "0.003.");
+      if (!radius_given)
+        grading.radius = 2 * grading.fine_size;
       if (std::filesystem::path(args[2]).extension() != ".msh")
         throw InputError("command line",
                          0,
@@ -315,7 +359,7 @@ namespace palpate
           << nodes << " nodes, " << Utilities::to_string(scale, 6)
           << " m per file unit)\n";
       const SurfaceMeshReport report = mesh_surface_file(
-        args[1], scale, "--scale", nodes, time_limit, args[2]);
+        args[1], scale, "--scale", nodes, time_limit, args[2], grading);
       for (const auto &line : report.lines())
         out << "  " << line << "\n";
       out << "  use it:        subsection Mesh: set Source = file, set File "

@@ -472,9 +472,17 @@ namespace palpate
         // norm instead. Without line search the full step is taken.
         start             = Clock::now();
         const double phi0 = norm(residual);
-        const bool   predictor =
+        //
+        // With a sphere the constraints are the contact conditions, which
+        // stay violated while the active set changes from step to step:
+        // only the first step of an increment (the probe has moved) is a
+        // predictor; afterwards the residual norm must decrease, which
+        // keeps the semi-smooth Newton method from cycling between active
+        // sets (full steps cycled for 25 iterations on the liver).
+        const bool predictor =
           system->constraint_violation(residual) >
-          settings.increment_tolerance * system->length_scale();
+            settings.increment_tolerance * system->length_scale() &&
+          (iteration == 0 || !system->has_contact());
         const double s0 = directional_derivative(residual, step);
         // The energy of the mixed u-p formulation has a saddle in p, so
         // there the residual norm is the merit function.

@@ -110,11 +110,15 @@ namespace palpate
       std::string bytes;
       {
         std::ifstream in(path, std::ios::binary);
+        // error_code: a name the file system refuses (too long, a loop of
+        // links) is a missing file, not an internal error.
+        std::error_code exists_error;
         if (!in)
           throw scene.error(
             "Mesh/File name",
             "the surface file '" + path + "' " +
-              (fs::exists(path) ? "cannot be read" : "does not exist"),
+              (fs::exists(path, exists_error) ? "cannot be read" :
+                                                "does not exist"),
             "a relative path is relative to the directory of the scene "
             "file.");
         std::ostringstream s;
@@ -124,7 +128,14 @@ namespace palpate
       std::uint64_t hash = 1469598103934665603ull; // FNV-1a
       for (const char c :
            bytes + "|" + Utilities::to_string(p.scale_factor, 17) + "|" +
-             std::to_string(p.surface_target_nodes) + "|palpate-mesh-1")
+             std::to_string(p.surface_target_nodes) + "|palpate-mesh-1" +
+             (p.surface_fine_size > 0 ?
+                "|graded " + Utilities::to_string(p.surface_fine_size, 17) +
+                  " " + Utilities::to_string(p.surface_fine_radius, 17) + " " +
+                  Utilities::to_string(
+                    scene.parameters.boundary_conditions.active_node.point,
+                    17) :
+                std::string()))
         hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
       char hex[17];
       std::snprintf(hex, sizeof(hex), "%016llx", (unsigned long long)hash);
@@ -141,15 +152,21 @@ namespace palpate
                      std::to_string(p.surface_target_nodes) + "-" +
                      std::string(hex).substr(0, 8) + ".msh");
       std::string how = "reused";
-      if (!fs::exists(file))
+      if (std::error_code exists_error; !fs::exists(file, exists_error))
         try
           {
+            MeshGrading grading;
+            grading.fine_size = p.surface_fine_size;
+            grading.radius    = p.surface_fine_radius;
+            grading.center =
+              scene.parameters.boundary_conditions.active_node.point;
             const auto report = mesh_surface_file(path,
                                                   p.scale_factor,
                                                   "Mesh / Scale factor",
                                                   p.surface_target_nodes,
                                                   p.surface_time_limit,
-                                                  file.string());
+                                                  file.string(),
+                                                  grading);
             how               = "meshed now in " +
                   Utilities::to_string(report.meshing.seconds, 3) + " s";
             const auto repairs = report.repairs.lines();
@@ -457,7 +474,10 @@ namespace palpate
       }
 
     const std::string path = scene.resolve_path(p.file_name);
-    if (!std::filesystem::exists(path))
+    // error_code: a name the file system refuses (too long, a loop of
+    // links) is reported below as a file that cannot be read.
+    std::error_code exists_error;
+    if (!std::filesystem::exists(path, exists_error) && !exists_error)
       throw scene.error(
         "Mesh/File name",
         "the mesh file '" + path + "' does not exist",

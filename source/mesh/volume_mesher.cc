@@ -39,7 +39,8 @@ namespace palpate
     std::string
     mesh_in_child(const Surface     &s,
                   const unsigned int target,
-                  const std::string &out)
+                  const std::string &out,
+                  const MeshGrading &grading)
     {
       const double volume = s.volume();
       // Nodes of a Delaunay mesh with sizes in [h/2, h]: about V / (0.8 h^3)
@@ -98,7 +99,30 @@ namespace palpate
                   gmsh::model::geo::synchronize();
                   gmsh::model::addPhysicalGroup(3, {body}, 1);
                   gmsh::model::addPhysicalGroup(2, surface_tags, 1);
-                  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * h);
+                  const bool graded =
+                    grading.fine_size > 0 && grading.fine_size < h;
+                  gmsh::option::setNumber("Mesh.MeshSizeMin",
+                                          0.5 *
+                                            (graded ? grading.fine_size : h));
+                  if (graded)
+                    {
+                      // size(r) = fine + growth max(0, r - radius), capped
+                      // at h by MeshSizeMax; max(0, t) = (t + |t|)/2
+                      // written with Sqrt, which MathEval surely has.
+                      const auto        &c = grading.center;
+                      std::ostringstream r, f;
+                      r.precision(17);
+                      f.precision(17);
+                      r << "(Sqrt((x-(" << c[0] << "))^2+(y-(" << c[1]
+                        << "))^2+(z-(" << c[2] << "))^2)-" << grading.radius
+                        << ")";
+                      f << grading.fine_size << "+" << grading.growth << "*("
+                        << r.str() << "+Sqrt(" << r.str() << "^2))/2";
+                      const int field =
+                        gmsh::model::mesh::field::add("MathEval");
+                      gmsh::model::mesh::field::setString(field, "F", f.str());
+                      gmsh::model::mesh::field::setAsBackgroundMesh(field);
+                    }
                   gmsh::option::setNumber("Mesh.MeshSizeMax", h);
                   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
                   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
@@ -148,7 +172,9 @@ namespace palpate
           // Close enough to the target? Otherwise correct the size by the
           // cube root of the ratio (nodes ~ 1/h^3) and mesh again.
           const double ratio = double(nodes) / target;
-          if (std::abs(ratio - 1) <= 0.15 || pass == 3)
+          // A graded mesh: the target sets the coarse size (that of a
+          // uniform mesh of so many nodes), the refinement adds its own.
+          if (grading.fine_size > 0 || std::abs(ratio - 1) <= 0.15 || pass == 3)
             {
               std::ostringstream s;
               s.precision(17);
@@ -169,7 +195,8 @@ namespace palpate
               const unsigned int target_nodes,
               const double       time_limit,
               const std::string &out_msh,
-              const std::string &surface_name)
+              const std::string &surface_name,
+              const MeshGrading &grading)
   {
     const auto        start = Clock::now();
     const std::string tmp =
@@ -190,7 +217,7 @@ namespace palpate
         std::string report;
         try
           {
-            report = mesh_in_child(surface, target_nodes, tmp);
+            report = mesh_in_child(surface, target_nodes, tmp, grading);
           }
         catch (const std::exception &e)
           {
@@ -358,7 +385,8 @@ namespace palpate
                     const std::string &scale_entry,
                     const unsigned int target_nodes,
                     const double       time_limit,
-                    const std::string &out_msh)
+                    const std::string &out_msh,
+                    const MeshGrading &grading)
   {
     SurfaceMeshReport report;
     Surface           s = read_surface(surface_file, scale);
@@ -384,7 +412,7 @@ namespace palpate
     report.self_intersections =
       count_self_intersections(s, report.intersection);
     report.meshing =
-      mesh_volume(s, target_nodes, time_limit, out_msh, surface_file);
+      mesh_volume(s, target_nodes, time_limit, out_msh, surface_file, grading);
     const MeshData data = read_mesh_file(out_msh);
     report.quality      = mesh_quality(data.nodes, data.tetrahedra);
     {

@@ -126,6 +126,27 @@ namespace palpate
             "makes (Gmsh 2.2, in metres), relative to the current "
             "directory. A mesh is reused while the surface file, the scale "
             "factor and the target are the same.");
+          prm.declare_entry(
+            "Refinement size",
+            "0",
+            Patterns::Double(0., 1.),
+            "With Source = surface: the element size (m) near where the "
+            "probe works, within Refinement radius of Boundary conditions / "
+            "Active node / Point; beyond it the size grows by 0.3 m per m of "
+            "distance up to the size that Target nodes sets. A probe's "
+            "contact needs elements well below its radius where it touches "
+            "(a third of the sphere's radius is a good start; "
+            "doc/benchmarks/convergence.md), and nothing of the kind "
+            "elsewhere. 0: a uniform mesh. With a refinement, Target nodes sets "
+            "the size away from the probe (that of a uniform mesh of so many "
+            "nodes) and the refined region adds its nodes.");
+          prm.declare_entry(
+            "Refinement radius",
+            "0.02",
+            Patterns::Double(0., 10.),
+            "With Refinement size > 0: the radius (m) around Active node / "
+            "Point that is meshed at Refinement size: the region the probe "
+            "explores.");
         }
         prm.leave_subsection();
 
@@ -179,6 +200,8 @@ namespace palpate
           surface_target_nodes   = prm.get_integer("Target nodes");
           surface_time_limit     = prm.get_double("Time limit");
           surface_mesh_directory = prm.get("Volume mesh directory");
+          surface_fine_size      = prm.get_double("Refinement size");
+          surface_fine_radius    = prm.get_double("Refinement radius");
         }
         prm.leave_subsection();
 

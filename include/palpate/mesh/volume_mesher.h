@@ -26,6 +26,23 @@ namespace palpate
   };
 
   /**
+   * A volume mesh graded toward where the probe works: elements of
+   * @p fine_size (m) within @p radius (m) of @p center, growing by
+   * @p growth metres of element size per metre of distance beyond it, up
+   * to the mesh's coarse size. fine_size = 0: a uniform mesh. A contact
+   * of a probe needs elements well below its radius where it touches,
+   * and nothing of the kind elsewhere: grading buys that accuracy at a
+   * fraction of the nodes of a uniformly fine mesh.
+   */
+  struct MeshGrading
+  {
+    double            fine_size = 0;
+    Utilities::Point3 center    = {{0, 0, 0}};
+    double            radius    = 0;
+    double            growth    = 0.3;
+  };
+
+  /**
    * Remesh the closed, repaired @p surface (metres) to elements of about
    * the size that gives @p target_nodes nodes, tetrahedralise it with Gmsh
    * (its API: surface classification, reparametrisation, Frontal-Delaunay
@@ -43,7 +60,8 @@ namespace palpate
               const unsigned int target_nodes,
               const double       time_limit,
               const std::string &out_msh,
-              const std::string &surface_name);
+              const std::string &surface_name,
+              const MeshGrading &grading = {});
 
   /** Everything `palpate mesh` (and Mesh / Source = surface) did. */
   struct SurfaceMeshReport
@@ -82,7 +100,8 @@ namespace palpate
                     const std::string &scale_entry,
                     const unsigned int target_nodes,
                     const double       time_limit,
-                    const std::string &out_msh);
+                    const std::string &out_msh,
+                    const MeshGrading &grading = {});
 
   /**
    * Advice for a body @p size metres across at @p factor metres per file

@@ -53,6 +53,10 @@ namespace palpate
       unsigned int surface_target_nodes;
       double       surface_time_limit;
       std::string  surface_mesh_directory;
+      /** Source = surface: the element size (m) within the radius (m) of
+       * Active node / Point; 0: a uniform mesh. */
+      double surface_fine_size   = 0;
+      double surface_fine_radius = 0.02;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
