@@ -616,6 +616,24 @@ namespace palpate
               finer       = f;
             }
         }
+      else if (m.source == "surface")
+        {
+          // The same surface, finer: the refinement around the probe
+          // halved (the indenter's region), or twice the nodes.
+          if (m.surface_fine_size > 0)
+            {
+              coarse_name = "refinement " + mm(m.surface_fine_size);
+              m.surface_fine_size /= 2;
+              finer_name = "refinement " + mm(m.surface_fine_size);
+            }
+          else
+            {
+              coarse_name = std::to_string(m.surface_target_nodes) + " nodes";
+              m.surface_target_nodes *= 2;
+              finer_name = std::to_string(m.surface_target_nodes) + " nodes";
+            }
+          finer = f;
+        }
       else if (m.source == "blob")
         {
           ++m.blob_refinements;
@@ -941,13 +959,41 @@ namespace palpate
       }
     progress.finish();
 
+    // --- The discretisation error of the scene's own mesh and element,
+    // for the scene's own probe: the largest p95 difference to the finer
+    // variant of either knob. The grid knobs measure interpolation and
+    // tolerance against direct solves on the *same* discretisation; the
+    // force the device renders is off by both. A point probe has none:
+    // its force does not converge as the mesh is refined.
+    const bool point_probe =
+      !(p0.boundary_conditions.active_node.tip_radius > 0);
+    if (!point_probe)
+      for (const std::string knob : {"mesh", "element"})
+        {
+          // The knob's rows for this probe: the scene's first, the finest
+          // (the reference) last.
+          std::vector<const StudyRow *> rows;
+          for (const auto &row : result.rows)
+            if (row.knob == knob && row.probe == "tip " + mm(tip))
+              rows.push_back(&row);
+          if (rows.size() >= 2 && rows.front()->covered > 0 &&
+              rows.front()->err_p95_pct > result.discretization_pct)
+            {
+              result.discretization_pct     = rows.front()->err_p95_pct;
+              result.discretization_against = knob + " " + rows.front()->value +
+                                              " against " + rows.back()->value;
+            }
+        }
+
     // --- The recommendation: the fastest grid-knob setting whose p95
-    // force error is below the threshold and that covers 95 % of the
-    // positions.
+    // force error, plus the discretisation error where it is known, is
+    // below the threshold and that covers 95 % of the positions.
+    const double budget =
+      result.threshold_pct - std::max(0.0, result.discretization_pct);
     for (unsigned int r = 0; r < result.rows.size(); ++r)
       {
         const auto &row = result.rows[r];
-        if (!passes(row, result.threshold_pct))
+        if (!passes(row, budget))
           continue;
         if (result.recommended < 0 ||
             row.speed_mm_s > result.rows[result.recommended].speed_mm_s)
@@ -1028,17 +1074,45 @@ namespace palpate
                  "the tip rows.\n";
       }
 
+    out << "\nDiscretisation error (the scene's mesh and element, its "
+           "probe, p95):\n  ";
+    if (point_probe)
+      out << "not bounded: a point probe's force does not converge as the "
+             "mesh is refined (Boundary conditions / Active node / Tip = "
+             "sphere gives one that does).\n";
+    else if (result.discretization_pct >= 0)
+      out << fixed(result.discretization_pct, 2) << " % ("
+          << result.discretization_against
+          << (budget > 0 ?
+                "); the recommendation keeps interpolation and tolerance "
+                "within " +
+                  fixed(budget, 2) + " % so that the total stays within " +
+                  fixed(result.threshold_pct, 1) + " %.\n" :
+                "), which alone exceeds " + fixed(result.threshold_pct, 1) +
+                  " %.\n");
+    else
+      out << "not measured (no finer mesh or element to compare with).\n";
+
     out << "\nRecommendation (fastest setting with p95 force error <= "
         << result.threshold_pct
-        << " %, half the human force discrimination threshold):\n";
+        << " %, half the human force discrimination threshold"
+        << (result.discretization_pct >= 0 ? ", discretisation included" :
+                                             std::string())
+        << "):\n";
     if (result.recommended >= 0)
       {
         const auto &row = result.rows[result.recommended];
         out << "  " << row.knob << " " << row.value << ", " << row.interpolation
             << ", h = " << row.h_mm << " mm: p95 force error "
-            << fixed(row.err_p95_pct, 2) << " %, " << fixed(row.state_ms, 1)
-            << " ms per state, about " << fixed(row.speed_mm_s, 0)
-            << " mm/s straight-line speed with " << workers << " worker(s).\n"
+            << fixed(row.err_p95_pct, 2) << " %"
+            << (result.discretization_pct >= 0 ?
+                  " (total with the discretisation: " +
+                    fixed(row.err_p95_pct + result.discretization_pct, 2) +
+                    " %)" :
+                  std::string())
+            << ", " << fixed(row.state_ms, 1) << " ms per state, about "
+            << fixed(row.speed_mm_s, 0) << " mm/s straight-line speed with "
+            << workers << " worker(s).\n"
             << "  In the scene: State space / Grid spacing = "
             << row.h_mm / 1000 << ", Interpolation = "
             << (row.interpolation == "Hermite" ? "tricubic Hermite" :
@@ -1053,8 +1127,12 @@ namespace palpate
       }
     else
       out << "  none of the settings keeps the p95 error below "
-          << result.threshold_pct
-          << " % on 95 % of the positions: use a finer grid or Hermite.\n";
+          << result.threshold_pct << " % on 95 % of the positions"
+          << (result.discretization_pct >= result.threshold_pct ?
+                ": the discretisation alone is off by " +
+                  fixed(result.discretization_pct, 2) +
+                  " %; use a finer mesh or element.\n" :
+                ": use a finer grid or Hermite.\n");
 
     // --- CSV.
     result.csv_file = options.csv_file;

@@ -85,6 +85,15 @@ namespace palpate
     int recommended = -1;
     /** The error bound of the recommendation: p95 (%). */
     double threshold_pct = 3.5;
+    /**
+     * The discretisation error of the scene's mesh and element for its
+     * probe (p95 %, the larger of the mesh and element knobs' difference
+     * to their finer variant), and what it was measured against; -1 when
+     * not known (a point probe has none: its force does not converge).
+     * The recommendation keeps the total within threshold_pct.
+     */
+    double      discretization_pct = -1;
+    std::string discretization_against;
     /** Where the CSV and the plot went (plot empty: none drawn). */
     std::string csv_file, plot_file;
     /** Wall time of the study (s). */
