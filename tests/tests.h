@@ -117,6 +117,29 @@ force_and_reactions_at_rest(const palpate::Scene &scene)
   return {s.force, sum};
 }
 
+/**
+ * The force an interaction renders at @p x once its rate limiter has
+ * settled (Haptics / Maximum force change): force(x) called until two
+ * calls agree, at most @p calls times. A template, so that tests.h needs
+ * no haptics header.
+ */
+template <typename Interaction>
+palpate::Utilities::Point3
+settled_force(Interaction                      &interaction,
+              const palpate::Utilities::Point3 &x,
+              const unsigned int                calls = 100000)
+{
+  palpate::Utilities::Point3 f = interaction.force(x);
+  for (unsigned int i = 0; i < calls; ++i)
+    {
+      const palpate::Utilities::Point3 g = interaction.force(x);
+      if (palpate::Utilities::distance(f, g) == 0)
+        break;
+      f = g;
+    }
+  return f;
+}
+
 /** A shipped scene from parameters/, e.g. "liver-stvk.prm". */
 inline palpate::Scene
 shipped_scene(const std::string &name)
@@ -139,6 +162,22 @@ small_beam_scene()
   p.scheduler.cloud_radius   = 0.0045;
   p.engine.workers           = 2;
   return scene;
+}
+
+/**
+ * The indenter tests' set-up: the beam scene @p scene lying clamped on its
+ * bottom face (boundary id 4), touched in the middle of its top face by a
+ * sphere of radius @p radius (Tip = sphere).
+ */
+inline void
+touch_beam_with_sphere(palpate::Scene &scene, const double radius)
+{
+  auto &p                                        = scene.parameters;
+  p.boundary_conditions.fixed_nodes.boundary_ids = {4};
+  p.boundary_conditions.active_node.point        = {{0.05, 0, 0.01}};
+  p.boundary_conditions.active_node.tip =
+    palpate::Parameters::ActiveNode::Tip::sphere;
+  p.boundary_conditions.active_node.tip_radius = radius;
 }
 
 /** Every direct solver and ordering palpate offers, for the solver tests. */

@@ -172,8 +172,19 @@ namespace palpate
         << ",\"spacing\":" << grid.spacing()
         << ",\"extent\":" << grid.spacing() * grid.half_width()
         << ",\"diameter\":" << mesh.diameter()
-        << ",\"scene\":" << json_string(interaction.scene().file())
-        << ",\"engine\":" << json_string(interaction.summary().engine);
+        << ",\"scene\":" << json_string(interaction.scene().file());
+      // A sphere probe: its centre at HIP = 0 and its radius (m), so that
+      // the page draws the indenter where it touches, not a marker at the
+      // active node.
+      const auto &tip =
+        interaction.scene().parameters.boundary_conditions.active_node;
+      if (tip.tip == Parameters::ActiveNode::Tip::sphere)
+        {
+          const auto &c = interaction.nodes().sphere_center;
+          m << ",\"sphere\":[" << c[0] << "," << c[1] << "," << c[2] << ","
+            << tip.tip_radius << "]";
+        }
+      m << ",\"engine\":" << json_string(interaction.summary().engine);
       m << "}";
       mesh_json = m.str();
       displacement.assign(3 * surface.size(), 0.0);

@@ -116,8 +116,13 @@ function start(m) {
   fixed.setAttribute("position", new THREE.BufferAttribute(new Float32Array(fx), 3));
   scene.add(new THREE.Points(fixed, new THREE.PointsMaterial({ color: 0x4080ff, size: m.diameter / 60 })));
   activeIndex = m.active;
-  probe = new THREE.Mesh(new THREE.SphereGeometry(m.diameter / 80, 16, 12),
-                         new THREE.MeshPhongMaterial({ color: 0xffd040 }));
+  // The probe: a marker at the active node, or the indenter itself (a
+  // half-transparent sphere of its radius, so the dent shows through).
+  probe = m.sphere ?
+    new THREE.Mesh(new THREE.SphereGeometry(m.sphere[3], 32, 24),
+                   new THREE.MeshPhongMaterial({ color: 0xffd040, transparent: true, opacity: 0.55 })) :
+    new THREE.Mesh(new THREE.SphereGeometry(m.diameter / 80, 16, 12),
+                   new THREE.MeshPhongMaterial({ color: 0xffd040 }));
   scene.add(probe);
   // The state cloud (the paper's Fig. 1): grey not computed yet, yellow
   // being computed, green computed, red failure points; it follows the
@@ -209,7 +214,8 @@ function show(f) {
     if (f.active >= 0) activeIndex = f.active;
     const a = 3 * activeIndex;
     const x = new THREE.Vector3(rest[a] + f.hip[0], rest[a + 1] + f.hip[1], rest[a + 2] + f.hip[2]);
-    probe.position.copy(x);
+    const sp = m.sphere;
+    probe.position.copy(sp ? new THREE.Vector3(sp[0] + f.hip[0], sp[1] + f.hip[1], sp[2] + f.hip[2]) : x);
     const c = f.cloud, n = c.length / 4, xyz = new Float32Array(3 * n), rgb = new Float32Array(3 * n);
     for (let i = 0; i < n; ++i) {
       for (let k = 0; k < 3; ++k) {

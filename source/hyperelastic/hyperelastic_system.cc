@@ -1254,12 +1254,15 @@ namespace palpate
       }
 
     // The constraints: beta B^T x_lambda and beta (B u - g).
-    double lambda_norm = 0;
+    // (The probe's DoF multipliers come first; a sphere has none: its
+    // multipliers are the contact rows below.)
+    double             lambda_norm = 0;
+    const unsigned int n_probe_dof =
+      s.n_contact > 0 ? 0 : s.n_active_multipliers;
     for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
       {
         const unsigned int d = s.multiplier_dof[m];
-        const double       value =
-          m < s.n_active_multipliers ? target[m % 3] : s.fixed_value[d];
+        const double value = m < n_probe_dof ? target[m % 3] : s.fixed_value[d];
         const unsigned int e      = s.n_free + s.n_contact + m;
         const double       lambda = s.beta * x[e];
         residual[s.eq_of_dof[d]] += lambda;
@@ -1487,8 +1490,17 @@ namespace palpate
     const auto     f = nodal_residual(state.solution);
     for (const unsigned int d : s.fixed)
       reaction[d] = -f[d];
-    for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
-      reaction[s.multiplier_dof[m]] = state.multipliers[m];
+    if (has_contact())
+      {
+        // The contact forces, where the sphere touches.
+        for (const auto &c : contact(state))
+          if (c.force > 0)
+            for (const unsigned int d : c.dofs)
+              reaction[d] = -f[d];
+      }
+    else
+      for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+        reaction[s.multiplier_dof[m]] = state.multipliers[m];
 
     // With a pressure field the FE has a fourth, scalar component.
     std::vector<DataComponentInterpretation::DataComponentInterpretation>

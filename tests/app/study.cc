@@ -139,15 +139,10 @@ main(int argc, char **argv)
   // A sphere on the beam lying on its bottom face: the study measures the
   // discretisation error of the scene's mesh and element for the sphere,
   // and its recommendation (if any) keeps the total within 3.5 %.
-  palpate::Scene sphere                          = shipped_scene("beam.prm");
-  auto          &p                               = sphere.parameters;
-  p.boundary_conditions.fixed_nodes.boundary_ids = {4};
-  p.boundary_conditions.active_node.point        = {{0.05, 0, 0.01}};
-  p.boundary_conditions.active_node.tip =
-    palpate::Parameters::ActiveNode::Tip::sphere;
-  p.boundary_conditions.active_node.tip_radius = 0.01;
-  options.samples                              = 8;
-  options.csv_file                             = "study-sphere.csv";
+  palpate::Scene sphere = shipped_scene("beam.prm");
+  touch_beam_with_sphere(sphere, 0.01);
+  options.samples  = 8;
+  options.csv_file = "study-sphere.csv";
   std::ostringstream         sphere_out;
   const palpate::StudyResult s =
     palpate::run_study(sphere_out, sphere, options);

@@ -37,7 +37,7 @@ namespace
   /** force() at @p x until the engine has done what it can for its cell
    * (at most 2 minutes), then until the force settles. */
   Point3
-  settled_force(palpate::Interaction &interaction, const Point3 &x)
+  computed_and_settled_force(palpate::Interaction &interaction, const Point3 &x)
   {
     const auto start = std::chrono::steady_clock::now();
     interaction.force(x);
@@ -47,15 +47,7 @@ namespace
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
         interaction.force(x);
       }
-    Point3 f = interaction.force(x);
-    for (unsigned int i = 0; i < 1000; ++i)
-      {
-        const Point3 g = interaction.force(x);
-        if (palpate::Utilities::distance(f, g) == 0)
-          break;
-        f = g;
-      }
-    return f;
+    return ::settled_force(interaction, x, 1000);
   }
 } // namespace
 
@@ -79,7 +71,7 @@ main(int argc, char **argv)
   for (int i = 1; i <= 220; ++i)
     {
       const double z = -0.0005 * i;
-      const Point3 f = settled_force(interaction, {{0, 0, z}});
+      const Point3 f = computed_and_settled_force(interaction, {{0, 0, z}});
       const auto   c = interaction.missing_cause();
       finite         = finite && all_finite(f);
       failure_region =
@@ -124,9 +116,9 @@ main(int argc, char **argv)
       return Point3{{r * std::sin(a), 0, zc + r * std::cos(a)}};
     };
     for (unsigned int k = 0; k < n; k += 50)
-      settled_force(interaction, point(k));
+      computed_and_settled_force(interaction, point(k));
     Loop   result;
-    Point3 f_previous = settled_force(interaction, point(0));
+    Point3 f_previous = computed_and_settled_force(interaction, point(0));
     for (unsigned int k = 1; k <= n; ++k)
       {
         const Point3 x = point(k), x_previous = point(k - 1);

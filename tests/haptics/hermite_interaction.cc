@@ -60,15 +60,8 @@ main(int argc, char **argv)
           << std::endl;
 
   // Settle the rate-limited force at the point.
-  Point3 f = interaction.force(inside);
-  for (unsigned int i = 0; i < 100000; ++i)
-    {
-      const Point3 g = interaction.force(inside);
-      if (palpate::Utilities::distance(f, g) == 0)
-        break;
-      f = g;
-    }
-  const auto sample =
+  const Point3 f = settled_force(interaction, inside);
+  const auto   sample =
     palpate::interpolate_force(grid, cache, inside, Interpolation::hermite);
   deallog << "cell interpolated by Hermite: " << ok(sample.hermite)
           << "; settled force = the Hermite interpolant: "

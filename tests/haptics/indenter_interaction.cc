@@ -30,25 +30,7 @@
 
 #include "../tests.h"
 
-namespace
-{
-  using palpate::Utilities::Point3;
-
-  /** The force after the rate limiter settles at @p x. */
-  Point3
-  settled(palpate::Interaction &interaction, const Point3 &x)
-  {
-    Point3 f = interaction.force(x);
-    for (unsigned int i = 0; i < 100000; ++i)
-      {
-        const Point3 g = interaction.force(x);
-        if (palpate::Utilities::distance(f, g) == 0)
-          break;
-        f = g;
-      }
-    return f;
-  }
-} // namespace
+using palpate::Utilities::Point3;
 
 int
 main(int argc, char **argv)
@@ -56,13 +38,9 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene                           = small_beam_scene();
-  auto          &p                               = scene.parameters;
-  p.boundary_conditions.fixed_nodes.boundary_ids = {4}; // the bottom face
-  p.boundary_conditions.active_node.point        = {{0.05, 0, 0.01}};
-  p.boundary_conditions.active_node.tip =
-    palpate::Parameters::ActiveNode::Tip::sphere;
-  p.boundary_conditions.active_node.tip_radius = 0.01;
+  palpate::Scene scene = small_beam_scene();
+  auto          &p     = scene.parameters;
+  touch_beam_with_sphere(scene, 0.01);
   // Elements of 5 mm: a sphere finds the gaps between coarser nodes.
   p.mesh.beam_subdivisions_length = 20;
   p.mesh.beam_subdivisions_width  = 4;
@@ -107,7 +85,7 @@ main(int argc, char **argv)
             << "; each equals a direct solve from rest: "
             << ok(largest > 0 && worst <= 1e-6 * largest) << std::endl;
 
-    pressed_force     = settled(interaction, inside);
+    pressed_force     = settled_force(interaction, inside);
     const auto sample = palpate::interpolate_force(
       grid, cache, inside, palpate::Interpolation::trilinear);
     deallog << "1.1 mm in: the force is the blend of its cell: "
@@ -123,7 +101,7 @@ main(int argc, char **argv)
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
         off = interaction.force(above);
       }
-    off = settled(interaction, above);
+    off = settled_force(interaction, above);
     deallog << "3 mm above the surface: force exactly 0: "
             << ok(off[0] == 0 && off[1] == 0 && off[2] == 0)
             << ", nothing missing: " << ok(interaction.data_complete())
@@ -136,7 +114,7 @@ main(int argc, char **argv)
   again.attach();
   while (!again.initial_cloud_complete())
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  const Point3 f = settled(again, inside);
+  const Point3 f = settled_force(again, inside);
   deallog << "a second interaction loads the store (at least the initial "
              "cloud): "
           << ok(again.stored_points() >= computed) << "; same force: "

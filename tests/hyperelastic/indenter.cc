@@ -18,7 +18,10 @@
 //   state path-independent, so the loop does no net work (the trapezoidal
 //   sum of f . dc is below 1e-3 of the sum of |f . dc|), and the state at
 //   the end of the loop is the state computed directly (1e-8 of the
-//   depth).
+//   depth);
+// - with the fixed nodes held by multipliers the state is the same (the
+//   contact rows stay apart from the supports'), and a VTU of the pressed
+//   state shows the reactions.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -37,18 +40,14 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene scene                           = shipped_scene("beam.prm");
-  auto          &p                               = scene.parameters;
-  p.mesh.beam_subdivisions_length                = 40;
-  p.mesh.beam_subdivisions_width                 = 8;
-  p.mesh.beam_subdivisions_height                = 8;
-  p.boundary_conditions.fixed_nodes.boundary_ids = {4}; // the bottom face
-  p.boundary_conditions.active_node.point        = {{0.05, 0, 0.01}};
-  p.boundary_conditions.active_node.tip =
-    palpate::Parameters::ActiveNode::Tip::sphere;
-  p.boundary_conditions.active_node.tip_radius = 0.01;
-  p.nonlinear_solver.residual_tolerance        = 1e-12;
-  p.nonlinear_solver.increment_tolerance       = 1e-12;
+  palpate::Scene scene            = shipped_scene("beam.prm");
+  auto          &p                = scene.parameters;
+  p.mesh.beam_subdivisions_length = 40;
+  p.mesh.beam_subdivisions_width  = 8;
+  p.mesh.beam_subdivisions_height = 8;
+  touch_beam_with_sphere(scene, 0.01);
+  p.nonlinear_solver.residual_tolerance  = 1e-12;
+  p.nonlinear_solver.increment_tolerance = 1e-12;
   const Body           body(scene);
   palpate::StateSolver solver(body.mesh, body.nodes, p);
   const auto          &system = solver.system();
@@ -97,6 +96,30 @@ main(int argc, char **argv)
           << ok(palpate::Utilities::distance(sum, s.force) <= 1e-9 * f)
           << "; pushes the sphere out of the body: " << ok(s.force[2] > 0)
           << std::endl;
+
+  // The fixed nodes held by multipliers instead of elimination: the same
+  // state, and the contact rows stay apart from the supports' rows.
+  {
+    palpate::Scene held                                       = scene;
+    held.parameters.boundary_conditions.fixed_nodes.treatment = "multipliers";
+    palpate::StateSolver by_multipliers(body.mesh, body.nodes, held.parameters);
+    const palpate::State m =
+      by_multipliers.solve(by_multipliers.rest_state(), pressed);
+    deallog << "  fixed nodes by multipliers: the same force to 1e-8: "
+            << ok(m.converged &&
+                  palpate::Utilities::distance(m.force, s.force) <= 1e-8 * f)
+            << std::endl;
+  }
+  // ParaView output shows the contact reactions.
+  system.write_vtu(s, "indenter.vtu");
+  {
+    std::ifstream     vtu("indenter.vtu");
+    std::stringstream text;
+    text << vtu.rdbuf();
+    deallog << "  VTU written with the reactions: "
+            << ok(text.str().find("reaction") != std::string::npos)
+            << std::endl;
+  }
 
   // --- Off the surface. From here on the scene's tolerances: at rest the
   // force scale is the floor 1e-12 E L^2, against which a residual of
