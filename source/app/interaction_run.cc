@@ -74,7 +74,7 @@ namespace palpate
     const auto &p = scene.parameters;
 
     // How long the initial cloud may take before the motion starts anyway.
-    const double wait_limit = 120;
+    const double wait_limit = p.haptics.trajectory.initial_cloud_time_limit;
 
     // The output directory is checked before anything runs, so that no
     // work is lost to an unwritable directory at the end.
@@ -161,7 +161,9 @@ namespace palpate
       out << "  initial cloud: " << interaction.initial_cloud_size()
           << " grid points around the rest position; the motion starts when "
              "they are computed (at most "
-          << wait_limit << " s)\n"
+          << wait_limit
+          << " s: Haptics / Trajectory / Initial cloud time "
+             "limit)\n"
           << std::flush;
     double next_progress = 10; // s: a word every 10 s while waiting
 
@@ -192,7 +194,11 @@ namespace palpate
             out << "  initial cloud: " << counts.first << " states computed, "
                 << counts.second << " failure points, in "
                 << std::setprecision(3) << t << " s"
-                << (t > wait_limit ? " (not complete: starting anyway)" : "")
+                << (t > wait_limit ?
+                      " (not complete after Initial cloud time limit = " +
+                        Utilities::to_string(wait_limit, 4) +
+                        " s: starting anyway)" :
+                      std::string())
                 << "; motion starts\n"
                 << std::flush;
             loop.start_motion();

@@ -1098,6 +1098,17 @@ namespace palpate
                           "When the motion starts: once the initial cloud "
                           "around the rest position is computed (the "
                           "paper's protocol), or at once.");
+        prm.declare_entry(
+          "Initial cloud time limit",
+          "120",
+          Patterns::Double(0, 3600),
+          "With Start = after initial cloud: the longest the motion waits "
+          "for the initial cloud (s); then it starts anyway, and the run "
+          "says so. Every state of the cloud (Scheduler / Cloud radius) "
+          "around the rest position, at the scene's cost per state, divided "
+          "by the workers: a large organ or cloud needs more than the "
+          "default. States kept in a store (State space / Store) are not "
+          "computed again.");
       }
       prm.leave_subsection();
     }
@@ -1109,14 +1120,15 @@ namespace palpate
     {
       prm.enter_subsection("Trajectory");
       {
-        type      = prm.get("Type");
-        direction = get_point(prm, "Direction");
-        speed     = prm.get_double("Speed");
-        duration  = prm.get_double("Duration");
-        radius    = prm.get_double("Radius");
-        seed      = prm.get_integer("Seed");
-        file_name = prm.get("File name");
-        start     = prm.get("Start");
+        type                     = prm.get("Type");
+        direction                = get_point(prm, "Direction");
+        speed                    = prm.get_double("Speed");
+        duration                 = prm.get_double("Duration");
+        radius                   = prm.get_double("Radius");
+        seed                     = prm.get_integer("Seed");
+        file_name                = prm.get("File name");
+        start                    = prm.get("Start");
+        initial_cloud_time_limit = prm.get_double("Initial cloud time limit");
       }
       prm.leave_subsection();
     }

@@ -332,6 +332,9 @@ namespace palpate
       std::string  file_name;
       /** "after initial cloud" or "immediately". */
       std::string start;
+      /** The longest wait for the initial cloud before the motion starts
+       * anyway (s). */
+      double initial_cloud_time_limit;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
