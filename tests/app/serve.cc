@@ -24,7 +24,9 @@
 // - attach, detach and changes sent at once from several clients take
 //   turns: every change is made (none refused because another request
 //   attached in between), and it still serves;
-// - a second server cannot take the same port.
+// - a second server cannot take the same port;
+// - with a sphere (Tip = sphere, the beam on its bottom face) the page gets
+//   the sphere to draw, and the force shown 2 mm in is the state's.
 
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
@@ -272,4 +274,53 @@ main(int argc, char **argv)
           << ok(second.find("cannot listen on 127.0.0.1:") != std::string::npos)
           << std::endl;
   server.stop();
+
+  // The indenter in the live view: the page gets the sphere (centre at
+  // rest and radius) to draw, and the force shown 2 mm into the beam is
+  // the state's, pushing the probe out.
+  palpate::Scene sphere                           = small_beam_scene();
+  sphere.parameters.mesh.beam_subdivisions_length = 20;
+  sphere.parameters.mesh.beam_subdivisions_width  = 4;
+  sphere.parameters.mesh.beam_subdivisions_height = 4;
+  touch_beam_with_sphere(sphere, 0.01);
+  palpate::LiveServer indenter(sphere, "127.0.0.1", 0, 0.05);
+  httplib::Client     to_indenter("127.0.0.1", indenter.port());
+  to_indenter.set_read_timeout(10, 0);
+  const auto  drawn  = numbers(to_indenter.Get("/mesh")->body, "sphere");
+  const auto &centre = indenter.interaction().nodes().sphere_center;
+  deallog << "sphere: the page gets its centre and radius: "
+          << ok(drawn.size() == 4 &&
+                palpate::Utilities::distance({{drawn[0], drawn[1], drawn[2]}},
+                                             centre) < 1e-9 &&
+                drawn[3] == 0.01);
+  const auto begin = std::chrono::steady_clock::now();
+  while (!indenter.interaction().initial_cloud_complete() &&
+         std::chrono::steady_clock::now() - begin < std::chrono::seconds(120))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const auto &sphere_grid = indenter.interaction().grid();
+  const auto  pressed     = sphere_grid.linear({{0, 0, -1}});
+  const auto  into        = sphere_grid.position(pressed);
+  to_indenter.Post("/hip",
+                   palpate::Utilities::to_string(into, 17),
+                   "text/plain");
+  for (unsigned int k = 0; k < 300; ++k)
+    {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      indenter.last(hip, force);
+      if (palpate::Utilities::distance(hip, into) < 1e-12)
+        break;
+    }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200)); // settle
+  const auto pressed_frame = to_indenter.Get("/frame");
+  const auto pressed_shown = numbers(pressed_frame->body, "force");
+  const auto pressed_state = indenter.interaction().cache().state(pressed);
+  deallog << "; 2 mm in, force shown = the state's (1e-9): "
+          << ok(pressed_state && pressed_shown.size() == 3 &&
+                palpate::Utilities::distance(
+                  {{pressed_shown[0], pressed_shown[1], pressed_shown[2]}},
+                  pressed_state->force) <
+                  1e-9 * palpate::Utilities::norm(pressed_state->force))
+          << ", pushing the probe out: "
+          << ok(pressed_shown.size() == 3 && pressed_shown[2] > 0) << std::endl;
+  indenter.stop();
 }
