@@ -22,7 +22,8 @@
 //
 // state_ms: the engine's path on one core: a state computed from its
 // neighbour on the grid (5 mm away, the pressed state moved across the
-// surface), as a solver worker does.
+// surface), extrapolating from the state behind that neighbour on the
+// same grid line, as a solver worker does.
 //
 // RESULT convergence case=hertz|liver discretization=NAME nodes=N
 //   force_N=F extrapolated_N=X err_pct=E state_ms=T
@@ -110,7 +111,11 @@ namespace
 
   /**
    * The force at @p push from rest, and the cost of the engine's next
-   * state: the pressed state moved 5 mm along @p across.
+   * state: the pressed state moved along @p across, computed as a solver
+   * worker computes a grid neighbour: from the pressed state, with the
+   * state one step behind it on the same grid line to extrapolate from
+   * (StateSolver::solve's behind). The state behind is computed first,
+   * untimed, as the engine computed it earlier.
    */
   Level
   measure(const Mesh                      &mesh,
@@ -132,11 +137,15 @@ namespace
       quarter ? 4 * std::abs(pressed.force[2]) : Utilities::norm(pressed.force);
     const Point3 next = {
       {push[0] + across[0], push[1] + across[1], push[2] + across[2]}};
-    const auto  start = Clock::now();
-    const State moved = solver.solve(pressed, next);
-    level.state_ms    = 1e3 * seconds_since(start);
-    level.newton      = moved.newton_iterations;
-    level.converged   = level.converged && moved.converged;
+    const Point3 back = {
+      {push[0] - across[0], push[1] - across[1], push[2] - across[2]}};
+    const State behind = solver.solve(pressed, back);
+    const auto  start  = Clock::now();
+    const State moved =
+      solver.solve(pressed, next, behind.converged ? &behind : nullptr);
+    level.state_ms  = 1e3 * seconds_since(start);
+    level.newton    = moved.newton_iterations;
+    level.converged = level.converged && moved.converged;
     return level;
   }
 
