@@ -229,7 +229,7 @@ main(int argc, char **argv)
       std::vector<unsigned int> splits;
     };
     const std::vector<Discretisation> discretisations =
-      quick ? std::vector<Discretisation>{{"P1", 1, {1, 2}}, {"P2", 2, {1}}} :
+      quick ? std::vector<Discretisation>{{"P1", 1, {1, 2}}} :
               std::vector<Discretisation>{{"P1", 1, {1, 2, 3}}, {"P2", 2, {1}}};
     for (const auto &disc : discretisations)
       {
