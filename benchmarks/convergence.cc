@@ -55,11 +55,7 @@ namespace
 {
   using Clock = std::chrono::steady_clock;
 
-  double
-  seconds_since(const Clock::time_point start)
-  {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-  }
+  using palpate::Utilities::seconds_since;
 
   /** One mesh level of one discretisation. */
   struct Level

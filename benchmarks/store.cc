@@ -42,11 +42,7 @@ namespace
 {
   using Clock = std::chrono::steady_clock;
 
-  double
-  seconds_since(const Clock::time_point t)
-  {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  }
+  using palpate::Utilities::seconds_since;
 
   /** Seconds from constructing an interaction to its initial cloud. */
   double

@@ -51,11 +51,7 @@ namespace palpate
      */
     constexpr double two_solver_slowdown = 1.5;
 
-    double
-    seconds_since(const Clock::time_point start)
-    {
-      return std::chrono::duration<double>(Clock::now() - start).count();
-    }
+    using Utilities::seconds_since;
 
     double
     percentile(std::vector<double> v, const double q)

@@ -41,11 +41,7 @@ namespace palpate
   {
     using Clock = std::chrono::steady_clock;
 
-    double
-    seconds_since(const Clock::time_point t)
-    {
-      return std::chrono::duration<double>(Clock::now() - t).count();
-    }
+    using Utilities::seconds_since;
 
     std::size_t
     bytes_of(const State &s)

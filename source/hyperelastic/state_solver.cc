@@ -39,11 +39,7 @@ namespace palpate
   {
     using Clock = std::chrono::steady_clock;
 
-    double
-    seconds_since(const Clock::time_point start)
-    {
-      return std::chrono::duration<double>(Clock::now() - start).count();
-    }
+    using Utilities::seconds_since;
 
     double
     norm(const std::vector<double> &v)

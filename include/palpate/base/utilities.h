@@ -5,6 +5,7 @@
 #define palpate_base_utilities_h
 
 #include <array>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,16 @@ namespace palpate
   {
     /** A point or vector in 3-D space, in metres unless stated otherwise. */
     using Point3 = std::array<double, 3>;
+
+    /** Wall-clock seconds since @p start, on the steady clock that every
+     * timing in palpate uses. */
+    inline double
+    seconds_since(const std::chrono::steady_clock::time_point start)
+    {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                           start)
+        .count();
+    }
 
     /** @p s without leading and trailing white space. */
     std::string
