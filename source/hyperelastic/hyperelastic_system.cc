@@ -149,6 +149,10 @@ namespace palpate
 
     std::vector<int> eq_of_dof;
     unsigned int     n_free = 0, n_active_multipliers = 0;
+    // The first entries of multiplier_dof that hold a probe DoF at the HIP
+    // (a point probe's or glued tip's; none for a sphere, whose
+    // multipliers are contact rows), the rest hold fixed DoFs.
+    unsigned int n_probe_dof_multipliers = 0;
     // Tip = sphere: one multiplier per surface node that the sphere may
     // touch (the contact candidates), equations n_free ... n_free +
     // n_contact - 1, before those of multiplier_dof.
@@ -372,7 +376,8 @@ namespace palpate
         multiplier_dof.insert(multiplier_dof.end(),
                               tip_dofs.begin(),
                               tip_dofs.end());
-        n_active_multipliers = multiplier_dof.size();
+        n_active_multipliers    = multiplier_dof.size();
+        n_probe_dof_multipliers = multiplier_dof.size();
       }
     if (!eliminate)
       multiplier_dof.insert(multiplier_dof.end(), fixed.begin(), fixed.end());
@@ -957,7 +962,7 @@ namespace palpate
     if (!has_contact())
       {
         // The sum over the tip's nodes (one for a point probe).
-        for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+        for (unsigned int m = 0; m < s.n_probe_dof_multipliers; ++m)
           force[m % 3] += s.beta * x[s.n_free + m];
         return force;
       }
@@ -984,7 +989,7 @@ namespace palpate
     if (!has_contact())
       {
         // R_lambda = beta (u - target) at the probe's rows of component j.
-        for (unsigned int m = j; m < s.n_active_multipliers; m += 3)
+        for (unsigned int m = j; m < s.n_probe_dof_multipliers; m += 3)
           rhs[s.n_free + m] = s.beta;
         return;
       }
@@ -1018,7 +1023,7 @@ namespace palpate
     Utilities::Point3 df = {{0, 0, 0}};
     if (!has_contact())
       {
-        for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+        for (unsigned int m = 0; m < s.n_probe_dof_multipliers; ++m)
           df[m % 3] += s.beta * dx[s.n_free + m];
         return df;
       }
@@ -1254,15 +1259,12 @@ namespace palpate
       }
 
     // The constraints: beta B^T x_lambda and beta (B u - g).
-    // (The probe's DoF multipliers come first; a sphere has none: its
-    // multipliers are the contact rows below.)
-    double             lambda_norm = 0;
-    const unsigned int n_probe_dof =
-      s.n_contact > 0 ? 0 : s.n_active_multipliers;
+    double lambda_norm = 0;
     for (unsigned int m = 0; m < s.multiplier_dof.size(); ++m)
       {
         const unsigned int d = s.multiplier_dof[m];
-        const double value = m < n_probe_dof ? target[m % 3] : s.fixed_value[d];
+        const double       value =
+          m < s.n_probe_dof_multipliers ? target[m % 3] : s.fixed_value[d];
         const unsigned int e      = s.n_free + s.n_contact + m;
         const double       lambda = s.beta * x[e];
         residual[s.eq_of_dof[d]] += lambda;
@@ -1499,7 +1501,7 @@ namespace palpate
               reaction[d] = -f[d];
       }
     else
-      for (unsigned int m = 0; m < s.n_active_multipliers; ++m)
+      for (unsigned int m = 0; m < s.n_probe_dof_multipliers; ++m)
         reaction[s.multiplier_dof[m]] = state.multipliers[m];
 
     // With a pressure field the FE has a fourth, scalar component.
