@@ -84,7 +84,7 @@ namespace
     p.boundary_conditions.active_node.tip =
       c.tip_mm > 0 ? Parameters::ActiveNode::Tip::glued_nodes :
                      Parameters::ActiveNode::Tip::point;
-    p.nonlinear_solver.reuse_factorization  = false;
+    p.nonlinear_solver.set_reuse(false);
     p.nonlinear_solver.max_increment_length = 0.01;
     return scene;
   }

@@ -62,7 +62,7 @@ namespace
     p.effects.force_log           = false;
     p.output.summary_formats      = {};
     if (reuse != "scene")
-      p.nonlinear_solver.reuse_factorization = reuse == "yes";
+      p.nonlinear_solver.set_reuse(reuse == "yes");
     scene.validate();
     return scene;
   }

@@ -47,7 +47,28 @@ namespace palpate
       out << system.n_equations() - system.n_multipliers()
           << " displacements, ";
     out << system.n_multipliers() << " multipliers)\n"
-        << "  linear solver:  " << solver.linear_solver_name() << "\n"
+        << "  linear solver:  " << solver.linear_solver_name()
+        << (scene.parameters.linear_solver.ordering == "by size" ?
+              std::string(system.n_equations() >=
+                              Parameters::LinearSolver::metis_from ?
+                            " (Ordering = by size: at least " :
+                            " (Ordering = by size: fewer than ") +
+                Utilities::to_string(Parameters::LinearSolver::metis_from) +
+                " equations)" :
+              std::string())
+        << "\n"
+        << "  Newton steps:   "
+        << (solver.settings().reuse_factorization ?
+              "GMRES preconditioned by a kept factorisation" :
+              "a factorisation each")
+        << (scene.parameters.nonlinear_solver.reuse_by_size ?
+              std::string(solver.settings().reuse_factorization ?
+                            " (Reuse factorization = by size: at least " :
+                            " (Reuse factorization = by size: fewer than ") +
+                Utilities::to_string(Parameters::NonlinearSolver::reuse_from) +
+                " equations)" :
+              std::string())
+        << "\n"
         << "  active node:    from rest to (" << Utilities::to_string(target, 4)
         << ") m\n";
 

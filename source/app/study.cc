@@ -226,10 +226,10 @@ namespace palpate
                   const double                            weight,
                   const std::string                      &what)
     {
-      auto p                                 = body.scene.parameters;
-      p.nonlinear_solver.residual_tolerance  = tolerance;
-      p.nonlinear_solver.reuse_factorization = false;
-      p.state_space.interpolation            = "trilinear";
+      auto p                                = body.scene.parameters;
+      p.nonlinear_solver.residual_tolerance = tolerance;
+      p.nonlinear_solver.set_reuse(false);
+      p.state_space.interpolation = "trilinear";
       StateSolver         solver(body.mesh, body.nodes, p);
       const State         rest = solver.rest_state();
       std::vector<Sample> samples;

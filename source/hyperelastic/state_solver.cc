@@ -182,8 +182,14 @@ namespace palpate
       // The load effects the scene switches on, and only those.
       for (const auto &effect : Effect::create_enabled(p.effects))
         effect->apply(*system, p);
-      linear_solver =
-        LinearSolver::create(p.linear_solver.solver, p.linear_solver.ordering);
+      settings.reuse_factorization = settings.reuse_for(system->n_equations());
+      settings.reuse_by_size       = false;
+      // The ordering by the system's size unless the scene fixes it: the
+      // fill of nested dissection grows more slowly with the mesh than
+      // AMF's, which is cheaper to compute and as good on small meshes.
+      linear_solver = LinearSolver::create(p.linear_solver.solver,
+                                           p.linear_solver.ordering_for(
+                                             system->n_equations()));
       linear_solver->analyze(system->sparsity());
       setup_time = seconds_since(start);
     }

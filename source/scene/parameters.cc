@@ -792,18 +792,22 @@ namespace palpate
                           "on different workers (Engine / Workers).");
         prm.declare_entry(
           "Reuse factorization",
-          "true",
-          Patterns::Bool(),
-          "Solve each Newton step by GMRES, preconditioned with the last "
-          "factorisation of the tangent this solver made (in this state or "
-          "a neighbouring one), to 1e-4 of the residual, and factorise the "
-          "current tangent only when GMRES needs more than Maximum Krylov "
-          "iterations. The states are those of the exact Newton method to "
-          "the residual tolerance (forces within 1e-7 measured), but Newton "
-          "converges at a fixed rate of 1e-4 per step instead of "
-          "quadratically. Per state on the engine's path: Mooney-Rivlin "
-          "P1-P1 on liver501 28 -> 16 ms, StVK on liver2k 172 -> 125 ms, "
-          "StVK on liver501 12.6 -> 12.3 ms (doc/benchmarks/newton.md).");
+          "by size",
+          Patterns::Selection("by size|true|false"),
+          "true: solve each Newton step by GMRES, preconditioned with the "
+          "last factorisation of the tangent this solver made (in this state "
+          "or a neighbouring one), to 1e-4 of the residual, and factorise "
+          "the current tangent only when GMRES needs more than Maximum "
+          "Krylov iterations. The states are those of the exact Newton "
+          "method to the residual tolerance (forces within 1e-7 measured), "
+          "but Newton converges at a fixed rate of 1e-4 per step instead of "
+          "quadratically. false: a factorisation every Newton step. 'by "
+          "size': true from 1,500 equations on. Per state on the engine's "
+          "path: Mooney-Rivlin P1-P1 on liver501 (1,974 equations) 28 -> 16 "
+          "ms, on a 3,976-node liver 4.9 -> 3.6 s; StVK on liver501 (1,473 "
+          "equations) 12.6 -> 12.3 ms for one solver but 8 % fewer states "
+          "per second for two, whose triangular solves share MUMPS's lock "
+          "(doc/benchmarks/newton.md, scaling.md, organ-speed.md).");
         prm.declare_entry("Maximum Krylov iterations",
                           "10",
                           Patterns::Integer(1, 100),
@@ -822,17 +826,19 @@ namespace palpate
     {
       prm.enter_subsection("Nonlinear solver");
       {
-        n_increments          = prm.get_integer("Number of increments");
-        max_increment_length  = prm.get_double("Maximum increment length");
-        max_newton_iterations = prm.get_integer("Maximum Newton iterations");
-        residual_tolerance    = prm.get_double("Residual tolerance");
-        increment_tolerance   = prm.get_double("Increment tolerance");
-        line_search           = prm.get_bool("Line search");
-        max_line_search_steps = prm.get_integer("Maximum line search steps");
-        max_cutbacks          = prm.get_integer("Maximum cutbacks");
-        assembly_threads      = prm.get_integer("Assembly threads");
-        reuse_factorization   = prm.get_bool("Reuse factorization");
-        max_krylov_iterations = prm.get_integer("Maximum Krylov iterations");
+        n_increments            = prm.get_integer("Number of increments");
+        max_increment_length    = prm.get_double("Maximum increment length");
+        max_newton_iterations   = prm.get_integer("Maximum Newton iterations");
+        residual_tolerance      = prm.get_double("Residual tolerance");
+        increment_tolerance     = prm.get_double("Increment tolerance");
+        line_search             = prm.get_bool("Line search");
+        max_line_search_steps   = prm.get_integer("Maximum line search steps");
+        max_cutbacks            = prm.get_integer("Maximum cutbacks");
+        assembly_threads        = prm.get_integer("Assembly threads");
+        const std::string reuse = prm.get("Reuse factorization");
+        reuse_by_size           = reuse == "by size";
+        reuse_factorization     = reuse != "false";
+        max_krylov_iterations   = prm.get_integer("Maximum Krylov iterations");
       }
       prm.leave_subsection();
     }
@@ -855,12 +861,17 @@ namespace palpate
           "analyse the sparsity pattern once per solver.");
         prm.declare_entry(
           "Ordering",
-          "AMF",
-          Patterns::Selection("AMF|METIS|AMD|QAMD|PORD|SCOTCH|automatic"),
-          "Fill-reducing ordering of the MUMPS analysis (ICNTL(7)). AMF is "
-          "the fastest on the liver meshes (doc/benchmarks/newton.md); "
-          "METIS (nested dissection, computed by palpate since Debian's "
-          "MUMPS lacks it) needs fewer flops on larger meshes.");
+          "by size",
+          Patterns::Selection(
+            "by size|AMF|METIS|AMD|QAMD|PORD|SCOTCH|automatic"),
+          "Fill-reducing ordering of the MUMPS analysis (ICNTL(7)). 'by "
+          "size' chooses by the number of equations: AMF below 5,000 (the "
+          "fastest on liver501, doc/benchmarks/newton.md), METIS nested "
+          "dissection from 5,000 on (computed by palpate, since Debian's "
+          "MUMPS lacks it): on a 3,976-node liver it makes a state 1.2x "
+          "faster, on 1,607 nodes the two are even "
+          "(doc/benchmarks/organ-speed.md). 'automatic' is MUMPS's own "
+          "choice.");
       }
       prm.leave_subsection();
     }

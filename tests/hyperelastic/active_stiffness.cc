@@ -33,10 +33,10 @@ namespace
         const palpate::Utilities::Point3 &target,
         const bool                        reuse)
   {
-    auto &p                                = scene.parameters;
-    p.nonlinear_solver.reuse_factorization = reuse;
-    p.state_space.interpolation            = "tricubic Hermite";
-    const palpate::Mesh          mesh      = palpate::Mesh::create(scene);
+    auto &p = scene.parameters;
+    p.nonlinear_solver.set_reuse(reuse);
+    p.state_space.interpolation       = "tricubic Hermite";
+    const palpate::Mesh          mesh = palpate::Mesh::create(scene);
     const palpate::NodeSelection nodes =
       palpate::NodeSelection::create(scene, mesh);
     palpate::StateSolver solver(mesh, nodes, p);

@@ -30,9 +30,9 @@ main(int argc, char **argv)
       auto          &p     = scene.parameters;
       // Quadratic convergence is a property of the exact Newton step: no
       // GMRES with a kept factorisation here.
-      p.nonlinear_solver.reuse_factorization = false;
-      p.material_model.model_name            = material;
-      p.nonlinear_solver.residual_tolerance  = 1e-13;
+      p.nonlinear_solver.set_reuse(false);
+      p.material_model.model_name           = material;
+      p.nonlinear_solver.residual_tolerance = 1e-13;
       const Body           body(scene);
       palpate::StateSolver solver(body.mesh, body.nodes, p);
 

@@ -239,8 +239,27 @@ namespace palpate
       /** Solve Newton steps by GMRES preconditioned with a kept
        * factorisation, refactorising only when GMRES needs more than
        * max_krylov_iterations. */
-      bool         reuse_factorization;
-      unsigned int max_krylov_iterations;
+      bool reuse_factorization;
+      /** Reuse factorization = by size: reuse_factorization is decided by
+       * the solver from the system's size (from reuse_from equations). */
+      bool                          reuse_by_size = false;
+      static constexpr unsigned int reuse_from    = 1500;
+      unsigned int                  max_krylov_iterations;
+
+      /** Fix reuse_factorization to @p on (no choice by size). */
+      void
+      set_reuse(const bool on)
+      {
+        reuse_factorization = on;
+        reuse_by_size       = false;
+      }
+
+      /** Whether a system of @p n_equations reuses factorisations. */
+      bool
+      reuse_for(const unsigned int n_equations) const
+      {
+        return reuse_by_size ? n_equations >= reuse_from : reuse_factorization;
+      }
       /** Compute the active-node stiffness of every converged state (not an
        * entry: on when State space / Interpolation needs it). */
       bool compute_stiffness = false;
@@ -256,9 +275,25 @@ namespace palpate
     {
       /** "MUMPS", "UMFPACK", "KLU", "Amesos MUMPS" or "Amesos KLU". */
       std::string solver;
-      /** MUMPS fill-reducing ordering: "AMF", "METIS", "AMD", "QAMD",
-       * "PORD", "SCOTCH" or "automatic". */
+      /** MUMPS fill-reducing ordering: "by size" (AMF below
+       * Parameters::LinearSolver::metis_from equations, METIS from there
+       * on), "AMF", "METIS", "AMD", "QAMD", "PORD", "SCOTCH" or "automatic"
+       * (MUMPS's choice). */
       std::string ordering;
+
+      /** With "by size": the number of equations from which METIS's
+       * nested dissection beats AMF (measured on the liver meshes). */
+      static constexpr unsigned int metis_from = 5000;
+
+      /** The ordering used for a system of @p n_equations: ordering, or
+       * with "by size" the one chosen for that size. */
+      std::string
+      ordering_for(const unsigned int n_equations) const
+      {
+        if (ordering != "by size")
+          return ordering;
+        return n_equations >= metis_from ? "METIS" : "AMF";
+      }
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
