@@ -5,8 +5,8 @@
 // (none: the real-time part only)
 //
 // What accuracy costs in time, on the liver scenes of parameters/: the
-// study of `palpate study` (source/app/study.cc) on liver-stvk.prm and
-// liver-mooney-rivlin.prm. One knob at a time from the scene's settings -
+// study of `palpate study` (source/app/study.cc) on paper-stvk.prm and
+// paper-mooney-rivlin.prm. One knob at a time from the scene's settings -
 // grid spacing (2.5, 5, 10, 20 mm) with trilinear and tricubic Hermite
 // interpolation, the Newton residual tolerance, the staging increment -
 // then the fastest passing grid setting with the loosest passing
@@ -21,7 +21,7 @@
 // force_err_p95_pct <= 3.5 at speed_mm_s >= 150 with 2 workers; Hermite
 // at h = 10 mm is at least as accurate as trilinear at h = 5 mm.
 //
-// Real time (not with --quick): the liver-stvk interaction with a 10 kHz
+// Real time (not with --quick): the paper-stvk interaction with a 10 kHz
 // haptic loop, trilinear and Hermite, against a bare SCHED_FIFO loop at
 // 10 kHz for as long: interpolation p50 / p99.9 (target below 10 us) and
 // deadlines missed (no more than the bare loop's).
@@ -73,7 +73,7 @@ main(int argc, char **argv)
         continue;
       const Scene scene = Scene::read(
         std::string(PALPATE_SOURCE_DIR) + "/parameters/" +
-        (m == "stvk" ? "liver-stvk.prm" : "liver-mooney-rivlin.prm"));
+        (m == "stvk" ? "paper-stvk.prm" : "paper-mooney-rivlin.prm"));
       StudyOptions options;
       options.quick       = quick;
       options.csv_file    = "accuracy-" + m + ".csv";
@@ -148,7 +148,7 @@ main(int argc, char **argv)
     for (const std::string scheme : {"trilinear", "tricubic Hermite"})
       {
         Scene scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
-                                  "/parameters/liver-stvk.prm");
+                                  "/parameters/paper-stvk.prm");
         scene.parameters.haptics.loop_rate         = 10000;
         scene.parameters.state_space.interpolation = scheme;
         std::ostringstream quiet;
@@ -157,7 +157,7 @@ main(int argc, char **argv)
         const auto [bare, bare_late] = bare_loop(seconds, 10000);
         const auto [loaded, loaded_late] =
           bare_loop(seconds, 10000, scene.parameters.engine.workers);
-        std::cout << "Real time, liver-stvk, 10 kHz loop, " << scheme << ": "
+        std::cout << "Real time, paper-stvk, 10 kHz loop, " << scheme << ": "
                   << s.ticks << " ticks, interpolation p50 "
                   << s.interpolation_p50_us << " us, p99.9 "
                   << s.interpolation_p999_us << " us; deadline misses "

@@ -88,7 +88,7 @@ namespace
   {
     Scene scene = Scene::read(
       std::string(PALPATE_SOURCE_DIR) + "/parameters/" +
-      (m.key == "stvk" ? "liver-stvk.prm" : "liver-mooney-rivlin.prm"));
+      (m.key == "stvk" ? "paper-stvk.prm" : "paper-mooney-rivlin.prm"));
     const Mesh          mesh  = Mesh::create(scene);
     const NodeSelection nodes = NodeSelection::create(scene, mesh);
     StateSolver         solver(mesh, nodes, scene.parameters);

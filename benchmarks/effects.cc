@@ -3,7 +3,7 @@
 
 // benchmarks/run effects [--quick] [--repeats N]
 //
-// What each effect costs (issue 13): the liver-stvk interaction
+// What each effect costs (issue 13): the paper-stvk interaction
 // (liver501, 2 solver threads, the 1 kHz loop, the 2.86 s stroke at
 // 28 mm/s after the initial cloud) with every effect off, then each effect
 // on alone: gravity, a surface traction (10 Pa on the whole surface),
@@ -55,7 +55,7 @@ namespace
   run(const std::string &effect)
   {
     Scene scene        = Scene::read(std::string(PALPATE_SOURCE_DIR) +
-                              "/parameters/liver-stvk.prm");
+                              "/parameters/paper-stvk.prm");
     auto &p            = scene.parameters;
     p.output.directory = "effects-output";
     p.output.summary_formats.clear();
@@ -168,7 +168,7 @@ main(int argc, char **argv)
                                      "vtu-export"};
   if (!baseline.empty())
     effects.push_back("no-effects-build");
-  std::cout << "What each effect costs: liver-stvk interaction, " << machine()
+  std::cout << "What each effect costs: paper-stvk interaction, " << machine()
             << ", " << repeats << " run(s) each, interleaved"
             << (quick ? " [--quick]" : "") << "\n\n";
 

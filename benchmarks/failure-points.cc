@@ -5,7 +5,7 @@
 //                                [--cutbacks N]
 //
 // Where does the state space have no state, and why? On the shipped liver
-// (parameters/liver-stvk.prm: liver501, 25 cm, active node 95), N random
+// (parameters/paper-stvk.prm: liver501, 25 cm, active node 95), N random
 // targets (default 1000) uniform in the 10 cm ball of the paper's state
 // space - pushes and pulls in all directions - are solved from rest as the
 // engine stages a state: increments of at most 1 cm, Newton with line
@@ -75,8 +75,8 @@ namespace
   {
     Scene scene =
       Scene::read(std::string(PALPATE_SOURCE_DIR) +
-                  (c.material == "mr" ? "/parameters/liver-mooney-rivlin.prm" :
-                                        "/parameters/liver-stvk.prm"));
+                  (c.material == "mr" ? "/parameters/paper-mooney-rivlin.prm" :
+                                        "/parameters/paper-stvk.prm"));
     auto &p = scene.parameters;
     if (c.material == "nh")
       p.material_model.model_name = "Neo-Hookean";

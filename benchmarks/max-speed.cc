@@ -114,7 +114,7 @@ namespace
   {
     Scene scene = Scene::read(
       std::string(PALPATE_SOURCE_DIR) + "/parameters/" +
-      (c.material == "stvk" ? "liver-stvk.prm" : "liver-mooney-rivlin.prm"));
+      (c.material == "stvk" ? "paper-stvk.prm" : "paper-mooney-rivlin.prm"));
     auto &p = scene.parameters;
     if (c.mesh != "liver501")
       {

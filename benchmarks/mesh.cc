@@ -48,8 +48,7 @@ namespace
   make_user_surface(const std::string &file)
   {
     Surface s = read_surface(std::string(PALPATE_SOURCE_DIR) +
-                               "/../shared/meshes/liver-tetgen/"
-                               "liver501-surface.obj",
+                               "/meshes/liver-tetgen/liver501-surface.obj",
                              39.146e-3); // metres
     subdivide(s);
     subdivide(s);

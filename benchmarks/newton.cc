@@ -6,7 +6,7 @@
 //                       [--targets N]
 //                       [--spacing H] [--radius R] [--seed S] [--no-studies]
 //
-// The paper's Table 1, measured on the liver of parameters/liver-stvk.prm
+// The paper's Table 1, measured on the liver of parameters/paper-stvk.prm
 // (liver501, 25 cm, 11 fixed nodes, active node 95; see that file):
 //
 // 1. A scaffold of states on a regular grid of active-node positions
@@ -157,8 +157,8 @@ namespace
       Scene      scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
                                 (blob ? "/parameters/default.prm" :
                                       o.material == "mr" ?
-                                             "/parameters/liver-mooney-rivlin.prm" :
-                                             "/parameters/liver-stvk.prm"));
+                                             "/parameters/paper-mooney-rivlin.prm" :
+                                             "/parameters/paper-stvk.prm"));
       if (o.material == "nh")
         scene.parameters.material_model.model_name = "Neo-Hookean";
       if (blob)

@@ -7,14 +7,14 @@
 // solver: 1 and 2 solver threads (Engine / Type = threads) against 1 and 2
 // MPI solver servers (Engine / Type = mpi, plus the client rank, all on
 // this 2-core machine), on the same work: the initial cloud of
-// parameters/liver-stvk.prm (liver501, St.Venant-Kirchhoff, h = 5 mm)
+// parameters/paper-stvk.prm (liver501, St.Venant-Kirchhoff, h = 5 mm)
 // around the rest position, radius 25 mm (15 mm with --quick). Each run is
 // a whole interaction as `palpate scene.prm` runs it, in a fresh process;
 // throughput = states finished (converged or failure points) in the
 // initial cloud / the time from attach until the cloud was complete.
 // The median of --repeat runs (3; 1 with --quick) is reported.
 // --reuse overrides the scene's Nonlinear solver / Reuse factorization
-// (liver-stvk.prm: false, measured best for it), to compare.
+// (paper-stvk.prm: false, measured best for it), to compare.
 //
 // Why: MUMPS keeps global state, so solver threads take turns behind one
 // mutex; processes do not share it. Target (issue 8): MPI
@@ -49,7 +49,7 @@ namespace
             const std::string &reuse)
   {
     Scene scene                = Scene::read(std::string(PALPATE_SOURCE_DIR) +
-                              "/parameters/liver-stvk.prm");
+                              "/parameters/paper-stvk.prm");
     auto &p                    = scene.parameters;
     p.engine.type              = engine;
     p.engine.workers           = workers;

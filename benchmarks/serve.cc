@@ -162,11 +162,11 @@ main(int argc, char **argv)
     std::string scene, width, height;
     double      seconds;
   };
-  std::vector<Config> configs = {{"liver-stvk", "960", "640", 16}};
+  std::vector<Config> configs = {{"paper-stvk", "960", "640", 16}};
   if (!quick)
     configs = {{"beam", "960", "640", 10},
-               {"liver-stvk", "960", "640", 16},
-               {"liver-stvk", "1200", "800", 16}};
+               {"paper-stvk", "960", "640", 16},
+               {"paper-stvk", "1200", "800", 16}};
 
   std::vector<std::string> results;
   std::cout << std::left << std::setw(12) << "scene" << std::setw(10) << "view"

@@ -73,7 +73,7 @@ main(int argc, char **argv)
         std::cerr << "usage: benchmarks/run store [--quick]\n";
         return 2;
       }
-  std::cout << "The HDF5 state store: liver-stvk, " << machine()
+  std::cout << "The HDF5 state store: paper-stvk, " << machine()
             << (quick ? " [--quick]" : "") << "\n\n"
             << "| mesh | cloud states | first force from nothing (s) | from "
                "the store (s) | write (states/s) | read (states/s) | bytes "
@@ -84,11 +84,11 @@ main(int argc, char **argv)
                std::vector<std::string>{"liver501", "liver2k"})
     {
       Scene scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
-                                "/parameters/liver-stvk.prm");
+                                "/parameters/paper-stvk.prm");
       auto &p     = scene.parameters;
       if (mesh == "liver2k")
         p.mesh.file_name = std::string(PALPATE_SOURCE_DIR) +
-                           "/../shared/meshes/liver-tetgen/liver2k.msh";
+                           "/meshes/liver-tetgen/liver2k.msh";
       p.state_space.store = "bench-" + mesh + ".h5";
       std::filesystem::remove(p.state_space.store);
 

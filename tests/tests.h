@@ -32,9 +32,10 @@
 
 using dealii::deallog;
 
-/** The project's source tree, the shared data and the palpate program. */
+/** The project's source tree, its example organs (meshes/, README there)
+ * and the palpate program. */
 static const std::string palpate_source_dir = PALPATE_SOURCE_DIR;
-static const std::string palpate_shared_dir = PALPATE_SHARED_DIR;
+static const std::string palpate_meshes_dir = PALPATE_SOURCE_DIR "/meshes";
 static const std::string palpate_executable = PALPATE_EXECUTABLE;
 
 /** A check's outcome as the .output files print it: "yes", or "NO" (which

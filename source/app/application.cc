@@ -75,6 +75,11 @@ namespace palpate
       "  palpate --print-parameters [prm|markdown]\n"
       "                                  print every scene parameter with its\n"
       "                                  default and documentation\n"
+      "  ... --set ENTRY=VALUE           (repeatable, with any command that\n"
+      "                                  reads a scene) a variant of the scene\n"
+      "                                  without copying it: ENTRY is the\n"
+      "                                  entry's path, e.g. --set 'Material\n"
+      "                                  model/Model name=Neo-Hookean'\n"
       "  palpate --help                  this text\n"
       "  palpate --version               the version\n"
       "\n"
@@ -121,7 +126,9 @@ namespace palpate
      * does the work and reports). Input errors are rank 0's to report.
      */
     int
-    run_server_rank(const std::vector<std::string> &args, std::ostream &err)
+    run_server_rank(const std::vector<std::string> &args,
+                    const std::vector<std::string> &settings,
+                    std::ostream                   &err)
     {
       // palpate precompute and palpate serve under mpirun: the servers
       // compute, rank 0 writes the store or serves the page, whatever the
@@ -133,7 +140,8 @@ namespace palpate
         return ExitStatus::success;
       try
         {
-          const Scene scene = Scene::read(subcommand ? args[1] : args[0]);
+          const Scene scene =
+            Scene::read(subcommand ? args[1] : args[0], settings);
           if (subcommand ?
                 !(mpi_size() > 1 && scene.parameters.engine.type == "mpi") :
                 !serves(scene, false))
@@ -165,11 +173,12 @@ namespace palpate
      */
     int
     run_scene(const std::string               &filename,
+              const std::vector<std::string>  &settings,
               std::optional<Utilities::Point3> target,
               const bool                       solve,
               std::ostream                    &out)
     {
-      const Scene         scene = Scene::read(filename);
+      const Scene         scene = Scene::read(filename, settings);
       const Mesh          mesh  = Mesh::create(scene);
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
       const auto         &mode  = scene.parameters.run.mode;
@@ -227,9 +236,11 @@ namespace palpate
     /** Read the scene @p file, build its mesh and nodes, and print its
      * report: what precompute, serve and study show first. */
     Scene
-    read_and_report(const std::string &file, std::ostream &out)
+    read_and_report(const std::string              &file,
+                    const std::vector<std::string> &settings,
+                    std::ostream                   &out)
     {
-      const Scene         scene = Scene::read(file);
+      const Scene         scene = Scene::read(file, settings);
       const Mesh          mesh  = Mesh::create(scene);
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
       print_scene_report(out, scene, mesh, nodes);
@@ -369,8 +380,24 @@ namespace palpate
     }
 
     int
-    dispatch(const std::vector<std::string> &args, std::ostream &out)
+    dispatch(const std::vector<std::string> &args,
+             const std::vector<std::string> &settings,
+             std::ostream                   &out)
     {
+      const bool reads_scene =
+        !args.empty() && args[0] != "mesh" &&
+        (args[0] == "solve" || args[0] == "serve" || args[0] == "precompute" ||
+         args[0] == "study" || args[0].empty() || args[0][0] != '-');
+      if (!settings.empty() && !reads_scene)
+        throw InputError("command line",
+                         0,
+                         "--set " + settings.front(),
+                         "--set changes an entry of a scene, and '" +
+                           (args.empty() ? std::string("palpate") : args[0]) +
+                           "' reads none",
+                         "use it with a scene: 'palpate SCENE.prm --set "
+                         "ENTRY=VALUE', or with solve, study, precompute or "
+                         "serve.");
       if (args.empty() || args[0] == "--help" || args[0] == "-h")
         {
           out << usage;
@@ -429,7 +456,7 @@ namespace palpate
               }
             else
               throw unexpected(args[i]);
-          return run_scene(args[1], target, true, out);
+          return run_scene(args[1], settings, target, true, out);
         }
       if (args[0] == "mesh")
         return run_mesh(args, out);
@@ -443,9 +470,10 @@ namespace palpate
                              "run 'palpate serve SCENE.prm [--port P]'.");
           // Under mpirun the servers read this scene too and now wait for
           // its engine: released however this ends, a bad option included.
-          const auto  release = release_servers_at_end(Scene::read(args[1]));
-          int         port    = 8080;
-          std::string host    = "127.0.0.1";
+          const auto release =
+            release_servers_at_end(Scene::read(args[1], settings));
+          int         port = 8080;
+          std::string host = "127.0.0.1";
           for (unsigned int i = 2; i < args.size(); ++i)
             if (args[i] == "--port" && i + 1 < args.size())
               port = static_cast<int>(
@@ -454,7 +482,7 @@ namespace palpate
               host = args[++i];
             else
               throw unexpected(args[i]);
-          const Scene scene = read_and_report(args[1], out);
+          const Scene scene = read_and_report(args[1], settings, out);
           return run_serve(out, scene, host, port);
         }
       if (args[0] == "precompute")
@@ -468,14 +496,15 @@ namespace palpate
                              "R]'.");
           // Under mpirun the servers read this scene too and now wait for
           // its engine: released however this ends, a bad option included.
-          const auto release = release_servers_at_end(Scene::read(args[1]));
-          double     radius  = 0;
+          const auto release =
+            release_servers_at_end(Scene::read(args[1], settings));
+          double radius = 0;
           for (unsigned int i = 2; i < args.size(); ++i)
             if (args[i] == "--radius" && i + 1 < args.size())
               radius = number_argument("--radius", args[++i], 1e-4, 10, "0.05");
             else
               throw unexpected(args[i]);
-          const Scene scene = read_and_report(args[1], out);
+          const Scene scene = read_and_report(args[1], settings, out);
           return run_precompute(out, scene, radius);
         }
       if (args[0] == "study")
@@ -530,7 +559,7 @@ namespace palpate
                                "' cannot be read",
                              "give a finer mesh of the same organ, in the "
                              "scene's file unit (its Scale factor applies).");
-          const Scene scene = read_and_report(args[1], out);
+          const Scene scene = read_and_report(args[1], settings, out);
           run_study(out, scene, options);
           return ExitStatus::success;
         }
@@ -540,7 +569,7 @@ namespace palpate
                          args[1],
                          "unexpected argument '" + args[1] + "'",
                          "run 'palpate --help' for the usage.");
-      return run_scene(args[0], std::nullopt, false, out);
+      return run_scene(args[0], settings, std::nullopt, false, out);
     }
   } // namespace
 
@@ -549,12 +578,36 @@ namespace palpate
   int
   run_application(int argc, char **argv, std::ostream &out, std::ostream &err)
   {
-    const std::vector<std::string> args(argv + 1, argv + argc);
+    // `--set ENTRY=VALUE` (or `--set=ENTRY=VALUE`), anywhere and
+    // repeatable, changes the scene any subcommand reads; the rest is the
+    // subcommand's.
+    std::vector<std::string> args, settings;
+    bool                     dangling_set = false;
+    for (int i = 1; i < argc; ++i)
+      {
+        const std::string a = argv[i];
+        if (a == "--set" && i + 1 < argc)
+          settings.emplace_back(argv[++i]);
+        else if (a.compare(0, 6, "--set=") == 0)
+          settings.push_back(a.substr(6));
+        else
+          {
+            dangling_set = dangling_set || a == "--set";
+            args.push_back(a);
+          }
+      }
     if (mpi_rank() > 0)
-      return run_server_rank(args, err);
+      return run_server_rank(args, settings, err);
     try
       {
-        return dispatch(args, out);
+        if (dangling_set)
+          throw InputError(
+            "command line",
+            0,
+            "--set",
+            "--set needs ENTRY=VALUE after it",
+            "e.g. --set 'Material model/Model name=Neo-Hookean'.");
+        return dispatch(args, settings, out);
       }
     catch (const InputError &e)
       {

@@ -41,6 +41,14 @@ namespace palpate
     std::ostringstream s;
     s << std::setprecision(4);
 
+    // A variant made on the command line says so first: its output is not
+    // the scene file's.
+    if (!scene.command_line_settings().empty())
+      {
+        s << "Command line\n";
+        for (const auto &setting : scene.command_line_settings())
+          s << "  --set " << setting << "\n";
+      }
     s << "Mesh\n"
       << "  source:        " << mesh.description();
     if (p.mesh.source == "file")

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -282,6 +283,16 @@ namespace palpate
                                             t.speed,
                                             t.duration,
                                             t.seed);
-    return std::make_unique<Replay>(scene.resolve_path(t.file_name));
+    const std::string path = scene.resolve_path(t.file_name);
+    std::error_code   error;
+    if (!std::filesystem::exists(path, error))
+      throw scene.error("Haptics/Trajectory/File name",
+                        "the recording '" + t.file_name +
+                          "' was not found: looked for " +
+                          scene.where_looked(t.file_name),
+                        "a relative path is relative to the scene file's "
+                        "directory; give the recording's path from there, "
+                        "or an absolute one.");
+    return std::make_unique<Replay>(path);
   }
 } // namespace palpate

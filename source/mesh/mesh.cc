@@ -116,11 +116,15 @@ namespace palpate
         if (!in)
           throw scene.error(
             "Mesh/File name",
-            "the surface file '" + path + "' " +
-              (fs::exists(path, exists_error) ? "cannot be read" :
-                                                "does not exist"),
-            "a relative path is relative to the directory of the scene "
-            "file.");
+            fs::exists(path, exists_error) ?
+              "the surface file '" + path + "' cannot be read" :
+              "the surface file '" + p.file_name +
+                "' was not found: looked for " +
+                scene.where_looked(p.file_name),
+            "a relative path is relative to the scene file's directory; "
+            "the example organs are in the project's meshes/ (its "
+            "README), e.g. '../meshes/liver-tetgen/liver2k-surface.obj' "
+            "from parameters/.");
         std::ostringstream s;
         s << in.rdbuf();
         bytes = s.str();
@@ -480,11 +484,12 @@ namespace palpate
     if (!std::filesystem::exists(path, exists_error) && !exists_error)
       throw scene.error(
         "Mesh/File name",
-        "the mesh file '" + path + "' does not exist",
-        "a relative path is relative to the directory of the scene file. "
-        "The shared liver meshes are in ../shared/meshes next to the "
-        "project (see its README); or use Source = blob, which needs no "
-        "file.");
+        "the mesh file '" + p.file_name + "' was not found: looked for " +
+          scene.where_looked(p.file_name),
+        "a relative path is relative to the scene file's directory; the "
+        "example organs are in the project's meshes/ (its README), e.g. "
+        "'../meshes/liver-tetgen/liver501.msh' from parameters/. Or use "
+        "Source = blob, which needs no file.");
     std::unique_ptr<Mesh> mesh;
     try
       {

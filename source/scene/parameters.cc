@@ -70,8 +70,9 @@ namespace palpate
           ".vtu (ASCII or base64 binary, uncompressed). Only linear "
           "tetrahedra form the body; triangles set boundary ids. With "
           "Source = surface: the organ's closed surface (.stl, .obj, .ply, "
-          ".vtk POLYDATA, .vtp). A relative path is relative to the "
-          "directory of the scene file.");
+          ".vtk POLYDATA, .vtp). A relative path is looked up against the "
+          "scene file's directory first (see 'Relative paths' at the top "
+          "of doc/parameters.md).");
         prm.declare_entry("Scale factor",
                           "1",
                           Patterns::Double(0.),

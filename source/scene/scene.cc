@@ -21,6 +21,7 @@
 #include <functional>
 #include <iostream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -500,6 +501,97 @@ namespace palpate
                           dealii_words,
                         "fix the line the message names.");
     }
+
+    /** A `--set ENTRY=VALUE` from the command line, checked against the
+     * declared parameters. */
+    struct CommandLineSetting
+    {
+      std::vector<std::string> path; // subsections
+      std::string              name, value;
+    };
+
+    /**
+     * Check the command line's `--set ENTRY=VALUE` strings: the entry must
+     * exist, deal.II's pattern must accept the value, and each entry may be
+     * set once. The errors name the --set (not the scene file, which is
+     * fine) with the same help as a bad line in a file.
+     */
+    std::vector<CommandLineSetting>
+    parse_command_line_settings(const std::vector<std::string> &settings)
+    {
+      std::vector<CommandLineSetting> parsed;
+      std::set<std::string>           keys;
+      for (const std::string &text : settings)
+        {
+          const auto fail = [&](const std::string &problem,
+                                const std::string &fix) {
+            return InputError("command line", 0, "--set " + text, problem, fix);
+          };
+          const std::string example =
+            "e.g. --set 'Material model/Model name=Neo-Hookean' (the "
+            "subsections and the entry separated by '/'); 'palpate "
+            "--print-parameters' lists every entry.";
+          const auto equal = text.find('=');
+          if (equal == std::string::npos)
+            throw fail("--set takes ENTRY=VALUE", example);
+          CommandLineSetting s;
+          s.path  = Utilities::split(text.substr(0, equal), '/');
+          s.value = Utilities::trim(text.substr(equal + 1));
+          s.name  = s.path.back();
+          s.path.pop_back();
+          if (s.name.empty() ||
+              std::find(s.path.begin(), s.path.end(), "") != s.path.end())
+            throw fail("the entry's path has an empty name", example);
+          const DeclaredSection *here = &declared_tree();
+          for (std::size_t i = 0; i < s.path.size(); ++i)
+            {
+              const DeclaredSection *next = here->find_subsection(s.path[i]);
+              if (next == nullptr)
+                throw fail("there is no subsection '" + s.path[i] + "' in " +
+                             path_to_string(std::vector<std::string>(
+                               s.path.begin(), s.path.begin() + i)),
+                           suggestion(s.path[i], here->subsection_names()) +
+                             "The subsections there are: " +
+                             join(here->subsection_names(), ", ") + ". " +
+                             example);
+              here = next;
+            }
+          const DeclaredEntry *entry = here->find_entry(s.name);
+          if (entry == nullptr)
+            throw fail("there is no entry '" + s.name + "' in " +
+                         path_to_string(s.path),
+                       suggestion(s.name, here->entry_names()) +
+                         (here->entry_names().empty() ?
+                            std::string("That is a subsection without "
+                                        "entries of its own. ") :
+                            "The entries there are: " +
+                              join(here->entry_names(), ", ") + ". ") +
+                         example);
+          // deal.II's own pattern check, as for a line in the file.
+          dealii::ParameterHandler prm;
+          Parameters::AllParameters::declare_parameters(prm);
+          for (const auto &name : s.path)
+            prm.enter_subsection(name);
+          try
+            {
+              prm.set(s.name, s.value);
+            }
+          catch (const std::exception &)
+            {
+              throw fail("'" + s.value +
+                           "' is not allowed here: the entry "
+                           "takes " +
+                           describe_pattern(entry->pattern_description),
+                         "give such a value (its default is '" +
+                           entry->default_value + "').");
+            }
+          if (!keys.insert(entry_key(s.path, s.name)).second)
+            throw fail("the entry is set twice on the command line",
+                       "give one --set per entry.");
+          parsed.push_back(s);
+        }
+      return parsed;
+    }
   } // namespace
 
 
@@ -514,8 +606,13 @@ namespace palpate
 
 
   Scene
-  Scene::read(const std::string &filename)
+  Scene::read(const std::string              &filename,
+              const std::vector<std::string> &command_line)
   {
+    // The command line's --set entries first: a mistake there is reported
+    // as one, whatever the file holds.
+    const std::vector<CommandLineSetting> overrides =
+      parse_command_line_settings(command_line);
     namespace fs = std::filesystem;
     Scene scene{Unparsed()};
     scene.file_      = filename;
@@ -615,6 +712,20 @@ namespace palpate
     // caught instead of the last one silently winning.
     if (content.empty() || content.back() != '\n')
       content += '\n';
+    // The --set entries are read after the file, as lines of their own
+    // (below its last line, so the actions below tell them apart), and
+    // win over the file's values.
+    const unsigned int file_lines = lines.size();
+    for (const CommandLineSetting &o : overrides)
+      {
+        for (const auto &name : o.path)
+          content += "subsection " + name + "\n";
+        content += "set " + o.name + " = " + o.value + "\n";
+        for (std::size_t i = 0; i < o.path.size(); ++i)
+          content += "end\n";
+        scene.command_line_settings_.push_back(entry_key(o.path, o.name) + "=" +
+                                               o.value);
+      }
     std::istringstream stream(content);
     const auto         line_now = [&]() -> unsigned int {
       const std::streamoff position = stream.tellg();
@@ -695,6 +806,12 @@ namespace palpate
     std::map<std::string, const Setting *> first_setting;
     for (const Setting &s : settings)
       {
+        if (s.line > file_lines) // a --set: it replaces the file's value
+          {
+            scene.entry_lines_[s.key]  = 0;
+            scene.entry_values_[s.key] = s.value;
+            continue;
+          }
         const auto [it, first] = first_setting.emplace(s.key, &s);
         if (!first)
           throw InputError(filename,
@@ -727,8 +844,8 @@ namespace palpate
               const double x   = std::strtod(piece.c_str(), &end);
               if (end != piece.c_str() && errno == ERANGE)
                 throw InputError(
-                  filename,
-                  s.line,
+                  s.line > file_lines ? std::string("command line") : filename,
+                  s.line > file_lines ? 0 : s.line,
                   shown_key(s.key) + " = " + s.value,
                   "'" + piece + "' is out of the range of numbers palpate " +
                     "computes with (" +
@@ -752,15 +869,69 @@ namespace palpate
 
 
 
+  namespace
+  {
+    /** The candidates Scene::resolve_path() tries, in order, without
+     * repeats. */
+    std::vector<std::string>
+    path_candidates(const std::string &directory, const std::string &path)
+    {
+      namespace fs = std::filesystem;
+      if (path.empty() || fs::path(path).is_absolute())
+        return {path};
+      std::vector<std::string> candidates;
+      const auto               add = [&](const fs::path &base) {
+        const std::string c = (base / path).lexically_normal().string();
+        if (std::find(candidates.begin(), candidates.end(), c) ==
+            candidates.end())
+          candidates.push_back(c);
+      };
+      add(directory.empty() ? fs::path() : fs::path(directory));
+      add(fs::path());
+#ifdef PALPATE_SOURCE_DIR
+      add(fs::path(PALPATE_SOURCE_DIR) / "parameters");
+#endif
+      return candidates;
+    }
+  } // namespace
+
+
+
   std::string
   Scene::resolve_path(const std::string &path) const
   {
-    if (path.empty() || std::filesystem::path(path).is_absolute() ||
-        directory_.empty())
-      return path;
-    return (std::filesystem::path(directory_) / path)
-      .lexically_normal()
-      .string();
+    const auto candidates = path_candidates(directory_, path);
+    for (const auto &c : candidates)
+      {
+        // error_code: a name the file system refuses (too long, a loop of
+        // links) is not there; the caller's message says so.
+        std::error_code error;
+        if (std::filesystem::exists(c, error))
+          return c;
+      }
+    return candidates.front();
+  }
+
+
+
+  std::string
+  Scene::where_looked(const std::string &path) const
+  {
+    const auto  candidates = path_candidates(directory_, path);
+    std::string text;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      {
+        // Absolute: "../meshes/x.msh" would not say where that was.
+        std::error_code error;
+        const auto      shown = std::filesystem::absolute(candidates[i], error);
+        text +=
+          (i == 0                     ? "" :
+           i + 1 == candidates.size() ? " or " :
+                                        ", ") +
+          ("'" + (error ? candidates[i] : shown.lexically_normal().string()) +
+           "'");
+      }
+    return text;
   }
 
 
@@ -781,6 +952,15 @@ namespace palpate
   {
     std::string shown = std::regex_replace(entry, std::regex("/"), " / ");
     const auto  value = entry_values_.find(entry);
+    for (const std::string &setting : command_line_settings_)
+      if (setting.compare(0, entry.size() + 1, entry + "=") == 0)
+        return InputError("command line",
+                          0,
+                          "--set " + setting + " (scene " +
+                            (file_.empty() ? std::string("(default)") : file_) +
+                            ")",
+                          problem,
+                          fix);
     if (value != entry_values_.end())
       shown += " = " + value->second;
     else
@@ -1185,7 +1365,26 @@ namespace palpate
            "built-in organ-like blob, St.Venant-Kirchhoff, no effects.\n\n"
         << "This page is generated by `palpate --print-parameters markdown "
            "> doc/parameters.md`; the test `scene/parameter_reference` fails "
-           "when it is out of date.\n";
+           "when it is out of date.\n\n"
+        << "**Relative paths.** A file a scene reads (Mesh / File name, "
+           "Haptics / Trajectory / File name) may be given relative to the "
+           "scene file's directory: the shipped scenes name the example "
+           "organs as `../meshes/...`. If it is not there, palpate looks "
+           "relative to the current directory, then relative to "
+           "`parameters/` of the palpate source tree it was built from, so "
+           "a scene copied out of `parameters/` still finds its organ. A "
+           "file found nowhere is reported with every place looked. Files "
+           "a scene writes (Output / Directory, State space / Store, the "
+           "volume meshes of Mesh / Surface) are relative to the current "
+           "directory.\n\n"
+        << "**Variants without copying.** Every command that reads a scene "
+           "takes `--set ENTRY=VALUE`, repeatable, with the entry's path "
+           "from the top (subsections and entry separated by `/`), e.g. "
+           "`palpate parameters/liver-stvk.prm --set 'Material model/Model "
+           "name=Neo-Hookean' --set \"Material model/Neo-Hookean/Young's "
+           "modulus=15465\"`. It replaces the file's value (or the "
+           "default), is checked like a line of the file, and the scene "
+           "report lists it first.\n";
     for (const auto &[name, sub] : declared_tree().subsections)
       print_markdown_section(out, sub, {name});
   }

@@ -2,7 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 // The hand never falls through the tissue (issue 10). St.Venant-Kirchhoff
-// on the shipped liver (parameters/liver-stvk.prm) has no equilibrium
+// on the shipped liver (parameters/paper-stvk.prm) has no equilibrium
 // beyond about 2.5 cm of push at its active node: the cells there hold
 // failure points, and beyond 10 cm the grid ends. The HIP is pushed 11 cm
 // into the liver in 0.5 mm steps; at each step the engine is given the
@@ -57,7 +57,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene       scene = shipped_scene("liver-stvk.prm");
+  palpate::Scene       scene = shipped_scene("paper-stvk.prm");
   palpate::Interaction interaction(scene);
   interaction.force({{0, 0, 0}});
   interaction.attach();

@@ -109,17 +109,17 @@ main(int argc, char **argv)
   const palpate::Utilities::Point3 at_rest = {{0, 0, 0}};
   for (const bool reuse : {false, true})
     {
-      check("liver501 StVK", shipped_scene("liver-stvk.prm"), push, reuse);
-      palpate::Scene nh                       = shipped_scene("liver-stvk.prm");
+      check("liver501 StVK", shipped_scene("paper-stvk.prm"), push, reuse);
+      palpate::Scene nh                       = shipped_scene("paper-stvk.prm");
       nh.parameters.material_model.model_name = "Neo-Hookean";
       check("liver501 neo-Hookean", nh, push, reuse);
       check("liver501 Mooney-Rivlin",
-            shipped_scene("liver-mooney-rivlin.prm"),
+            shipped_scene("paper-mooney-rivlin.prm"),
             push,
             reuse);
     }
   check("liver501 StVK at rest",
-        shipped_scene("liver-stvk.prm"),
+        shipped_scene("paper-stvk.prm"),
         at_rest,
         false);
   palpate::Scene tip = shipped_scene("beam.prm");
@@ -134,7 +134,7 @@ main(int argc, char **argv)
   // so that the sphere slides and K has off-diagonal terms.
   for (const bool reuse : {false, true})
     {
-      palpate::Scene sphere = shipped_scene("liver-stvk.prm");
+      palpate::Scene sphere = shipped_scene("paper-stvk.prm");
       auto          &a      = sphere.parameters.boundary_conditions.active_node;
       a.tip                 = palpate::Parameters::ActiveNode::Tip::sphere;
       a.tip_radius          = 0.01;

@@ -35,7 +35,7 @@ main(int argc, char **argv)
   for (const std::string name :
        {"MUMPS", "UMFPACK", "KLU", "Amesos MUMPS", "Amesos KLU"})
     {
-      palpate::Scene scene                  = shipped_scene("liver-stvk.prm");
+      palpate::Scene scene                  = shipped_scene("paper-stvk.prm");
       scene.parameters.linear_solver.solver = name;
       const Body           body(scene);
       palpate::StateSolver a(body.mesh, body.nodes, body.scene.parameters),

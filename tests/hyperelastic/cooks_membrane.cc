@@ -31,7 +31,7 @@ namespace
                    const unsigned int n,
                    bool              &converged)
   {
-    palpate::Scene scene = shipped_scene("liver-mooney-rivlin.prm");
+    palpate::Scene scene = shipped_scene("paper-mooney-rivlin.prm");
     auto          &p     = scene.parameters;
     const double   E = 240.565e6, nu = 0.499;
     const double   mu = E / (2 * (1 + nu)), kappa = E / (3 * (1 - 2 * nu));

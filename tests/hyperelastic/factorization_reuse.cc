@@ -21,7 +21,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  const Body           body(shipped_scene("liver-stvk.prm"));
+  const Body           body(shipped_scene("paper-stvk.prm"));
   const auto          &p = body.scene.parameters;
   palpate::StateSolver direct(body.mesh, body.nodes, p),
     reuse(body.mesh, body.nodes, p);

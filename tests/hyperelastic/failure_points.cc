@@ -52,7 +52,7 @@ main(int argc, char **argv)
 
   for (const std::string material : {"St.Venant-Kirchhoff", "Neo-Hookean"})
     {
-      palpate::Scene scene        = shipped_scene("liver-stvk.prm");
+      palpate::Scene scene        = shipped_scene("paper-stvk.prm");
       auto          &p            = scene.parameters;
       p.material_model.model_name = material;
       const Body           body(scene);

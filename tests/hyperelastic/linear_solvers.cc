@@ -19,7 +19,7 @@ main(int argc, char **argv)
   palpate::State reference;
   for (const auto &[solver_name, ordering] : every_linear_solver())
     {
-      palpate::Scene scene                    = shipped_scene("liver-stvk.prm");
+      palpate::Scene scene                    = shipped_scene("paper-stvk.prm");
       scene.parameters.linear_solver.solver   = solver_name;
       scene.parameters.linear_solver.ordering = ordering;
       scene.parameters.nonlinear_solver.residual_tolerance = 1e-10;

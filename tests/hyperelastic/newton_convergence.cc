@@ -26,7 +26,7 @@ main(int argc, char **argv)
 
   for (const std::string material : {"St.Venant-Kirchhoff", "Neo-Hookean"})
     {
-      palpate::Scene scene = shipped_scene("liver-stvk.prm");
+      palpate::Scene scene = shipped_scene("paper-stvk.prm");
       auto          &p     = scene.parameters;
       // Quadratic convergence is a property of the exact Newton step: no
       // GMRES with a kept factorisation here.
@@ -58,7 +58,7 @@ main(int argc, char **argv)
     }
 
   // Path independence.
-  palpate::Scene scene = shipped_scene("liver-stvk.prm");
+  palpate::Scene scene = shipped_scene("paper-stvk.prm");
   scene.parameters.nonlinear_solver.residual_tolerance = 1e-11;
   const Body           body(scene);
   palpate::StateSolver solver(body.mesh, body.nodes, scene.parameters);

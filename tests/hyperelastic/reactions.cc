@@ -50,7 +50,7 @@ main(int argc, char **argv)
   palpate::State eliminated;
   for (const std::string treatment : {"elimination", "multipliers"})
     {
-      palpate::Scene scene = shipped_scene("liver-stvk.prm");
+      palpate::Scene scene = shipped_scene("paper-stvk.prm");
       scene.parameters.boundary_conditions.fixed_nodes.treatment = treatment;
       scene.parameters.nonlinear_solver.residual_tolerance       = 1e-11;
       const Body           body(scene);
@@ -124,7 +124,7 @@ main(int argc, char **argv)
   // multiplier is still the reaction, and reactions still balance.
   for (const std::string element : {"P1-P1", "Taylor-Hood"})
     {
-      palpate::Scene scene = shipped_scene("liver-mooney-rivlin.prm");
+      palpate::Scene scene = shipped_scene("paper-mooney-rivlin.prm");
       scene.parameters.material_model.set("Mooney-Rivlin", "Element", element);
       scene.parameters.nonlinear_solver.residual_tolerance = 1e-11;
       const Body           body(scene);

@@ -25,7 +25,7 @@ main(int argc, char **argv)
 
   // Exact Newton steps (no kept factorisation), so that two solves of the
   // same transition can be compared iteration for iteration.
-  palpate::Scene scene = shipped_scene("liver-stvk.prm");
+  palpate::Scene scene = shipped_scene("paper-stvk.prm");
   scene.parameters.nonlinear_solver.set_reuse(false);
   const Body           body(scene);
   palpate::StateSolver solver(body.mesh, body.nodes, body.scene.parameters);

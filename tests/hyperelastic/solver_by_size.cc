@@ -38,12 +38,12 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  palpate::Scene stvk = shipped_scene("liver-stvk.prm");
+  palpate::Scene stvk = shipped_scene("paper-stvk.prm");
   AssertThrow(stvk.parameters.nonlinear_solver.reuse_by_size &&
                 stvk.parameters.linear_solver.ordering == "by size",
               dealii::ExcMessage("the shipped scene should use the defaults"));
   report("liver501 StVK", stvk);
-  report("liver501 Mooney-Rivlin", shipped_scene("liver-mooney-rivlin.prm"));
+  report("liver501 Mooney-Rivlin", shipped_scene("paper-mooney-rivlin.prm"));
 
   palpate::Scene beam        = shipped_scene("beam.prm");
   auto          &m           = beam.parameters.mesh;

@@ -102,7 +102,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  const palpate::Scene liver = shipped_scene("liver-stvk.prm");
+  const palpate::Scene liver = shipped_scene("paper-stvk.prm");
   const palpate::Scene beam  = shipped_scene("beam.prm");
 
   check("liver, St.Venant-Kirchhoff, elimination",
@@ -144,7 +144,7 @@ main(int argc, char **argv)
 
   // Mooney-Rivlin: the mixed u-p residual, P1-P1 (stabilised) and
   // Taylor-Hood, exact and penalised incompressibility.
-  const palpate::Scene mr = shipped_scene("liver-mooney-rivlin.prm");
+  const palpate::Scene mr = shipped_scene("paper-mooney-rivlin.prm");
   check("liver, Mooney-Rivlin P1-P1, exact",
         mr,
         "Mooney-Rivlin",

@@ -36,7 +36,7 @@ main(int argc, char **argv)
          {"Mooney-Rivlin", "Taylor-Hood"},
          {"Yeoh", "P1-P1"}})
     {
-      palpate::Scene scene = shipped_scene("liver-mooney-rivlin.prm");
+      palpate::Scene scene = shipped_scene("paper-mooney-rivlin.prm");
       auto          &p     = scene.parameters;
       p.mesh.source        = "beam";
       p.mesh.beam_length = L, p.mesh.beam_width = W, p.mesh.beam_height = H;

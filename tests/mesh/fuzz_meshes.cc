@@ -114,8 +114,8 @@ main(int argc, char **argv)
 
   const palpate::MeshData  beam  = small_beam();
   std::vector<std::string> seeds = write_every_format(beam);
-  seeds.push_back(palpate_shared_dir + "/meshes/liver-tetgen/liver501.msh");
-  seeds.push_back(palpate_shared_dir + "/meshes/liver-tetgen/liver501.vtk");
+  seeds.push_back(palpate_meshes_dir + "/liver-tetgen/liver501.msh");
+  seeds.push_back(palpate_meshes_dir + "/liver-tetgen/liver501.vtk");
 
   std::mt19937       rng(20261123);
   const unsigned int per_seed    = 600;

@@ -202,20 +202,20 @@ main(int argc, char **argv)
     if (e.path().extension() == ".prm")
       names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  // The scenes name their meshes relative to parameters/ (../../shared/);
-  // the mutants are written here, where a link 'shared' points to the
-  // shared data. The seeds then have the same bytes wherever the project
-  // is checked out, and so have the mutants.
-  std::filesystem::remove("shared");
-  std::filesystem::create_directory_symlink(
-    std::filesystem::absolute(palpate_shared_dir), "shared");
-  const std::string relative = "../../shared/";
+  // The scenes name their meshes relative to parameters/ (../meshes/);
+  // the mutants are written here, where a link 'organs' points to the
+  // project's meshes/. The seeds then have the same bytes wherever the
+  // project is checked out, and so have the mutants. (Not 'meshes': that
+  // is where a surface scene keeps the volume meshes it makes.)
+  std::filesystem::remove("organs");
+  std::filesystem::create_directory_symlink(palpate_meshes_dir, "organs");
+  const std::string relative = "../meshes/";
   for (const auto &n : names)
     {
       std::string text = read_file(palpate_source_dir + "/parameters/" + n);
       for (auto at = text.find(relative); at != std::string::npos;
            at      = text.find(relative))
-        text.replace(at, relative.size(), "shared/");
+        text.replace(at, relative.size(), "organs/");
       seeds.push_back(text);
     }
   // The mutants, generated first: the same on every run.

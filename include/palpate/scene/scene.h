@@ -10,6 +10,7 @@
 #include <iosfwd>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace palpate
 {
@@ -55,9 +56,25 @@ namespace palpate
      * makes no sense, like nu = 0.5) is reported as an InputError naming the
      * file, line, entry and a fix, with a "did you mean" suggestion for
      * misspelled names.
+     *
+     * @p settings are "ENTRY=VALUE" strings from the command line
+     * (`--set 'Material model/Model name=Neo-Hookean'`, the entry's path
+     * with '/' between subsections): a variant of the scene without
+     * copying it. Each replaces the file's value for its entry (or the
+     * default); an unknown entry, a value its pattern refuses or an entry
+     * set twice on the command line is an InputError naming the --set.
      */
     static Scene
-    read(const std::string &filename);
+    read(const std::string              &filename,
+         const std::vector<std::string> &settings = {});
+
+    /** The entries the command line set (`--set`), as "ENTRY=VALUE" with
+     * the entry's full path, in the order given. */
+    const std::vector<std::string> &
+    command_line_settings() const
+    {
+      return command_line_settings_;
+    }
 
     /** The parameters. */
     Parameters::AllParameters parameters;
@@ -70,11 +87,25 @@ namespace palpate
     }
 
     /**
-     * A path written in the scene, resolved against the scene file's
-     * directory if it is relative (so a scene can be run from anywhere).
+     * An input file's path written in the scene (a mesh, a surface, a
+     * recorded trajectory), resolved. A relative path is looked up, in
+     * this order, against the scene file's directory (so a scene runs from
+     * anywhere), the current directory, and the directory of the shipped
+     * scenes, parameters/ of the palpate source tree (so a scene copied out
+     * of parameters/ still finds the example organs its '../meshes/...'
+     * names). The first candidate that exists is returned; if none does,
+     * the first (the scene file's directory), and where_looked() says
+     * where the others were.
      */
     std::string
     resolve_path(const std::string &path) const;
+
+    /**
+     * The places resolve_path() looked for @p path, for a message:
+     * "'A', 'B' or 'C'".
+     */
+    std::string
+    where_looked(const std::string &path) const;
 
     /**
      * The line that sets @p entry ("Material model/Model name"), or 0 if
@@ -108,6 +139,7 @@ namespace palpate
     std::string                         directory_;
     std::map<std::string, unsigned int> entry_lines_;
     std::map<std::string, std::string>  entry_values_;
+    std::vector<std::string>            command_line_settings_;
   };
 
   /** Output formats for print_parameters(). */

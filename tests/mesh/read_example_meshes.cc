@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// Read the shared liver meshes in every format they come in and compare
-// node and cell counts, volume and bounding box (in file units and after
-// scaling to a 25 cm liver) with the values published in
-// ../shared/meshes/README.md. Volumes and boxes must agree to 1e-3
+// Read the example liver meshes (meshes/) in every format they come in and
+// compare node and cell counts, volume and bounding box (in file units and
+// after scaling to a 25 cm liver) with the values published in
+// meshes/README.md. Volumes and boxes must agree to 1e-3
 // relative (the README rounds to 5-6 digits).
 
 #include <palpate/mesh/mesh.h>
@@ -38,7 +38,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  // The numbers of ../shared/meshes/README.md.
+  // The numbers of meshes/README.md.
   const std::vector<Reference> references = {
     {"liver-tetgen/liver501.msh", 501, 1819, 38.118, -4.65046, 1.70220},
     {"liver-tetgen/liver501.vtk", 501, 1819, 38.118, -4.65046, 1.70220},
@@ -49,7 +49,7 @@ main(int argc, char **argv)
 
   for (const auto &r : references)
     {
-      const std::string       path = palpate_shared_dir + "/meshes/" + r.file;
+      const std::string       path = palpate_meshes_dir + "/" + r.file;
       const palpate::MeshData data = palpate::read_mesh_file(path);
       const palpate::Mesh     unit(data, 1.0, r.file);
       const palpate::Mesh     metres(data, scale, r.file);
@@ -93,12 +93,11 @@ main(int argc, char **argv)
 
   // The scaled liver is 25 cm long, as the README states (0.249 x 0.189 x
   // 0.172 m for liver501).
-  const palpate::Mesh liver(palpate::read_mesh_file(
-                              palpate_shared_dir +
-                              "/meshes/liver-tetgen/liver501.msh"),
-                            scale,
-                            "liver501.msh");
-  const auto          box = liver.bounding_box();
+  const palpate::Mesh liver(
+    palpate::read_mesh_file(palpate_meshes_dir + "/liver-tetgen/liver501.msh"),
+    scale,
+    "liver501.msh");
+  const auto box = liver.bounding_box();
   deallog << "liver501 size " << std::setprecision(3)
           << box.second[0] - box.first[0] << " x "
           << box.second[1] - box.first[1] << " x "
