@@ -106,7 +106,10 @@ namespace palpate
         {
           solver = std::make_unique<StateSolver>(mesh, nodes, p);
           rest   = std::make_shared<const State>(solver->rest_state());
-          ready.set_text(solver->linear_solver_name());
+          ready.set_text(solver->linear_solver_name() + ", Newton steps " +
+                         (solver->settings().reuse_factorization ?
+                            "by GMRES on a kept factorisation" :
+                            "with a factorisation each"));
           if (rest->has_stiffness)
             {
               // The client publishes the rest state itself.

@@ -521,8 +521,13 @@ namespace palpate
   ThreadEngine::description() const
   {
     const unsigned int n = impl->solvers.size();
+    // The Newton method too: 'Reuse factorization = by size' chose it
+    // from the system's size, and the summary says which.
     return std::to_string(n) + " solver thread" + (n > 1 ? "s" : "") + ", " +
-           impl->solvers.front()->linear_solver_name();
+           impl->solvers.front()->linear_solver_name() + ", Newton steps " +
+           (impl->solvers.front()->settings().reuse_factorization ?
+              "by GMRES on a kept factorisation" :
+              "with a factorisation each");
   }
 
 
