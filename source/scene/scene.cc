@@ -974,6 +974,31 @@ namespace palpate
 
 
 
+  namespace Limits
+  {
+    // Bounds on the numbers that set a loop count, an allocation or a
+    // time (issue 26): without them a typo hangs a run or overflows.
+    /** Moduli (Pa): below this round-off decides the force (fat, the
+     * softest tissue, is ~1e2 Pa). */
+    constexpr double min_modulus = 1e-3;
+    /** Haptics / Loop rate (Hz): below this there is no haptic loop. */
+    constexpr double min_loop_rate = 1;
+    /** Nonlinear solver / Number of increments: each is a Newton solve. */
+    constexpr unsigned int max_increments = 1000;
+    /** Nonlinear solver / Maximum Newton iterations per increment. */
+    constexpr unsigned int max_newton_iterations = 1000;
+    /** Nonlinear solver / Maximum line search steps: 2^-60 is below
+     * double precision. */
+    constexpr unsigned int max_line_search_steps = 60;
+    /** Nonlinear solver / Maximum cutbacks: 2^-30 of an increment. */
+    constexpr unsigned int max_cutbacks = 30;
+    /** Engine / Memory budget (MiB): 1 TiB; beyond, its byte count
+     * overflows. */
+    constexpr double max_memory_budget = 1 << 20;
+  } // namespace Limits
+
+
+
   void
   Scene::validate() const
   {
@@ -1003,6 +1028,16 @@ namespace palpate
                     "at most " + Utilities::to_string(max_modulus, 3) +
                       " Pa: stiffer than any solid (diamond is 1.2e12 Pa); "
                       "such moduli only overflow the solver's force scale",
+                    "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
+                    "(liver: E = 15465 Pa).");
+      else if (value > 0 && value < min_modulus)
+        throw error("Material model/" + m.model_name +
+                      (entry.empty() ? "" : "/" + entry),
+                    "at least " + Utilities::to_string(min_modulus, 3) +
+                      " Pa (or 0 where the model allows it): softer than "
+                      "any tissue (fat is about 1e2 Pa), so that the forces "
+                      "fall below round-off and Newton 'converges' on any "
+                      "state",
                     "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
                     "(liver: E = 15465 Pa).");
 
@@ -1232,11 +1267,61 @@ namespace palpate
                       std::to_string(cores) + ".");
     }
 
+    // The Newton solver's loop counts.
+    const auto  count_bound = [&](const std::string &entry,
+                                 const unsigned int value,
+                                 const unsigned int bound,
+                                 const std::string &why,
+                                 const std::string &fix) {
+      if (value > bound)
+        throw error("Nonlinear solver/" + entry,
+                    "at most " + std::to_string(bound) + ": " + why,
+                    fix);
+    };
+    count_bound("Number of increments",
+                n.n_increments,
+                max_increments,
+                "each increment is a Newton solve, and increments shorter "
+                "than the grid spacing change no state, they only cost time "
+                "(doc/accuracy-vs-time.md)",
+                "use 1 (Maximum increment length shortens long paths).");
+    count_bound("Maximum Newton iterations",
+                n.max_newton_iterations,
+                max_newton_iterations,
+                "Newton converges in a few iterations or not at all; more "
+                "only keep a solver from the states the hand needs",
+                "use 25 (the default).");
+    count_bound("Maximum line search steps",
+                n.max_line_search_steps,
+                max_line_search_steps,
+                "each halves the step, and 2^-60 of a step is below double "
+                "precision",
+                "use 16 (the default).");
+    count_bound("Maximum cutbacks",
+                n.max_cutbacks,
+                max_cutbacks,
+                "each halves the increment and solves it again; 2^-30 of "
+                "an increment moves the probe by nothing",
+                "use 2 (the default).");
+    if (p.engine.memory_budget > max_memory_budget)
+      throw error("Engine/Memory budget",
+                  "at most " + Utilities::to_string(max_memory_budget, 7) +
+                    " MiB (1 TiB): more than any machine palpate runs on, "
+                    "and beyond it the budget's byte count overflows",
+                  "give the memory for cached states in MiB, e.g. 1024.");
+
     // Haptics.
     const auto &h = p.haptics;
     if (h.loop_rate <= 0)
       throw error("Haptics/Loop rate",
                   "the rate must be positive",
+                  "use 1000 Hz.");
+    if (h.loop_rate < min_loop_rate)
+      throw error("Haptics/Loop rate",
+                  "at least " + Utilities::to_string(min_loop_rate, 3) +
+                    " Hz: a haptic loop renders forces at hundreds to "
+                    "thousands of ticks per second, and a run waits for "
+                    "its ticks",
                   "use 1000 Hz.");
     if (h.force_limit <= 0)
       throw error("Haptics/Force limit",
@@ -1253,6 +1338,12 @@ namespace palpate
                     "and the loop preallocates its statistics for every tick",
                   "use 1000 Hz.");
     const auto &t = h.trajectory;
+    if ((t.type == "circle" || t.type == "smooth random") && !(t.radius > 0))
+      throw error("Haptics/Trajectory/Radius",
+                  "a " + t.type +
+                    " needs a positive radius (with 0 every "
+                    "position of the probe is undefined)",
+                  "give the radius in metres, e.g. 0.01.");
     if ((t.type == "straight line" || t.type == "circle") &&
         Utilities::norm(t.direction) == 0)
       throw error("Haptics/Trajectory/Direction",

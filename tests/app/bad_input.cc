@@ -358,6 +358,41 @@ main(int argc, char **argv)
   scene("an entry name with a different case",
         "case.prm",
         beam + "subsection Mesh\n  set scale factor = 1\nend\n");
+  // Numbers that set a loop count, an allocation or a time are bounded
+  // (issue 26): each of these hung, overflowed or gave NaN with exit 0.
+  scene("a circle of radius 0",
+        "circle-zero.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Type = circle\n    set Radius = 0\n  end\nend\n");
+  scene("Memory budget = 1e14 MiB",
+        "budget-huge.prm",
+        beam + "subsection Engine\n  set Memory budget = 1e14\nend\n");
+  scene("Young's modulus = 1e-200 Pa",
+        "young-tiny.prm",
+        beam + "subsection Material model\n"
+               "  subsection St.Venant-Kirchhoff\n"
+               "    set Young's modulus = 1e-200\n"
+               "  end\nend\n");
+  scene("Loop rate = 1e-9 Hz",
+        "loop-slow.prm",
+        beam + "subsection Haptics\n  set Loop rate = 1e-9\nend\n");
+  scene("Number of increments = 1000000000",
+        "increments.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Number of increments = 1000000000\nend\n");
+  scene("Maximum Newton iterations = 1000000000",
+        "iterations.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Maximum Newton iterations = 1000000000\n"
+               "  set Residual tolerance = 1e-300\nend\n");
+  scene("Maximum line search steps = 1000000000",
+        "line-search.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Maximum line search steps = 1000000000\nend\n");
+  scene("Maximum cutbacks = 1000000000",
+        "cutbacks.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Maximum cutbacks = 1000000000\nend\n");
   run("'solve' without a scene", "solve");
   run("'solve --to' with two numbers", "solve good.prm --to 0,0");
   run("an unexpected second argument", "good.prm other.prm");
