@@ -621,6 +621,21 @@ namespace palpate
         err << "\npalpate: output failed: " << e.what() << "\n";
         return ExitStatus::output_failed;
       }
+    catch (const std::filesystem::filesystem_error &e)
+      {
+        // A path the file system refuses (a loop of links, a name too
+        // long, no permission) that no check above named: the user's
+        // input, said as such, with the path.
+        out.flush();
+        err << "\npalpate: the input has a problem: the file system refuses "
+               "the path '"
+            << e.path1().string() << "' (" << e.code().message()
+            << ")\n  fix:     check the paths the scene and the command "
+               "line name (Output / Directory, State space / Store, the "
+               "mesh): a loop of symbolic links, a name longer than the "
+               "system allows, or a missing permission.\n";
+        return ExitStatus::input_error;
+      }
     catch (const NotAvailableError &e)
       {
         out.flush();

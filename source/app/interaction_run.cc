@@ -49,9 +49,12 @@ namespace palpate
         }
       catch (const std::filesystem::filesystem_error &e)
         {
+          // error_code: the path may be one the file system refuses
+          // altogether (a loop of links).
+          std::error_code error;
           problem = std::string("it cannot be created: ") + e.code().message() +
-                    (std::filesystem::exists(directory) &&
-                         !std::filesystem::is_directory(directory) ?
+                    (std::filesystem::exists(directory, error) &&
+                         !std::filesystem::is_directory(directory, error) ?
                        " (a file of that name is in the way)" :
                        "");
         }

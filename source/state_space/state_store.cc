@@ -447,7 +447,15 @@ namespace palpate
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     Impl &s = *impl;
     s.file  = file;
-    if (!std::filesystem::exists(file))
+    // error_code: a path the file system refuses (a loop of links, a name
+    // too long) is the user's input, not an internal error.
+    std::error_code error;
+    const bool      exists = std::filesystem::exists(file, error);
+    if (error)
+      s.fail("the file system refuses this path: " + error.message(),
+             "name a store file in a directory you can write, e.g. "
+             "'liver.h5'.");
+    if (!exists)
       {
         // The sizes come with the first state: create lazily then. Until
         // then the fingerprint is kept.

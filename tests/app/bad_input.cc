@@ -393,6 +393,18 @@ main(int argc, char **argv)
         "cutbacks.prm",
         beam + "subsection Nonlinear solver\n"
                "  set Maximum cutbacks = 1000000000\nend\n");
+  // Paths the file system refuses: a link to itself.
+  std::filesystem::remove("loop");
+  std::filesystem::create_symlink("loop", "loop");
+  scene("an output directory that is a loop of links",
+        "outdir-loop.prm",
+        interaction + beam_body +
+          "subsection Output\n  set Directory = loop\nend\n"
+          "subsection Effects\n  set Force log = true\nend\n");
+  scene("a state store that is a loop of links",
+        "store-loop.prm",
+        interaction + beam_body +
+          "subsection State space\n  set Store = loop\nend\n");
   run("'solve' without a scene", "solve");
   run("'solve --to' with two numbers", "solve good.prm --to 0,0");
   run("an unexpected second argument", "good.prm other.prm");
