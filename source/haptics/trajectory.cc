@@ -160,6 +160,32 @@ namespace palpate
   Replay::Replay(const std::string &filename)
     : file(filename)
   {
+    // A recording is a CSV of at most an hour at 1 kHz (~150 MB at most,
+    // a few MB usually): a device file (/dev/zero) or a huge file is
+    // refused before anything is read, instead of growing without bound.
+    {
+      constexpr std::uintmax_t max_bytes = std::uintmax_t(256) << 20;
+      std::error_code          error;
+      const auto status = std::filesystem::status(filename, error);
+      if (!error && std::filesystem::exists(status) &&
+          !std::filesystem::is_regular_file(status))
+        throw InputError(filename,
+                         0,
+                         "trajectory replay (Haptics / Trajectory / File name)",
+                         "this is not a regular file (a directory, a device "
+                         "or a pipe)",
+                         "name the recording's CSV file.");
+      const auto size = std::filesystem::file_size(filename, error);
+      if (!error && size > max_bytes)
+        throw InputError(filename,
+                         0,
+                         "trajectory replay (Haptics / Trajectory / File name)",
+                         "the file has " + std::to_string(size >> 20) +
+                           " MiB; a recording of an hour at 1 kHz has about "
+                           "150 MiB, and at most 256 MiB are read",
+                         "check that this is the recording (t, x, y, z per "
+                         "line), or shorten it.");
+    }
     std::ifstream in(filename);
     if (!in)
       throw InputError(

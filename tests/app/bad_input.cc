@@ -169,6 +169,11 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = path.csv\n  end\nend\n");
+  scene("a replay trajectory that is /dev/zero",
+        "replay-zero.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = /dev/zero\n  end\nend\n");
   run("a scene file that does not exist", "no-such-scene.prm");
   run("an unknown option", "--frobnicate");
 
