@@ -33,8 +33,8 @@
 namespace palpate
 {
   /** The page (serve_page.cc): three.js draws the surface, the HIP and the
-   * force; the mouse drags the HIP in the view plane, the wheel moves it
-   * in depth. */
+   * force; a drag on the organ moves the HIP in the view plane (with Alt,
+   * in depth), other drags and the wheel turn, pan and zoom the view. */
   extern const char *const live_view_page;
 
   /** three.js, compiled in (live_view_assets.cc). */
@@ -44,6 +44,8 @@ namespace palpate
     three_core();
     std::string_view
     three_module();
+    std::string_view
+    orbit_controls();
   } // namespace live_view_assets
 
   namespace
@@ -110,6 +112,29 @@ namespace palpate
             return "outside the state space";
         }
     }
+
+    /** The outward unit normal of the surface at vertex @p v: the
+     * area-weighted mean of the normals of the surface triangles around
+     * it (Mesh orients them outward), or 0 if it is on none. */
+    Utilities::Point3
+    outward_normal(const Mesh &mesh, const unsigned int v)
+    {
+      const auto       &x = mesh.vertices();
+      Utilities::Point3 n{{0, 0, 0}};
+      for (const auto &face : mesh.surface_faces())
+        {
+          const auto &t = face.vertices;
+          if (t[0] != v && t[1] != v && t[2] != v)
+            continue;
+          // Twice the area times the unit normal.
+          const auto c = Utilities::cross(Utilities::minus(x[t[1]], x[t[0]]),
+                                          Utilities::minus(x[t[2]], x[t[0]]));
+          for (unsigned int k = 0; k < 3; ++k)
+            n[k] += c[k];
+        }
+      const double length = Utilities::norm(n);
+      return length > 0 ? Utilities::scaled(n, 1 / length) : n;
+    }
   } // namespace
 
 
@@ -162,31 +187,26 @@ namespace palpate
       for (const unsigned int v : interaction.nodes().fixed_vertices)
         if (compact.count(v) > 0)
           fixed.push_back(compact[v]);
-      const auto  active = compact.find(interaction.nodes().active_vertex);
-      const auto &grid   = interaction.grid();
+      // The surface vertices' numbers as the mesh file gives them: the
+      // page names nodes by these, as the scene report and the scene's
+      // Active node / Node id do, never by its own (surface) or deal.II's
+      // (vertex) indices.
+      std::vector<double> ids;
+      for (const unsigned int v : surface)
+        ids.push_back(mesh.node_id(v));
+      const auto        &grid = interaction.grid();
       std::ostringstream m;
       m << "{\"vertices\":" << json_array(xyz, 9)
         << ",\"triangles\":" << json_array(tri, 9)
-        << ",\"fixed\":" << json_array(fixed, 9) << ",\"active\":"
-        << (active == compact.end() ? -1 : int(active->second))
+        << ",\"nodes\":" << json_array(ids, 17)
+        << ",\"fixed\":" << json_array(fixed, 9)
         << ",\"spacing\":" << grid.spacing()
         << ",\"extent\":" << grid.spacing() * grid.half_width()
         << ",\"diameter\":" << mesh.diameter()
         << ",\"scene\":" << json_string(interaction.scene().file());
-      // A sphere probe: its centre at HIP = 0 and its radius (m), so that
-      // the page draws the indenter where it touches, not a marker at the
-      // active node.
-      const auto &tip =
-        interaction.scene().parameters.boundary_conditions.active_node;
-      if (tip.tip == Parameters::ActiveNode::Tip::sphere)
-        {
-          const auto &c = interaction.nodes().sphere_center;
-          m << ",\"sphere\":[" << c[0] << "," << c[1] << "," << c[2] << ","
-            << tip.tip_radius << "]";
-        }
       m << ",\"engine\":" << json_string(interaction.summary().engine);
-      m << "}";
       mesh_json = m.str();
+      describe_active();
       displacement.assign(3 * surface.size(), 0.0);
 
       if (live_view_assets::three_module().empty())
@@ -196,6 +216,37 @@ namespace palpate
           "when cmake ran. Install npm (apt-get install npm), then run cmake "
           "and make again: cmake installs three.js from npm into the build "
           "tree and builds it in");
+    }
+
+    /** The active node as /mesh and /frame give it (active_json), made
+     * again when it changes: its number in the mesh file, the outward
+     * normal of the surface there (the page's first camera looks along
+     * it, at the probe's side of the organ) and, with a sphere probe, the
+     * sphere's centre at HIP = 0 and its radius (m), so that the page
+     * draws the indenter where it touches, not a marker at the node.
+     * Called with mutex held, or before the server runs. */
+    void
+    describe_active()
+    {
+      const Mesh          &mesh  = interaction.mesh();
+      const NodeSelection &nodes = interaction.nodes();
+      const auto          &tip =
+        interaction.scene().parameters.boundary_conditions.active_node;
+      const bool sphere = tip.tip == Parameters::ActiveNode::Tip::sphere;
+      const bool none   = nodes.active_vertex == NodeSelection::no_active_node;
+      std::ostringstream a;
+      a << "\"active\":" << (none ? -1L : mesh.node_id(nodes.active_vertex))
+        << ",\"normal\":"
+        << json_point(sphere ? nodes.active_normal :
+                      none   ? Utilities::Point3{{0, 0, 0}} :
+                               outward_normal(mesh, nodes.active_vertex));
+      if (sphere)
+        {
+          const auto &c = nodes.sphere_center;
+          a << ",\"sphere\":"
+            << json_array({c[0], c[1], c[2], tip.tip_radius}, 17);
+        }
+      active_json = a.str();
     }
 
     /** The device: at the loop rate, move the HIP toward the target as a
@@ -343,11 +394,7 @@ namespace palpate
         << ",\"failed\":" << counts.second << ",\"cloud_complete\":"
         << (interaction.initial_cloud_complete() ? "true" : "false")
         << ",\"attached\":" << (interaction.attached() ? "true" : "false")
-        << ",\"active\":"
-        << (surface_index.count(interaction.nodes().active_vertex) ?
-              int(surface_index.at(interaction.nodes().active_vertex)) :
-              -1)
-        << ",\"load\":{\"workers\":" << load.workers
+        << "," << active_json << ",\"load\":{\"workers\":" << load.workers
         << ",\"busy\":" << load.busy << ",\"queued\":" << load.queued
         << ",\"states_per_second\":" << json_number(states_per_second)
         << ",\"utilisation\":" << json_number(utilisation) << "}"
@@ -363,9 +410,10 @@ namespace palpate
     static constexpr double                  max_acceleration = 1.0;
     std::vector<unsigned int>                surface;
     std::vector<std::array<unsigned int, 3>> triangles, dofs;
-    std::string                              mesh_json;
-    std::vector<double>                      displacement;
-    std::atomic<double>                      target[3], hip[3], force[3];
+    // /mesh without the active node, and the active node (mutex).
+    std::string         mesh_json, active_json;
+    std::vector<double> displacement;
+    std::atomic<double> target[3], hip[3], force[3];
     // The device's HIP and velocity (device_mutex).
     Utilities::Point3 device_position{{0, 0, 0}}, device_velocity{{0, 0, 0}};
     std::atomic<std::uint8_t> cause{0};
@@ -426,6 +474,7 @@ namespace palpate
         {
           std::lock_guard<std::mutex> lock(device_mutex), frame_lock(mutex);
           interaction.change_parameters(p);
+          describe_active();
           // Another active node: the device at rest on it (a target sent
           // meanwhile was for the old one).
           if (rest)
@@ -471,17 +520,22 @@ namespace palpate
                  res.status = 204;
                });
     // three.js's modules: the page imports three.module.js, which imports
-    // ./three.core.js.
+    // ./three.core.js, and OrbitControls.js, which imports 'three' (the
+    // page's import map: /three.module.js, the same module).
     for (const auto &[path, module] :
          {std::make_pair("/three.module.js", live_view_assets::three_module()),
-          std::make_pair("/three.core.js", live_view_assets::three_core())})
+          std::make_pair("/three.core.js", live_view_assets::three_core()),
+          std::make_pair("/OrbitControls.js",
+                         live_view_assets::orbit_controls())})
       server.Get(
         path,
         [module = module](const httplib::Request &, httplib::Response &res) {
           res.set_content(module.data(), module.size(), "text/javascript");
         });
     server.Get("/mesh", [&s](const httplib::Request &, httplib::Response &res) {
-      res.set_content(s.mesh_json, "application/json");
+      std::lock_guard<std::mutex> lock(s.mutex);
+      res.set_content(s.mesh_json + "," + s.active_json + "}",
+                      "application/json");
     });
     server.Get("/material",
                [&s](const httplib::Request &, httplib::Response &res) {
@@ -517,8 +571,10 @@ namespace palpate
           }
       });
     // On-the-fly changes (the paper's): a material constant, as
-    // "ENTRY=VALUE" of the scene's model; another active node, as the point
-    // "x,y,z" (m, mesh coordinates) whose nearest surface node it becomes.
+    // "ENTRY=VALUE" of the scene's model; another active node, as "node N"
+    // (N as the mesh file numbers it, as the scene's Active node / Node id
+    // and the scene report do) or as the point "x,y,z" (m, mesh
+    // coordinates) whose nearest surface node it becomes.
     server.Post(
       "/material", [&s](const httplib::Request &req, httplib::Response &res) {
         const auto eq = req.body.find('=');
@@ -556,27 +612,62 @@ namespace palpate
         std::string refused;
         try
           {
-            const auto point = Utilities::parse_point(req.body);
-            // A point on the organ: within its bounding box, enlarged by a
-            // tenth of its diameter (a huge or NaN point would select no
-            // node).
-            const auto [low, high] = s.interaction.mesh().bounding_box();
-            const double margin    = 0.1 * s.interaction.mesh().diameter();
-            for (unsigned int k = 0; k < 3; ++k)
-              if (!(point[k] >= low[k] - margin &&
-                    point[k] <= high[k] + margin))
-                throw std::invalid_argument(
-                  "the point (" + Utilities::to_string(point, 6) +
-                  ") m is not on the organ (its bounding box is (" +
-                  Utilities::to_string(low, 6) + ") to (" +
-                  Utilities::to_string(high, 6) + ") m)");
-            refused = s.change(
-              [&](Parameters::AllParameters &p) {
-                p.boundary_conditions.active_node.selection =
-                  "nearest surface node";
-                p.boundary_conditions.active_node.point = point;
-              },
-              true);
+            const std::string body = Utilities::trim(req.body);
+            if (body.rfind("node", 0) == 0)
+              {
+                // The whole rest must be the number: "node 3x" is refused,
+                // not read as node 3.
+                const std::string number = Utilities::trim(body.substr(4));
+                std::size_t       used   = 0;
+                long              id     = 0;
+                try
+                  {
+                    id = std::stol(number, &used);
+                  }
+                catch (const std::exception &)
+                  {
+                    used = 0;
+                  }
+                if (used == 0 || used != number.size())
+                  throw std::invalid_argument("'" + number +
+                                              "' is not a node number");
+                refused = s.change(
+                  [&](Parameters::AllParameters &p) {
+                    p.boundary_conditions.active_node.selection = "node id";
+                    p.boundary_conditions.active_node.node_id   = id;
+                  },
+                  true);
+              }
+            else
+              {
+                const auto point = Utilities::parse_point(body);
+                // A point on the organ: within its bounding box, enlarged by a
+                // tenth of its diameter (a huge or NaN point would select no
+                // node).
+                const auto [low, high] = s.interaction.mesh().bounding_box();
+                const double margin    = 0.1 * s.interaction.mesh().diameter();
+                for (unsigned int k = 0; k < 3; ++k)
+                  if (!(point[k] >= low[k] - margin &&
+                        point[k] <= high[k] + margin))
+                    throw std::invalid_argument(
+                      "the point (" + Utilities::to_string(point, 6) +
+                      ") m is not on the organ (its bounding box is (" +
+                      Utilities::to_string(low, 6) + ") to (" +
+                      Utilities::to_string(high, 6) + ") m)");
+                refused = s.change(
+                  [&](Parameters::AllParameters &p) {
+                    p.boundary_conditions.active_node.selection =
+                      "nearest surface node";
+                    p.boundary_conditions.active_node.point = point;
+                  },
+                  true);
+              }
+          }
+        catch (const std::invalid_argument &e)
+          {
+            refused = std::string(e.what()) +
+                      "; send 'node N' (N as the mesh file numbers the "
+                      "node) or a point 'x,y,z' (m) on the organ";
           }
         catch (const std::exception &e)
           {
@@ -590,7 +681,7 @@ namespace palpate
             Utilities::Point3           x;
             for (unsigned int k = 0; k < 3; ++k)
               x[k] = 1000 * m.vertices()[v][k];
-            res.set_content("vertex " + std::to_string(v) + " at (" +
+            res.set_content("node " + std::to_string(m.node_id(v)) + " at (" +
                               Utilities::to_string(x, 4) +
                               ") mm; the cached states were dropped and are "
                               "computed again",
@@ -735,10 +826,13 @@ namespace palpate
       }
     out << "Live view: open http://" << where << ":" << server.port() << "/"
         << (where != host ? " (listening on every interface)" : "")
-        << " in a browser. Drag with the mouse to move the probe in the "
-           "view plane, the wheel (or a drag with Alt held) moves it in "
-           "depth; keys: a attach, d detach, r back to rest, m a material "
-           "constant, shift-click another active node. Ctrl-C ends.\n"
+        << " in a browser. A drag on the organ moves the probe in the view "
+           "plane (with Alt held, in depth); a drag elsewhere or with the "
+           "right button turns the view, the middle button (or Shift and "
+           "the right) pans it, the wheel zooms; keys: f look at the probe, "
+           "v the first view, a attach, d detach, r back to rest, m a "
+           "material constant, shift-click another active node. Ctrl-C "
+           "ends.\n"
         << std::flush;
     stop_serving.store(false);
     auto *const previous_int  = std::signal(SIGINT, on_stop);

@@ -3,7 +3,8 @@
 
 // The live view's page (palpate serve): HTML and JavaScript, drawn with
 // three.js (from npm, compiled into palpate and served as /three.module.js
-// and /three.core.js: live_view_assets.cc).
+// and /three.core.js, with its OrbitControls as /OrbitControls.js:
+// live_view_assets.cc).
 
 namespace palpate
 {
@@ -21,25 +22,34 @@ namespace palpate
   #message { color: #9fd0ff; }
   #events { color: #ffb347; font-size: 12px; }
   #plot { position: absolute; bottom: 8px; left: 8px; background: rgba(0,0,0,0.5); }
+  #help { position: absolute; bottom: 8px; right: 8px; color: #ccc; font-size: 12px;
+          background: rgba(0,0,0,0.5); padding: 6px 8px; border-radius: 4px; line-height: 1.5; }
 </style>
 </head>
 <body>
 <div id="info">
   <b>palpate</b> <span id="scene"></span><br>
   force: <span id="force">-</span> N<br>
-  HIP: <span id="hip">-</span> mm<br>
+  HIP: <span id="hip">-</span> mm &middot; active node <span id="active">-</span><br>
   states: <span id="states">-</span><br>
   engine: <span id="engine">-</span><br>
   view: <span id="rate">-</span><br>
   <span id="warn"></span><br>
   <span id="message"></span><br>
   <div id="events"></div>
-  drag: move the probe &middot; depth: wheel, alt-drag or <button id="depth">drag in depth: off</button> (z)<br>
-  a/d: attach/detach &middot; r: rest &middot; m: change a material constant &middot; shift-click: another active node
+</div>
+<div id="help">
+  probe: drag on the organ &middot; in depth: alt-drag or <button id="depth">drag in depth: off</button> (z)<br>
+  view: drag elsewhere or right-drag turns &middot; middle- or shift-right-drag pans &middot; wheel zooms<br>
+  f: look at the probe &middot; v: first view &middot; a/d: attach/detach &middot; r: rest<br>
+  m: change a material constant &middot; shift-click: another active node
 </div>
 <canvas id="plot" width="320" height="100"></canvas>
+<!-- OrbitControls imports "three": the same module as the page's. -->
+<script type="importmap">{ "imports": { "three": "/three.module.js" } }</script>
 <script type="module">
 import * as THREE from "/three.module.js";
+import { OrbitControls } from "/OrbitControls.js";
 // Errors show on the page (and to a browser test reading it).
 function showError(message) {
   document.getElementById("warn").textContent = "page error: " + message;
@@ -70,6 +80,11 @@ const light = new THREE.DirectionalLight(0xffffff, 0.8 * Math.PI);
 light.position.set(1, 2, 3);
 scene.add(light);
 let organ = null, probe = null, arrow = null, rest = null, activeIndex = -1, cloudPoints = null;
+// The camera's orbit, pan and zoom (made when the surface has come: the
+// first view depends on it); surfaceOf: a node's number in the mesh file
+// (the one the scene report and Active node / Node id use, and the only
+// one the page shows or sends) -> its index among the surface's vertices.
+let controls = null, surfaceOf = new Map();
 // Cloud point colours by status: not computed, computed, failure point,
 // being computed, given in sRGB as the hex colours are. Vertex colours
 // are linear: converted.
@@ -115,7 +130,9 @@ function start(m) {
   for (const i of m.fixed) fx.push(m.vertices[3 * i], m.vertices[3 * i + 1], m.vertices[3 * i + 2]);
   fixed.setAttribute("position", new THREE.BufferAttribute(new Float32Array(fx), 3));
   scene.add(new THREE.Points(fixed, new THREE.PointsMaterial({ color: 0x4080ff, size: m.diameter / 60 })));
-  activeIndex = m.active;
+  m.nodes.forEach((id, i) => surfaceOf.set(id, i));
+  activeIndex = surfaceOf.has(m.active) ? surfaceOf.get(m.active) : -1;
+  document.getElementById("active").textContent = m.active;
   // The probe: a marker at the active node, or the indenter itself (a
   // half-transparent sphere of its radius, so the dent shows through).
   probe = m.sphere ?
@@ -139,12 +156,69 @@ function start(m) {
     part.renderOrder = 1;
   }
   scene.add(arrow);
+  firstView(m, geometry);
+  poll();
+}
+
+// The first view faces the probe: it looks against the outward normal of
+// the surface at the active node (the server's), at the point of the
+// normal's line level with the organ's centre, so that the probe is in the
+// middle of the view whatever the mesh's coordinates (an organ in CT
+// coordinates touched from below would otherwise hide it), from as near as
+// shows every surface vertex with a sixth of the view to spare (the
+// panels cover the corners).
+function firstView(m, geometry) {
   geometry.computeBoundingSphere();
   const c = geometry.boundingSphere.center, r = geometry.boundingSphere.radius;
-  camera.position.set(c.x, c.y - 0.2 * r, c.z + 3.2 * r);
-  camera.up.set(0, 1, 0);
-  camera.lookAt(c);
-  poll();
+  const n = new THREE.Vector3(m.normal[0], m.normal[1], m.normal[2]);
+  if (n.length() < 0.5) n.set(0, 0, 1);  // no active node: from +z
+  n.normalize();
+  const a = activeIndex >= 0 ? new THREE.Vector3(rest[3 * activeIndex], rest[3 * activeIndex + 1],
+                                                 rest[3 * activeIndex + 2]) : c.clone();
+  const centre = a.clone().addScaledVector(n, c.clone().sub(a).dot(n));
+  // Up: y, or z if the normal is near y, so that the orbit's
+  // axis (the camera's up) is never the view's direction.
+  camera.up.set(0, Math.abs(n.y) < 0.9 ? 1 : 0, Math.abs(n.y) < 0.9 ? 0 : 1);
+  camera.position.copy(centre).addScaledVector(n, r);
+  camera.lookAt(centre);
+  camera.updateMatrixWorld();
+  // A vertex at height y and width x across the view and h along n from
+  // the centre is in the view from a distance d when |y| <= (d - h)
+  // tan(fov / 2) and |x| <= (d - h) tan(fov / 2) aspect.
+  const right = new THREE.Vector3(), up = new THREE.Vector3(), back = new THREE.Vector3();
+  camera.matrixWorld.extractBasis(right, up, back);
+  const tanY = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)), tanX = tanY * camera.aspect;
+  let distance = 0;
+  for (let i = 0; i < rest.length; i += 3) {
+    const p = new THREE.Vector3(rest[i], rest[i + 1], rest[i + 2]).sub(centre);
+    distance = Math.max(distance, p.dot(n) + 1.2 * Math.max(Math.abs(p.dot(right)) / tanX,
+                                                            Math.abs(p.dot(up)) / tanY));
+  }
+  camera.position.copy(centre).addScaledVector(n, distance);
+  camera.lookAt(centre);
+  // The controls take the camera's up when made: made now. The left button
+  // turns the view unless the probe's drag takes the press (below); the
+  // right turns it anywhere (with Shift, Ctrl or Meta: pans, as three.js
+  // makes any turning button do); the middle pans; the wheel zooms.
+  controls = new OrbitControls(camera, renderer.domElement);
+  controls.mouseButtons = { LEFT: THREE.MOUSE.ROTATE, MIDDLE: THREE.MOUSE.PAN, RIGHT: THREE.MOUSE.ROTATE };
+  controls.target.copy(centre);
+  controls.minDistance = 0.01 * r;
+  controls.maxDistance = 20 * distance;
+  controls.update();
+  controls.saveState();  // v: back to this view
+  controls.addEventListener("change", requestDraw);
+  requestDraw();
+}
+
+// f: the view centred on the probe, from the same direction and distance
+// (the orbit then turns about the probe).
+function lookAtProbe() {
+  if (!controls || !probe) return;
+  const shift = probe.position.clone().sub(controls.target);
+  controls.target.add(shift);
+  camera.position.add(shift);
+  controls.update();
 }
 
 // A log of what happened (missing data, failure points, the server gone),
@@ -211,10 +285,11 @@ function show(f) {
     for (let i = 0; i < p.array.length; ++i) p.array[i] = rest[i] + f.displacement[i];
     p.needsUpdate = true;
     organ.geometry.computeVertexNormals();
-    if (f.active >= 0) activeIndex = f.active;
+    if (surfaceOf.has(f.active)) activeIndex = surfaceOf.get(f.active);
+    document.getElementById("active").textContent = f.active;
     const a = 3 * activeIndex;
     const x = new THREE.Vector3(rest[a] + f.hip[0], rest[a + 1] + f.hip[1], rest[a + 2] + f.hip[2]);
-    const sp = m.sphere;
+    const sp = f.sphere;  // where the sphere is now: another active node moves it
     probe.position.copy(sp ? new THREE.Vector3(sp[0] + f.hip[0], sp[1] + f.hip[1], sp[2] + f.hip[2]) : x);
     const c = f.cloud, n = c.length / 4, xyz = new Float32Array(3 * n), rgb = new Float32Array(3 * n);
     for (let i = 0; i < n; ++i) {
@@ -271,7 +346,8 @@ function plot() {
   g.fillText("|f| (N), max " + top.toFixed(2), 4, 12);
 }
 
-// The mouse as a 3-DOF device: drag in the view plane, wheel in depth.
+// The mouse as a 3-DOF device: a drag on the organ moves the probe in the
+// view plane, one with Alt (or the depth button) in depth.
 // Targets go one at a time (so they arrive in order), at most every 16 ms;
 // what moved meanwhile goes next, so the last target always arrives.
 let dragging = false, last = null, sending = false, again = false;
@@ -286,10 +362,17 @@ function sendTarget() {
     }, Math.max(0, 16 - (performance.now() - began)));
   });
 }
+// Metres per pixel at the probe's depth in the view: the probe follows the
+// mouse whatever the zoom.
+function metresPerPixel() {
+  const ahead = camera.getWorldDirection(new THREE.Vector3());
+  const depth = Math.max(camera.near, probe.position.clone().sub(camera.position).dot(ahead));
+  return 2 * depth * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) / window.innerHeight;
+}
 function move(dx, dy, dz) {
   const m = state.mesh;
-  if (!m) return;
-  const scale = m.diameter / window.innerHeight;
+  if (!m || !probe) return;
+  const scale = metresPerPixel();
   const right = new THREE.Vector3(), up = new THREE.Vector3(), back = new THREE.Vector3();
   camera.matrixWorld.extractBasis(right, up, back);
   const d = right.multiplyScalar(dx * scale).add(up.multiplyScalar(-dy * scale))
@@ -299,16 +382,40 @@ function move(dx, dy, dz) {
   }
   sendTarget();
 }
+// The organ (or the probe) under the pointer, if any.
+function organAt(e) {
+  const ray = new THREE.Raycaster();
+  ray.setFromCamera(new THREE.Vector2(2 * e.clientX / window.innerWidth - 1,
+                                      1 - 2 * e.clientY / window.innerHeight), camera);
+  return ray.intersectObjects([organ, probe])[0];
+}
 // Pointer events: a mouse, a touchpad, a pen or a finger on a touch screen
 // (touch-action none: the browser does not scroll or zoom the page).
+// Whether a press moves the probe or the view is decided here, before the
+// controls see it (a capturing listener runs first): the left button on
+// the organ or the probe, anywhere with Alt or the depth button on, moves
+// the probe, and the controls sit this press out; a shift-click on the
+// organ picks a node and moves nothing. Any other press is the view's.
+let holding = false;  // the controls are off for this press
 renderer.domElement.style.touchAction = "none";
 renderer.domElement.addEventListener("pointerdown", e => {
+  if (!organ || e.button !== 0) return;
+  const onOrgan = organAt(e) !== undefined;
+  if (e.shiftKey ? !onOrgan : !(onOrgan || e.altKey || depthDrag)) return;
+  holding = true;
+  controls.enabled = false;
+  // Its release comes here, wherever the pointer is then.
+  renderer.domElement.setPointerCapture(e.pointerId);
+  if (e.shiftKey) return;
   dragging = true;
   last = [e.clientX, e.clientY];
-  renderer.domElement.setPointerCapture(e.pointerId);
-});
-renderer.domElement.addEventListener("pointerup", () => { dragging = false; });
-renderer.domElement.addEventListener("pointercancel", () => { dragging = false; });
+}, { capture: true });
+function release() {
+  dragging = false;
+  if (holding) { holding = false; controls.enabled = true; }
+}
+renderer.domElement.addEventListener("pointerup", release);
+renderer.domElement.addEventListener("pointercancel", release);
 // With Alt held (a touchpad without a wheel), a drag up moves the probe
 // away from the viewer, down toward. Desktops that take Alt-drag to move
 // windows, and touch screens, have the button (or z): while it is on,
@@ -325,20 +432,22 @@ renderer.domElement.addEventListener("pointermove", e => {
   else move(e.clientX - last[0], e.clientY - last[1], 0);
   last = [e.clientX, e.clientY];
 });
-renderer.domElement.addEventListener("wheel", e => { e.preventDefault(); move(0, 0, 0.2 * e.deltaY); },
-                                     { passive: false });
-// Shift-click on the surface: make the nearest surface node the active node.
+// Shift-click on the surface: the node of the triangle hit nearest to
+// the point hit becomes the active node, sent by its number in the mesh
+// file.
 renderer.domElement.addEventListener("click", e => {
   if (!e.shiftKey || !organ) return;
-  const mouse = new THREE.Vector2(2 * e.clientX / window.innerWidth - 1,
-                                  1 - 2 * e.clientY / window.innerHeight);
   const ray = new THREE.Raycaster();
-  ray.setFromCamera(mouse, camera);
+  ray.setFromCamera(new THREE.Vector2(2 * e.clientX / window.innerWidth - 1,
+                                      1 - 2 * e.clientY / window.innerHeight), camera);
   const hit = ray.intersectObject(organ)[0];
   if (!hit) return;
-  const v = 3 * hit.face.a;  // a vertex of the face hit, at rest
+  const p = organ.geometry.attributes.position;
+  const at = i => new THREE.Vector3(p.getX(i), p.getY(i), p.getZ(i));
+  const corners = [hit.face.a, hit.face.b, hit.face.c];
+  const nearest = corners.reduce((i, j) => at(j).distanceTo(hit.point) < at(i).distanceTo(hit.point) ? j : i);
   state.target = [0, 0, 0];
-  post("/active", [rest[v], rest[v + 1], rest[v + 2]].map(x => x.toFixed(6)).join(","))
+  post("/active", "node " + state.mesh.nodes[nearest])
     .then(t => { document.getElementById("message").textContent = "active node: " + t; });
 });
 window.addEventListener("keydown", e => {
@@ -358,6 +467,8 @@ window.addEventListener("keydown", e => {
   // Rest: the target goes after any sent before it.
   if (e.key === "r") { state.target = [0, 0, 0]; sendTarget(); }
   if (e.key === "z") toggleDepth();
+  if (e.key === "f") lookAtProbe();
+  if (e.key === "v" && controls) controls.reset();
 });
 window.addEventListener("resize", () => {
   camera.aspect = window.innerWidth / window.innerHeight;
@@ -376,9 +487,10 @@ function requestDraw() { redraw = true; }
 })();
 window.palpate = state;
 loadMesh();
-// The view, for a browser test that clicks on the surface (three.js is a
-// module here, not a global).
-window.palpateView = { THREE: THREE, camera: camera, organ: () => organ };
+// The view, for a browser test that clicks on the surface and turns the
+// camera (three.js is a module here, not a global).
+window.palpateView = { THREE: THREE, camera: camera, organ: () => organ, probe: () => probe,
+                       controls: () => controls, metresPerPixel: metresPerPixel };
 </script>
 </body>
 </html>

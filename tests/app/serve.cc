@@ -4,9 +4,19 @@
 // palpate serve's server (issue 16), driven over HTTP as the page drives it,
 // on the small beam:
 // - the page, three.js and the surface are served (three.js's two modules,
-//   the core the revision source/app/web/package.json pins); the surface
-//   has the
-//   mesh's surface vertices, the fixed and active nodes;
+//   the core the revision source/app/web/package.json pins, and its
+//   OrbitControls, which the page's import map points at the same
+//   module); the surface has the mesh's surface vertices, the fixed and
+//   active nodes;
+// - one node numbering everywhere, the mesh file's: the active node /mesh
+//   and /frame name is the one the scene report names, each surface
+//   vertex comes with its number, "node N" posted to /active makes node N
+//   the active node (the reply and the frame name it, at its place), and
+//   a number the mesh does not have, or a node inside the body, is
+//   refused; on a Gmsh file that numbers its nodes 1000 + 7 (n - 1 - i),
+//   neither deal.II's vertex index nor the surface index, too; the first
+//   view's normal at the active node is the surface's outward normal
+//   there;
 // - a target sent with POST /hip is reached by the device thread, smoothly
 //   (from rest at most at 1 m/s^2) and at most at 5 cm/s, and the
 //   force /frame shows equals the state's force at that grid point (the
@@ -26,10 +36,15 @@
 //   attached in between), and it still serves;
 // - a second server cannot take the same port;
 // - with a sphere (Tip = sphere, the beam on its bottom face) the page gets
-//   the sphere to draw, and the force shown 2 mm in is the state's.
+//   the sphere to draw, and the force shown 2 mm in is the state's; another
+//   active node moves the sphere, and the frames say where it went.
 
+#include <palpate/app/scene_report.h>
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/mesh/generators.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
@@ -37,6 +52,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
 #include <thread>
 #include <vector>
 
@@ -60,6 +79,75 @@ namespace
       v.push_back(std::stod(item));
     return v;
   }
+
+  /** The integer after "key": in @p json, or -2 if there is none. */
+  long
+  integer(const std::string &json, const std::string &key)
+  {
+    const auto at = json.find("\"" + key + "\":");
+    if (at == std::string::npos)
+      return -2;
+    try
+      {
+        return std::stol(json.substr(at + key.size() + 3));
+      }
+    catch (const std::exception &)
+      {
+        return -2;
+      }
+  }
+
+  /** The node number the scene report gives the active node ("active
+   * node:   node N at ..."), or -1. */
+  long
+  reported_active_node(const palpate::Interaction &interaction)
+  {
+    std::ostringstream report;
+    palpate::print_scene_report(report,
+                                interaction.scene(),
+                                interaction.mesh(),
+                                interaction.nodes());
+    const std::string text = report.str();
+    const auto        at   = text.find("active node:   node ");
+    return at == std::string::npos ? -1 : std::stol(text.substr(at + 20));
+  }
+
+  /** The numbers of a surface node of @p json's /mesh other than @p
+   * active, and of a node inside the body (or -1), for the /active
+   * posts. */
+  std::pair<long, long>
+  other_nodes(const palpate::Mesh &mesh, const long active)
+  {
+    long surface = -1, inside = -1;
+    for (unsigned int v = 0; v < mesh.n_vertices(); ++v)
+      if (mesh.on_surface()[v] && mesh.node_id(v) != active && surface < 0 &&
+          mesh.vertices()[v][0] > 0.08)
+        surface = mesh.node_id(v);
+      else if (!mesh.on_surface()[v] && inside < 0)
+        inside = mesh.node_id(v);
+    return {surface, inside};
+  }
+
+  /** Whether the reply to "node N" names node @p id at its place (mm, to
+   * the 4 digits the reply gives), and /frame names it too. */
+  bool
+  picked_node(const httplib::Result &reply,
+              httplib::Client       &client,
+              const palpate::Mesh   &mesh,
+              const long             id)
+  {
+    const auto v = mesh.vertex_of_node_id(id);
+    if (!reply || reply->status != 200 || !v)
+      return false;
+    palpate::Utilities::Point3 x;
+    for (unsigned int k = 0; k < 3; ++k)
+      x[k] = 1000 * mesh.vertices()[*v][k];
+    const auto frame = client.Get("/frame");
+    return reply->body.rfind("node " + std::to_string(id) + " at (" +
+                               palpate::Utilities::to_string(x, 4) + ") mm",
+                             0) == 0 &&
+           frame && integer(frame->body, "active") == id;
+  }
 } // namespace
 
 int
@@ -77,6 +165,7 @@ main(int argc, char **argv)
   const auto  module = client.Get("/three.module.js");
   const auto  core   = client.Get("/three.core.js");
   const auto  mesh   = client.Get("/mesh");
+  const auto  orbit  = client.Get("/OrbitControls.js");
   const auto &body   = server.interaction().mesh();
   // "three": "0.187.0" -> revision '187'.
   const std::string pinned =
@@ -86,21 +175,61 @@ main(int argc, char **argv)
     at == std::string::npos ?
       "?" :
       pinned.substr(at + 12, pinned.find('.', at + 12) - (at + 12));
-  deallog << "page served: "
-          << ok(page && page->status == 200 &&
-                page->body.find("from \"/three.module.js\"") !=
-                  std::string::npos)
-          << ", three.js: "
-          << ok(module && module->status == 200 &&
-                module->body.find("from './three.core.js'") !=
-                  std::string::npos &&
-                core && core->status == 200 &&
-                core->body.find("const REVISION = '" + revision + "'") !=
-                  std::string::npos)
-          << ", surface: "
-          << ok(mesh && numbers(mesh->body, "vertices").size() ==
-                          3 * body.n_surface_vertices())
-          << " (" << body.n_surface_vertices() << " vertices)" << std::endl;
+  deallog
+    << "page served: "
+    << ok(page && page->status == 200 &&
+          page->body.find("from \"/three.module.js\"") != std::string::npos)
+    << ", three.js: "
+    << ok(module && module->status == 200 &&
+          module->body.find("from './three.core.js'") != std::string::npos &&
+          core && core->status == 200 &&
+          core->body.find("const REVISION = '" + revision + "'") !=
+            std::string::npos)
+    << ", OrbitControls: "
+    << ok(page->body.find(R"("imports": { "three": "/three.module.js" })") !=
+            std::string::npos &&
+          page->body.find("from \"/OrbitControls.js\"") != std::string::npos &&
+          orbit && orbit->status == 200 &&
+          orbit->body.find("class OrbitControls extends Controls") !=
+            std::string::npos &&
+          orbit->body.find("from 'three'") != std::string::npos)
+    << ", surface: "
+    << ok(mesh && numbers(mesh->body, "vertices").size() ==
+                    3 * body.n_surface_vertices())
+    << " (" << body.n_surface_vertices() << " vertices)" << std::endl;
+
+  // The node numbers: the generator's beam numbers its nodes as deal.II
+  // does (the active node is 87, its index among the surface's vertices
+  // 68); the file's own numbering is checked on a Gmsh file below.
+  const long reported = reported_active_node(server.interaction());
+  // Each surface vertex's number is the mesh's node at its place (the
+  // places come with 9 digits).
+  const auto ids    = numbers(mesh->body, "nodes");
+  const auto places = numbers(mesh->body, "vertices");
+  bool       numbered =
+    ids.size() == body.n_surface_vertices() && places.size() == 3 * ids.size();
+  for (std::size_t i = 0; numbered && i < ids.size(); ++i)
+    {
+      const auto v = body.vertex_of_node_id(std::lround(ids[i]));
+      numbered     = v && body.on_surface()[*v] &&
+                 palpate::Utilities::distance(body.vertices()[*v],
+                                              {{places[3 * i],
+                                                places[3 * i + 1],
+                                                places[3 * i + 2]}}) < 1e-9;
+    }
+  const auto normal = numbers(mesh->body, "normal");
+  deallog << "the active node /mesh and /frame name is the scene report's: "
+          << ok(reported >= 0 && integer(mesh->body, "active") == reported &&
+                integer(client.Get("/frame")->body, "active") == reported)
+          << " (node " << reported << "), the surface vertices' numbers are "
+          << "the mesh's: " << ok(numbered)
+          << ", the normal there is the surface's, (1, 0, 1)/sqrt(2) at the "
+             "free end's top edge (1e-9): "
+          << ok(normal.size() == 3 &&
+                palpate::Utilities::distance(
+                  {{normal[0], normal[1], normal[2]}},
+                  {{std::sqrt(0.5), 0, std::sqrt(0.5)}}) < 1e-9)
+          << std::endl;
 
   // The initial cloud, then a target on a grid point.
   const auto start = std::chrono::steady_clock::now();
@@ -214,11 +343,30 @@ main(int argc, char **argv)
   const auto off    = client.Post("/active", "1e200,0,0", "text/plain");
   deallog << "another active node picked: "
           << ok(picked && picked->status == 200 && last &&
-                last->body.find("\"active\":") != std::string::npos)
+                integer(last->body, "active") ==
+                  reported_active_node(server.interaction()))
           << ", a point off the organ refused: "
           << ok(off && off->status == 400 &&
                 off->body.find("is not on the organ") != std::string::npos)
           << std::endl;
+  const auto [other, inside] = other_nodes(body, reported);
+  const auto by_number =
+    client.Post("/active", "node " + std::to_string(other), "text/plain");
+  deallog
+    << "\"node N\" picks node N: "
+    << ok(picked_node(by_number, client, body, other) &&
+          reported_active_node(server.interaction()) == other)
+    << ", a node inside refused: "
+    << ok(
+         inside >= 0 &&
+         client.Post("/active", "node " + std::to_string(inside), "text/plain")
+             ->body.find("is inside the body") != std::string::npos)
+    << ", a number the mesh does not have refused: "
+    << ok(client.Post("/active", "node 100000", "text/plain")
+            ->body.find("the mesh has no node 100000") != std::string::npos)
+    << ", \"node 3x\" refused: "
+    << ok(client.Post("/active", "node 3x", "text/plain")->status == 400)
+    << std::endl;
 
   // Several clients at once, as a page's keys and clicks can come: d, a,
   // shift-click and m from four threads, three times each.
@@ -275,6 +423,84 @@ main(int argc, char **argv)
           << std::endl;
   server.stop();
 
+  // The same beam from a Gmsh file that numbers its nodes 1000 + 7 (n - 1
+  // - i): backwards, from 1000, in steps of 7, so that the file's number
+  // is neither the vertex index nor the surface index. The active node's
+  // number is computed here from the generator's nodes.
+  {
+    palpate::Scene from_file = small_beam_scene();
+    const auto     data = palpate::generate_beam(from_file.parameters.mesh);
+    const auto     n    = data.nodes.size();
+    const auto     tag  = [&](const std::size_t i) {
+      return 1000 + 7 * long(n - 1 - i);
+    };
+    const auto    file = std::filesystem::absolute("numbered-beam.msh");
+    std::ofstream f(file);
+    f << std::setprecision(17)
+      << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n"
+      << n << "\n";
+    for (std::size_t i = 0; i < n; ++i)
+      f << tag(i) << " " << data.nodes[i][0] << " " << data.nodes[i][1] << " "
+        << data.nodes[i][2] << "\n";
+    f << "$EndNodes\n$Elements\n"
+      << data.triangles.size() + data.tetrahedra.size() << "\n";
+    std::size_t e = 1;
+    for (std::size_t t = 0; t < data.triangles.size(); ++t, ++e)
+      f << e << " 2 2 " << data.triangle_boundary_ids[t] << " "
+        << data.triangle_boundary_ids[t] << " " << tag(data.triangles[t][0])
+        << " " << tag(data.triangles[t][1]) << " " << tag(data.triangles[t][2])
+        << "\n";
+    for (const auto &t : data.tetrahedra)
+      f << e++ << " 4 2 7 7 " << tag(t[0]) << " " << tag(t[1]) << " "
+        << tag(t[2]) << " " << tag(t[3]) << "\n";
+    f << "$EndElements\n";
+    f.close();
+    from_file.parameters.mesh.source       = "file";
+    from_file.parameters.mesh.file_name    = file.string();
+    from_file.parameters.mesh.scale_factor = 1;
+    long expected                          = -1;
+    for (std::size_t i = 0; i < n; ++i)
+      if (palpate::Utilities::distance(
+            data.nodes[i],
+            from_file.parameters.boundary_conditions.active_node.point) < 1e-12)
+        expected = tag(i);
+    palpate::LiveServer numbered(from_file, "127.0.0.1", 0, 0.05);
+    httplib::Client     to_numbered("127.0.0.1", numbered.port());
+    to_numbered.set_read_timeout(60, 0);
+    const auto &m     = numbered.interaction().mesh();
+    const long  named = reported_active_node(numbered.interaction());
+    // The index the view gave it before: among the surface's vertices in
+    // the order the surface triangles first name them.
+    const long surface = [&] {
+      std::map<unsigned int, long> order;
+      for (const auto &face : m.surface_faces())
+        for (const unsigned int v : face.vertices)
+          order.emplace(v, long(order.size()));
+      return order.at(numbered.interaction().nodes().active_vertex);
+    }();
+    const auto first_mesh  = to_numbered.Get("/mesh");
+    const auto first_frame = to_numbered.Get("/frame");
+    const auto other_node  = other_nodes(m, named).first;
+    const auto pick        = to_numbered.Post("/active",
+                                       "node " + std::to_string(other_node),
+                                       "text/plain");
+    deallog << "a Gmsh file's numbers: the scene report names its active "
+               "node "
+            << ok(named == expected) << " (node " << expected
+            << ", not its vertex index "
+            << numbered.interaction().nodes().active_vertex
+            << " nor its index among the surface's vertices " << surface
+            << "), /mesh and /frame name it: "
+            << ok(integer(first_mesh->body, "active") == named &&
+                  integer(first_frame->body, "active") == named)
+            << ", \"node N\" picks file node N: "
+            << ok(picked_node(pick, to_numbered, m, other_node) &&
+                  reported_active_node(numbered.interaction()) == other_node)
+            << std::endl;
+    numbered.stop();
+    std::filesystem::remove(file);
+  }
+
   // The indenter in the live view: the page gets the sphere (centre at
   // rest and radius) to draw, and the force shown 2 mm into the beam is
   // the state's, pushing the probe out.
@@ -322,5 +548,31 @@ main(int argc, char **argv)
                   1e-9 * palpate::Utilities::norm(pressed_state->force))
           << ", pushing the probe out: "
           << ok(pressed_shown.size() == 3 && pressed_shown[2] > 0) << std::endl;
+  // Another active node moves the sphere: the frames say where it is now
+  // (the page draws it there), its centre one radius out along the
+  // normal at the node, on the top face (0, 0, 1).
+  const auto &body_of_indenter = indenter.interaction().mesh();
+  long        top_node         = -1;
+  for (unsigned int v = 0; v < body_of_indenter.n_vertices() && top_node < 0;
+       ++v)
+    {
+      const auto &x = body_of_indenter.vertices()[v];
+      if (std::abs(x[0] - 0.08) < 1e-9 && std::abs(x[1]) < 1e-9 &&
+          std::abs(x[2] - 0.01) < 1e-9)
+        top_node = body_of_indenter.node_id(v);
+    }
+  const auto moved    = to_indenter.Post("/active",
+                                      "node " + std::to_string(top_node),
+                                      "text/plain");
+  const auto moved_to = numbers(to_indenter.Get("/frame")->body, "sphere");
+  deallog << "another active node moves the sphere, and the frames say where: "
+          << ok(moved && moved->status == 200 && moved_to.size() == 4 &&
+                palpate::Utilities::distance(
+                  {{moved_to[0], moved_to[1], moved_to[2]}},
+                  indenter.interaction().nodes().sphere_center) < 1e-12 &&
+                palpate::Utilities::distance(
+                  {{moved_to[0], moved_to[1], moved_to[2]}},
+                  {{0.08, 0, 0.02}}) < 1e-9)
+          << std::endl;
   indenter.stop();
 }

@@ -6,10 +6,13 @@
 //   node drive.js CHROMIUM PORT SCREENSHOT.png
 //
 // Debian's headless Chromium loads the page palpate serve serves on PORT and
-// is driven as a person would drive it: a mouse drag pushes the probe, the
-// keys m (a material constant, through the page's prompt), d and a
-// (detach, attach), shift-click (another active node), then a reload (a
-// client that leaves and comes back). What the page shows is printed, one
+// is driven as a person would drive it: the camera is turned (a left drag
+// off the organ, a right drag on it), zoomed (the wheel) and panned (a
+// middle drag), f centres it on the probe, a mouse drag on the organ pushes
+// the probe, the keys m (a material constant, through the page's prompt),
+// d and a (detach, attach), Alt and the depth button (the probe in
+// depth), shift-click (another active node), v (the first view), then a
+// reload (a client that leaves and comes back). What the page shows is printed, one
 // "KEY value..." line each, for the C++ side to check against the API; the
 // page's own numbers come from window.palpate (the state the page draws).
 // A screenshot is kept. Nothing here decides pass or fail except a timeout
@@ -72,11 +75,113 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await page.evaluate(`window.cloudDone = ${cloudDone.toString()}`);
   await until(() => window.palpate && window.palpate.mesh && window.palpate.frame, 30000);
   await until(() => window.cloudDone(), 120000);
-
-  // The drag: down the screen, by 0.45 of the state space's extent,
-  // over about a second (the device thread limits the HIP to 5 cm/s).
   const m = await page.evaluate(() => window.palpate.mesh);
-  const pixels = Math.round(0.45 * m.extent / (m.diameter / 640));
+
+  // The camera as the page holds it: its position, the point it turns
+  // about, the probe's place on the screen (x, y from -1 to 1) and the
+  // target the page sent for the probe.
+  const view = () => page.evaluate(() => {
+    const V = window.palpateView, c = V.controls(), q = V.probe().position.clone().project(V.camera);
+    return { position: V.camera.position.toArray(), target: c.target.toArray(), probe: [q.x, q.y],
+             probeTarget: window.palpate.target.slice() };
+  });
+  const sub = (a, b) => a.map((x, k) => x - b[k]);
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const norm = a => Math.hypot(...a);
+  // The angle (degrees) between the directions the camera looks from.
+  const turned = (v, w) => {
+    const a = sub(v.position, v.target), b = sub(w.position, w.target);
+    return Math.acos(Math.min(1, dot(a, b) / (norm(a) * norm(b)))) * 180 / Math.PI;
+  };
+  const drag = async (from, by, button, steps) => {
+    await page.mouse.move(from[0], from[1]);
+    await page.mouse.down({ button: button });
+    for (let i = 1; i <= steps; ++i) {
+      await page.mouse.move(from[0] + Math.round(by[0] * i / steps), from[1] + Math.round(by[1] * i / steps));
+      await sleep(20);
+    }
+    await page.mouse.up({ button: button });
+  };
+
+  // The first view: the angle between the direction it looks from and
+  // the outward normal at the active node, the probe's distance from the
+  // middle of the screen, and whether every surface vertex is in the
+  // picture. The active node as /mesh, the frame and the page's text name
+  // it.
+  const first = await page.evaluate(() => {
+    const V = window.palpateView, THREE = V.THREE, s = window.palpate, v = s.mesh.vertices;
+    let inside = true;
+    for (let i = 0; i < v.length; i += 3) {
+      const q = new THREE.Vector3(v[i], v[i + 1], v[i + 2]).project(V.camera);
+      inside = inside && Math.abs(q.x) < 1 && Math.abs(q.y) < 1;
+    }
+    return { inside: inside, active: [s.mesh.active, s.frame.active, document.getElementById("active").textContent] };
+  });
+  const v0 = await view();
+  out("FIRST_VIEW", turned(v0, { position: m.normal, target: [0, 0, 0] }),
+      norm(v0.probe), first.inside ? "yes" : "no");
+  out("ACTIVE_NODE", ...first.active);
+
+  // Turn: a left drag from a pixel where the canvas shows no organ or
+  // probe, 120 pixels to the right; then a right drag that starts on the
+  // probe, 60 pixels up. Neither moves the probe.
+  const background = await page.evaluate(() => {
+    const V = window.palpateView, THREE = V.THREE, canvas = document.querySelector("canvas");
+    const ray = new THREE.Raycaster();
+    for (let y = 120; y < 520; y += 20)
+      for (let x = 900; x > 40; x -= 20) {
+        if (document.elementFromPoint(x, y) !== canvas) continue;
+        ray.setFromCamera(new THREE.Vector2(2 * x / window.innerWidth - 1, 1 - 2 * y / window.innerHeight), V.camera);
+        if (ray.intersectObjects([V.organ(), V.probe()]).length === 0) return [x, y];
+      }
+    return null;
+  });
+  await drag(background, [120, 0], "left", 12);
+  const v1 = await view();
+  const onProbe = v1.probe.map((q, k) => k === 0 ? (q + 1) * 480 : (1 - q) * 320);
+  await drag(onProbe, [0, -60], "right", 6);
+  const v2 = await view();
+  out("ORBIT", turned(v0, v1), turned(v1, v2), norm(sub(v2.probeTarget, v0.probeTarget)),
+      background ? "from_background" : "no_background");
+  // Zoom: the wheel, twice 200 up (toward the screen).
+  await page.mouse.move(480, 320);
+  await page.mouse.wheel({ deltaY: -200 });
+  await sleep(50);
+  await page.mouse.wheel({ deltaY: -200 });
+  await sleep(50);
+  const v3 = await view();
+  out("ZOOM", norm(sub(v3.position, v3.target)) / norm(sub(v2.position, v2.target)), turned(v2, v3));
+  // Pan: a middle drag of 80 pixels left and 40 down moves the point
+  // the camera turns about by the same on the screen at its depth
+  // (2 d tan(20 deg) / 640 metres per pixel at distance d); the
+  // direction stays.
+  await drag(background, [-80, 40], "middle", 8);
+  const v4 = await view();
+  const d3 = norm(sub(v3.position, v3.target));
+  out("PAN", norm(sub(v4.target, v3.target)) / (Math.hypot(80, 40) * 2 * d3 * Math.tan(Math.PI / 9) / 640),
+      turned(v3, v4));
+
+  // f: the view centred on the probe, from the same direction and
+  // distance: the probe's distance from the middle of the screen before
+  // and after.
+  await page.keyboard.press("f");
+  const v5 = await view();
+  out("LOOK_AT_PROBE", norm(v4.probe), norm(v5.probe), turned(v4, v5),
+      norm(sub(v5.position, v5.target)) / norm(sub(v4.position, v4.target)));
+
+  // The drag on the probe, in the view turned: down the screen, by 0.45
+  // of the state space's extent (the page's metres per pixel at the
+  // probe), over about a second (the device thread limits the HIP to
+  // 5 cm/s). The target moves down the screen (the camera's -up) by
+  // that much.
+  const scale = await page.evaluate(() => window.palpateView.metresPerPixel());
+  const pixels = Math.round(0.45 * m.extent / scale);
+  const down = await page.evaluate(() => {
+    const up = new window.palpateView.THREE.Vector3();
+    window.palpateView.camera.matrixWorld.extractBasis(new window.palpateView.THREE.Vector3(), up,
+                                                       new window.palpateView.THREE.Vector3());
+    return up.negate().toArray();
+  });
   const before = await page.evaluate(() => [window.palpate.received, performance.now()]);
   await page.mouse.move(480, 320);
   await page.mouse.down();
@@ -89,6 +194,8 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await sleep(1000);
   const after = await page.evaluate(() => [window.palpate.received, performance.now()]);
   out("RATE", (after[0] - before[0]) / ((after[1] - before[1]) / 1000), "dragged_pixels", pixels);
+  const dragged = sub(await page.evaluate(() => window.palpate.target.slice()), v5.probeTarget);
+  out("DRAG", dot(dragged, down) / norm(dragged), norm(dragged) / (pixels * scale));
   await until(settled, 120000);
   // What the page shows: the force's text, and the frame's numbers.
   const shown = await page.evaluate(() => ({
@@ -132,7 +239,13 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   out("DETACH_ATTACH", "yes");
 
   // A drag down with Alt held moves the probe toward the viewer (the
-  // camera's back axis, about +z here), not in the view plane.
+  // camera's back axis), not in the view plane: the cosine of the angle
+  // between the two.
+  const back = await page.evaluate(() => {
+    const T = window.palpateView.THREE, b = new T.Vector3();
+    window.palpateView.camera.matrixWorld.extractBasis(new T.Vector3(), new T.Vector3(), b);
+    return b.toArray();
+  });
   const t0 = await page.evaluate(() => window.palpate.target.slice());
   await page.keyboard.down("Alt");
   await page.mouse.move(480, 320);
@@ -145,8 +258,7 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await page.keyboard.up("Alt");
   const t1 = await page.evaluate(() => window.palpate.target.slice());
   const moved = t1.map((x, k) => x - t0[k]);
-  out("DEPTH", moved[2] > 0.8 * Math.hypot(...moved) && Math.hypot(...moved) > 0.2 * m.extent ? "yes" : "no",
-      ...moved.map(x => x.toPrecision(6)));
+  out("DEPTH", dot(moved, back) / norm(moved), norm(moved) / m.extent);
   // The same with the page's depth button (touch screens, desktops that
   // take Alt-drag): a drag up, away from the viewer.
   await page.click("#depth");
@@ -161,17 +273,17 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await page.click("#depth");
   const t3 = await page.evaluate(() => window.palpate.target.slice());
   const away = t3.map((x, k) => x - t2[k]);
-  out("DEPTH_BUTTON", -away[2] > 0.8 * Math.hypot(...away) && Math.hypot(...away) > 0.2 * m.extent ? "yes" : "no",
-      ...away.map(x => x.toPrecision(6)),
+  out("DEPTH_BUTTON", -dot(away, back) / norm(away), norm(away) / m.extent,
       await page.evaluate(() => document.getElementById("depth").textContent));
 
   // r: back to rest; then shift-click on the surface where a vertex far
   // from the active node shows (the ray through that pixel must hit the
-  // surface there): another active node.
+  // surface there): another active node, the one of that vertex (its
+  // number in the mesh file, from /mesh).
   await page.keyboard.press("r");
   await until(() => Math.hypot(...window.palpate.frame.hip) < 1e-9, 10000);
   const pick = await page.evaluate(() => {
-    const s = window.palpate, v = s.mesh.vertices, a = s.frame.active;
+    const s = window.palpate, v = s.mesh.vertices, a = s.mesh.nodes.indexOf(s.frame.active);
     const THREE = window.palpateView.THREE;
     const camera = window.palpateView.camera, organ = window.palpateView.organ();
     const at = i => new THREE.Vector3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
@@ -183,16 +295,25 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
       ray.setFromCamera(new THREE.Vector2(q.x, q.y), camera);
       const hit = ray.intersectObject(organ)[0];
       if (hit && hit.point.distanceTo(at(i)) < 0.05 * s.mesh.diameter)
-        return { old: a, vertex: i, x: (q.x + 1) * window.innerWidth / 2, y: (1 - q.y) * window.innerHeight / 2 };
+        return { old: s.frame.active, node: s.mesh.nodes[i], x: (q.x + 1) * window.innerWidth / 2,
+                 y: (1 - q.y) * window.innerHeight / 2 };
     }
-    return { old: a, vertex: -1, x: window.innerWidth / 2, y: window.innerHeight / 2 };
+    return { old: s.frame.active, node: -1, x: window.innerWidth / 2, y: window.innerHeight / 2 };
   });
   await page.keyboard.down("Shift");
   await page.mouse.click(pick.x, pick.y);
   await page.keyboard.up("Shift");
   await until(a => window.palpate.frame.active !== a, 60000, pick.old);
-  out("ACTIVE", pick.old, await page.evaluate(() => window.palpate.frame.active),
+  await until(() => document.getElementById("message").textContent.startsWith("active node: "), 10000);
+  out("ACTIVE", pick.old, await page.evaluate(() => window.palpate.frame.active), pick.node,
+      await page.evaluate(() => document.getElementById("active").textContent),
       await page.evaluate(() => document.getElementById("message").textContent));
+
+  // v: the first view again.
+  await page.keyboard.press("v");
+  const v6 = await view();
+  out("FIRST_VIEW_AGAIN", norm(sub(v6.position, v0.position)) / m.diameter,
+      norm(sub(v6.target, v0.target)) / m.diameter);
 
   // A client that leaves and comes back: the page reloaded.
   await page.reload();

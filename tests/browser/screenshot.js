@@ -8,8 +8,9 @@
 //   NODE_PATH=build/browser-test/node_modules node tests/browser/screenshot.js \
 //     /usr/bin/chromium 8080 doc/images/serve.png
 //
-// The mouse pushes the liver into itself and holds it while the cloud
-// follows; the picture is taken when the cloud around the probe is computed.
+// The mouse pushes the liver into itself from the middle of the page (the
+// first view faces the probe there) and holds it while the cloud follows;
+// the picture is taken when the cloud around the probe is computed.
 "use strict";
 const puppeteer = require("puppeteer-core");
 const [chromium, port, file] = process.argv.slice(2);

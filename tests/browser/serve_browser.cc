@@ -5,6 +5,22 @@
 // Chromium, driven by puppeteer-core (drive.js), loads the page served for
 // the small beam and is used as a person would use it. Checked here, against
 // the API:
+// - the first view looks at the probe against the outward normal at the
+//   active node (0.01 degree), the probe in the middle of the screen
+//   (0.001 of its half-width) and the whole surface in the picture; the
+//   active node the page names (from /mesh, the frames and its text) is
+//   the one the scene report names, in the mesh's numbering;
+// - the camera turns through real mouse events (three.js's OrbitControls):
+//   a left drag of 120 pixels off the organ turns it by 120 / 640 of a
+//   turn, 67.5 degrees, and a right drag of 60 pixels up that starts on
+//   the probe by 33.75 (0.1 degree each), neither moving the probe; the
+//   wheel (twice 200) zooms in to 0.95^4 of the distance, a middle drag
+//   pans the point it turns about by what the pixels span at its depth
+//   (1e-6 each, the direction kept); f centres the view on the probe
+//   (0.001 of the screen's half-width, from 0.1 or more off), keeping
+//   direction and distance;
+// - the drag on the probe in the view turned moves the target down the
+//   screen (the camera's -up) by what the pixels span at the probe (1e-6);
 // - frames reach the page at 20 Hz or more while the mouse drags the probe;
 // - once the probe rests, the force the page holds is the force
 //   Interaction::force() returned at that HIP (the device thread's last
@@ -16,14 +32,18 @@
 // - the m key's prompt changes Young's modulus on the fly to twice its
 //   value: the force at the same HIP doubles (St.Venant-Kirchhoff, 1e-6);
 // - d and a detach and attach; a drag with Alt held, or with the page's
-//   depth button on, moves the probe in depth; shift-click picks another
-//   active node;
+//   depth button on, moves the probe in depth (along the camera's axis,
+//   1e-6); shift-click picks another active node: the node, as the mesh
+//   numbers it, of the vertex clicked, which the page names and the server
+//   then has; v brings back the first view;
 // - a reloaded page (a client that leaves and comes back) is served;
 // - the view is drawn (more than 5 % of its pixels are not background) and
 //   a screenshot is kept: PALPATE_ARTEFACT_DIR/live-view.png.
 
+#include <palpate/app/scene_report.h>
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/mesh/mesh.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
@@ -104,6 +124,32 @@ namespace
       }
     return true;
   }
+
+  /** The node number the scene report gives the active node ("active
+   * node:   node N at ..."), or -1. */
+  long
+  reported_active_node(const palpate::Interaction &interaction)
+  {
+    std::ostringstream report;
+    palpate::print_scene_report(report,
+                                interaction.scene(),
+                                interaction.mesh(),
+                                interaction.nodes());
+    const std::string text = report.str();
+    const auto        at   = text.find("active node:   node ");
+    return at == std::string::npos ? -1 : std::stol(text.substr(at + 20));
+  }
+
+  /** Whether @p v has an entry @p i, and it is @p expected within @p
+   * tolerance. */
+  bool
+  near(const std::vector<double> &v,
+       const std::size_t          i,
+       const double               expected,
+       const double               tolerance)
+  {
+    return v.size() > i && std::abs(v[i] - expected) <= tolerance;
+  }
 } // namespace
 
 int
@@ -114,6 +160,8 @@ main(int argc, char **argv)
 
   const palpate::Scene scene = small_beam_scene();
   palpate::LiveServer  server(scene, "127.0.0.1", 0, 0.05);
+  // The active node as the scene report names it (`palpate SCENE.prm`).
+  const long reported = reported_active_node(server.interaction());
 
   const std::filesystem::path artefacts(PALPATE_ARTEFACT_DIR);
   std::filesystem::create_directories(artefacts);
@@ -162,6 +210,49 @@ main(int argc, char **argv)
           << std::endl;
   // What the browser saw, for the log (not compared: it varies).
   std::cout << "drive.js said:\n" << log << std::endl;
+
+  const auto first = numbers_in(value("FIRST_VIEW"));
+  const auto named = numbers_in(value("ACTIVE_NODE"));
+  deallog << "the first view looks at the probe against the outward normal "
+             "at the active node: "
+          << ok(near(first, 0, 0, 0.01))
+          << ", the probe in the middle: " << ok(near(first, 1, 0, 0.001))
+          << ", the whole organ in the view: "
+          << ok(value("FIRST_VIEW").find(" yes") != std::string::npos)
+          << std::endl;
+  deallog << "the active node the page names (/mesh, frame, text) is the "
+             "scene report's: "
+          << ok(named.size() == 3 && reported >= 0 && named[0] == reported &&
+                named[1] == reported && named[2] == reported)
+          << " (node " << reported << ")" << std::endl;
+  // 120 and 60 pixels of a 640-pixel-high view: 120 / 640 and 60 / 640 of
+  // a turn (OrbitControls' rotateSpeed 1).
+  const auto orbit = numbers_in(value("ORBIT"));
+  const auto zoom  = numbers_in(value("ZOOM"));
+  const auto pan   = numbers_in(value("PAN"));
+  const auto look  = numbers_in(value("LOOK_AT_PROBE"));
+  deallog << "a left drag off the organ turns the view by 67.5 degrees: "
+          << ok(near(orbit, 0, 67.5, 0.1) &&
+                value("ORBIT").find("from_background") != std::string::npos)
+          << ", a right drag on the probe by 33.75: "
+          << ok(near(orbit, 1, 33.75, 0.1))
+          << ", neither moves the probe: " << ok(near(orbit, 2, 0, 0))
+          << std::endl;
+  deallog << "the wheel zooms to 0.95^4 of the distance: "
+          << ok(near(zoom, 0, std::pow(0.95, 4), 1e-6) &&
+                near(zoom, 1, 0, 1e-4))
+          << ", a middle drag pans by what its pixels span: "
+          << ok(near(pan, 0, 1, 1e-6) && near(pan, 1, 0, 1e-4)) << std::endl;
+  deallog << "f centres the view on the probe: "
+          << ok(look.size() == 4 && look[0] > 0.1 && look[1] < 0.001)
+          << ", from the same direction and distance: "
+          << ok(near(look, 2, 0, 1e-4) && near(look, 3, 1, 1e-9)) << std::endl;
+  const auto dragged = numbers_in(value("DRAG"));
+  deallog << "the drag on the probe in the turned view moves it down the "
+             "screen: "
+          << ok(near(dragged, 0, 1, 1e-6))
+          << ", by what the pixels span at the probe: "
+          << ok(near(dragged, 1, 1, 1e-6)) << std::endl;
 
   const auto rate = numbers_in(value("RATE"));
   deallog << "frames at 20 Hz or more during the drag: "
@@ -228,17 +319,31 @@ main(int argc, char **argv)
                          2) < 1e-6)
           << std::endl;
 
+  // Old, new (the frame's), the node of the vertex clicked, the page's
+  // text, and the reply "node N at (...) mm".
   const auto active = numbers_in(value("ACTIVE"));
-  deallog << "d and a detached and attached: "
-          << ok(value("DETACH_ATTACH") == "yes")
-          << ", a drag with Alt moved the probe in depth: "
-          << ok(value("DEPTH").rfind("yes", 0) == 0)
-          << ", and with the depth button: "
-          << ok(value("DEPTH_BUTTON").rfind("yes", 0) == 0 &&
-                value("DEPTH_BUTTON").find("drag in depth: off") !=
-                  std::string::npos)
-          << ", shift-click picked another active node: "
-          << ok(active.size() >= 2 && active[0] != active[1] && active[1] >= 0)
+  const auto depth  = numbers_in(value("DEPTH"));
+  const auto button = numbers_in(value("DEPTH_BUTTON"));
+  const auto again  = numbers_in(value("FIRST_VIEW_AGAIN"));
+  deallog
+    << "d and a detached and attached: " << ok(value("DETACH_ATTACH") == "yes")
+    << ", a drag with Alt moved the probe in depth: "
+    << ok(near(depth, 0, 1, 1e-6) && depth.size() > 1 && depth[1] > 0.2)
+    << ", and with the depth button: "
+    << ok(near(button, 0, 1, 1e-6) && button.size() > 1 && button[1] > 0.2 &&
+          value("DEPTH_BUTTON").find("drag in depth: off") != std::string::npos)
+    << std::endl;
+  deallog << "shift-click picked the node of the vertex clicked: "
+          << ok(active.size() >= 5 && active[0] != active[1] &&
+                active[1] == active[2] && active[3] == active[1] &&
+                value("ACTIVE").find("active node: node " +
+                                     std::to_string(long(active[2])) +
+                                     " at (") != std::string::npos)
+          << ", the server's active node: "
+          << ok(active.size() >= 2 &&
+                reported_active_node(server.interaction()) == active[1])
+          << ", v brings back the first view: "
+          << ok(near(again, 0, 0, 1e-9) && near(again, 1, 0, 1e-9))
           << ", a reloaded page is served: "
           << ok(value("RECONNECTED") == "yes") << std::endl;
 

@@ -26,17 +26,22 @@ namespace palpate
    * mouse's jumps become bounded accelerations), and calls
    * Interaction::force() like a real device.
    *
-   * Endpoints: GET / (the page), GET /three.module.js and /three.core.js
-   * (three.js from npm, built in: live_view_assets.cc),
-   * GET /mesh (the surface: rest positions, triangles, fixed and active
-   * nodes, the state space's extent, the engine), GET /frame (HIP, target,
-   * force, the surface's displacement, the cloud around the HIP with each
-   * point's status: not computed, computed, failed, being computed; the
-   * engine's load; the missing-data cause),
+   * Endpoints: GET / (the page), GET /three.module.js, /three.core.js and
+   * /OrbitControls.js (three.js and its camera controls from npm, built in:
+   * live_view_assets.cc),
+   * GET /mesh (the surface: rest positions, triangles, each surface
+   * vertex's node number, the fixed nodes, the active node with the
+   * outward normal there, the state space's extent, the engine), GET
+   * /frame (HIP, target, force, the active node, the surface's
+   * displacement, the cloud around the HIP with each point's status: not
+   * computed, computed, failed, being computed; the engine's load; the
+   * missing-data cause),
    * GET /material (the model and its constants now),
    * POST /hip with "x,y,z" (the target displacement from rest, m),
-   * POST /material with "ENTRY=VALUE", POST /active with "x,y,z" (m),
-   * POST /attach, /detach, /reset.
+   * POST /material with "ENTRY=VALUE", POST /active with "node N" or
+   * "x,y,z" (m: its nearest surface node), POST /attach, /detach, /reset.
+   * Nodes are named everywhere as the mesh file numbers them
+   * (Mesh::node_id()), as the scene report and Active node / Node id do.
    */
   class LiveServer
   {
