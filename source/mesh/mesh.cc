@@ -176,6 +176,11 @@ namespace palpate
             const auto repairs = report.repairs.lines();
             for (const auto &r : repairs)
               how += "; " + r;
+            // The mesher's warnings (a node count it could not meet,
+            // slivers) reach the scene report too, not only palpate mesh.
+            for (const auto &line : report.lines())
+              if (line.rfind("warning:", 0) == 0)
+                how += "; " + Utilities::trim(line);
           }
         catch (const InputError &e)
           {

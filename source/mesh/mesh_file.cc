@@ -798,13 +798,43 @@ namespace palpate
       return std::stoull(value);
     }
 
+    /** Whether this machine stores numbers little-endian (x86, ARM). */
+    bool
+    host_is_little_endian()
+    {
+      const std::uint16_t one = 1;
+      unsigned char       first;
+      std::memcpy(&first, &one, 1);
+      return first == 1;
+    }
+
+    /** Reverse the @p size bytes at @p p: one value to the other byte
+     * order. */
+    void
+    reverse_bytes(unsigned char *p, const std::size_t size)
+    {
+      std::reverse(p, p + size);
+    }
+
     struct VtuContext
     {
       std::string filename;
       bool        header_64  = false;
       bool        compressed = false;
-      std::string appended; // raw bytes, or base64 text
-      bool        appended_base64 = false;
+      /**
+       * The file's byte order differs from this machine's: every binary
+       * value, the UInt32/UInt64 sizes of the array headers included, is
+       * byte-swapped as it is read. Ascii arrays are text and need
+       * nothing, whatever the file declares.
+       */
+      bool swap_bytes = false;
+      /** The byte_order attribute, if it is neither LittleEndian nor
+       * BigEndian: refused when a binary array needs it, and only then. */
+      std::string unknown_byte_order;
+      /** The line of the <VTKFile> tag, which declares the byte order. */
+      unsigned int file_tag_line = 1;
+      std::string  appended; // raw bytes, or base64 text
+      bool         appended_base64 = false;
       /** The line of the <DataArray> being read, for messages. */
       unsigned int line = 0;
 
@@ -841,14 +871,19 @@ namespace palpate
       const std::size_t hs = ctx.header_size();
       if (k >= header.size() / hs)
         throw ctx.damaged(name, "the array's header is cut short");
+      // The sizes are in the file's byte order, like the data.
+      unsigned char value[8];
+      std::memcpy(value, header.data() + k * hs, hs);
+      if (ctx.swap_bytes)
+        reverse_bytes(value, hs);
       if (ctx.header_64)
         {
           std::uint64_t v;
-          std::memcpy(&v, header.data() + k * hs, 8);
+          std::memcpy(&v, value, 8);
           return v;
         }
       std::uint32_t v;
-      std::memcpy(&v, header.data() + k * hs, 4);
+      std::memcpy(&v, value, 4);
       return v;
     }
 
@@ -1038,15 +1073,21 @@ namespace palpate
                                name);
     }
 
+    /** The values of type @p T in @p bytes, byte-swapped first if
+     * @p swap (the file's byte order is not this machine's). */
     template <typename T>
     std::vector<double>
-    bytes_to_doubles(const std::vector<unsigned char> &bytes)
+    bytes_to_doubles(const std::vector<unsigned char> &bytes, const bool swap)
     {
       std::vector<double> v(bytes.size() / sizeof(T));
       for (std::size_t i = 0; i < v.size(); ++i)
         {
+          unsigned char b[sizeof(T)];
+          std::memcpy(b, bytes.data() + i * sizeof(T), sizeof(T));
+          if (swap)
+            reverse_bytes(b, sizeof(T));
           T x;
-          std::memcpy(&x, bytes.data() + i * sizeof(T), sizeof(T));
+          std::memcpy(&x, b, sizeof(T));
           v[i] = static_cast<double>(x);
         }
       return v;
@@ -1079,6 +1120,16 @@ namespace palpate
                              "the file is damaged; write it again.");
           return v;
         }
+      if ((format == "binary" || format == "appended") &&
+          !ctx.unknown_byte_order.empty())
+        throw InputError(ctx.filename,
+                         ctx.file_tag_line,
+                         "VTKFile byte_order",
+                         "byte_order=\"" + ctx.unknown_byte_order +
+                           "\" is neither LittleEndian nor BigEndian, so "
+                           "the binary data cannot be read",
+                         "the file is damaged or was not written by VTK; "
+                         "write it again (ParaView, meshio, deal.II).");
       std::vector<unsigned char> bytes;
       if (format == "binary")
         bytes = binary_array_bytes(ctx, strip_space(content), true, 0, name);
@@ -1099,25 +1150,25 @@ namespace palpate
                          "unknown format '" + format + "'",
                          "write the file again as ascii or binary.");
       if (type == "Float64")
-        return bytes_to_doubles<double>(bytes);
+        return bytes_to_doubles<double>(bytes, ctx.swap_bytes);
       if (type == "Float32")
-        return bytes_to_doubles<float>(bytes);
+        return bytes_to_doubles<float>(bytes, ctx.swap_bytes);
       if (type == "Int64")
-        return bytes_to_doubles<std::int64_t>(bytes);
+        return bytes_to_doubles<std::int64_t>(bytes, ctx.swap_bytes);
       if (type == "UInt64")
-        return bytes_to_doubles<std::uint64_t>(bytes);
+        return bytes_to_doubles<std::uint64_t>(bytes, ctx.swap_bytes);
       if (type == "Int32")
-        return bytes_to_doubles<std::int32_t>(bytes);
+        return bytes_to_doubles<std::int32_t>(bytes, ctx.swap_bytes);
       if (type == "UInt32")
-        return bytes_to_doubles<std::uint32_t>(bytes);
+        return bytes_to_doubles<std::uint32_t>(bytes, ctx.swap_bytes);
       if (type == "Int16")
-        return bytes_to_doubles<std::int16_t>(bytes);
+        return bytes_to_doubles<std::int16_t>(bytes, ctx.swap_bytes);
       if (type == "UInt16")
-        return bytes_to_doubles<std::uint16_t>(bytes);
+        return bytes_to_doubles<std::uint16_t>(bytes, ctx.swap_bytes);
       if (type == "Int8")
-        return bytes_to_doubles<std::int8_t>(bytes);
+        return bytes_to_doubles<std::int8_t>(bytes, ctx.swap_bytes);
       if (type == "UInt8")
-        return bytes_to_doubles<std::uint8_t>(bytes);
+        return bytes_to_doubles<std::uint8_t>(bytes, ctx.swap_bytes);
       throw InputError(ctx.filename,
                        ctx.line,
                        "DataArray " + name,
@@ -1181,13 +1232,17 @@ namespace palpate
                      "tetrahedral mesh of it." :
                      "save the tetrahedral mesh as a .vtu unstructured "
                      "grid.");
-      if (attribute(file_tag, "byte_order") == "BigEndian")
-        throw InputError(filename,
-                         1,
-                         "mesh file",
-                         "big-endian binary data is not supported",
-                         "save it as ascii (ParaView: Data mode Ascii).");
-      ctx.header_64 = attribute(file_tag, "header_type") == "UInt64";
+      // VTK writes the byte order of the machine that wrote the file;
+      // another simulator's examples declare BigEndian even for ascii
+      // data. Binary values are swapped to this machine's order.
+      const std::string byte_order = attribute(file_tag, "byte_order");
+      const bool        big_endian = byte_order == "BigEndian";
+      if (big_endian || byte_order == "LittleEndian")
+        ctx.swap_bytes = big_endian == host_is_little_endian();
+      else if (!byte_order.empty())
+        ctx.unknown_byte_order = byte_order;
+      ctx.file_tag_line = line_at(text, file_tag_begin);
+      ctx.header_64     = attribute(file_tag, "header_type") == "UInt64";
       const std::string compressor = attribute(file_tag, "compressor");
       if (!compressor.empty() && compressor != "vtkZLibDataCompressor")
         throw InputError(filename,
@@ -1251,6 +1306,7 @@ namespace palpate
 
       // Collect the data arrays of the <Points> and <Cells> sections.
       std::map<std::string, std::vector<double>> arrays;
+      bool                                       binary_read = false;
       for (const std::string &section :
            {std::string("Points"), std::string(polydata ? "Polys" : "Cells")})
         {
@@ -1289,7 +1345,8 @@ namespace palpate
                 section == "Points" ? "points" : attribute(tag, "Name");
               ctx.line    = line_at(text, a);
               arrays[key] = data_array_values(ctx, tag, content);
-              pos         = next;
+              binary_read |= attribute(tag, "format") != "ascii";
+              pos = next;
             }
         }
       if (polydata)
@@ -1381,9 +1438,12 @@ namespace palpate
                 data.triangle_lines.push_back(0);
               }
           data.format = std::string("VTP ") +
-                        (ctx.compressed ? "zlib-compressed" : "uncompressed");
+                        (ctx.compressed ? "zlib-compressed" : "uncompressed") +
+                        (big_endian && binary_read ? ", big-endian" : "");
           return data;
         }
+      if (big_endian && binary_read)
+        data.format += ", big-endian";
       LineReader reader(filename);
       add_vtk_cells(
         reader, cells, types, std::vector<unsigned int>(cells.size(), 0), data);

@@ -67,7 +67,8 @@ namespace palpate
           Patterns::FileName(),
           "Mesh file read when Source = file: Gmsh .msh (format 2.2 or "
           "v1, ASCII), legacy VTK .vtk (ASCII UNSTRUCTURED_GRID) or "
-          ".vtu (ASCII or base64 binary, uncompressed). Only linear "
+          ".vtu (ASCII, or binary inline, appended, raw or zlib-compressed, "
+          "in either byte order). Only linear "
           "tetrahedra form the body; triangles set boundary ids. With "
           "Source = surface: the organ's closed surface (.stl, .obj, .ply, "
           ".vtk POLYDATA, .vtp). A relative path is looked up against the "
@@ -110,7 +111,7 @@ namespace palpate
                             "1500",
                             Patterns::Integer(50, 200000),
                             "With Source = surface: about how many nodes the "
-                            "volume mesh has (within 15 %). The paper's "
+                            "volume mesh has (within 10 %). The paper's "
                             "livers have 501 and 2011; each state costs "
                             "roughly in proportion.");
           prm.declare_entry("Time limit",

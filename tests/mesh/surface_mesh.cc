@@ -7,7 +7,7 @@
 //   ASCII and binary STL, OBJ, ASCII and binary PLY, ASCII and binary
 //   legacy VTK, ascii and base64 VTP, read back with scale 0.001 and
 //   repaired: the same vertex and triangle counts, the volume to 1e-6; then
-//   meshed to about 300 nodes: within 15 % of 300, volume within 3 % of
+//   meshed to about 300 nodes: within 10 % of 300, volume within 3 % of
 //   the surface's.
 // - Repairs: a surface facing inward is turned outward; three tiny
 //   zero-volume shells are removed; inconsistently oriented triangles are
@@ -135,8 +135,8 @@ main(int argc, char **argv)
         }
       deallog << file << " (" << s.format << "): read back " << ok(same)
               << (r.merged_vertices > 0 ? ", vertices merged" : "")
-              << "; meshed: nodes within 15 % of 300 "
-              << ok(std::abs(m.nodes / 300.0 - 1) <= 0.15)
+              << "; meshed: nodes within 10 % of 300 "
+              << ok(std::abs(m.nodes / 300.0 - 1) <= 0.10)
               << ", volume within 3 % " << ok(std::abs(volume / V - 1) < 0.03)
               << std::endl;
     }

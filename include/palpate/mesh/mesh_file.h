@@ -47,7 +47,9 @@ namespace palpate
    * Read a mesh file: Gmsh .msh (format 2.2 or the old v1, ASCII), legacy
    * VTK .vtk (ASCII UNSTRUCTURED_GRID, classic or OFFSETS/CONNECTIVITY
    * cells) or VTK XML .vtu (ascii, base64 binary or appended data, raw or
-   * zlib-compressed). The format follows from the extension.
+   * zlib-compressed; binary data little- or big-endian, with UInt32 or
+   * UInt64 headers, ascii data whatever byte_order the file declares). The
+   * format follows from the extension.
    *
    * Every problem (unreadable file, unsupported format or element type, a
    * node number that is not defined, a truncated section) throws an

@@ -13,14 +13,36 @@
 
 namespace palpate
 {
+  /**
+   * How far a uniform mesh's node count may be from the count asked for
+   * (a fraction: 0.1 is 10 %). Gmsh's count follows the element size only
+   * roughly, so mesh_volume() meshes again at a corrected size until the
+   * count is this close.
+   */
+  constexpr double target_nodes_tolerance = 0.1;
+
   /** What mesh_volume() made. */
   struct VolumeMeshing
   {
     unsigned int nodes = 0, tetrahedra = 0, surface_triangles = 0;
     /** The element size the mesher was given (m). */
     double size = 0;
-    /** Meshing attempts (the size is corrected toward the target count). */
+    /** Gmsh runs: one per meshing pass, more where Gmsh could not
+     * parametrise the surface's patches and was given smaller ones. */
     unsigned int attempts = 0;
+    /** Meshings at different element sizes (the size is corrected toward
+     * the target count after each). */
+    unsigned int passes = 0;
+    /** The node count asked for. */
+    unsigned int target_nodes = 0;
+    /** The mesh is graded (MeshGrading): the target sets its coarse size
+     * only, and its count is not corrected. */
+    bool graded = false;
+    /** The node count is within target_nodes_tolerance of the target. */
+    bool target_nodes_met = false;
+    /** The passes stopped early because another would likely have
+     * overrun the time limit. */
+    bool stopped_by_time_limit = false;
     /** Wall-clock time of the meshing (s). */
     double seconds = 0;
   };
@@ -48,7 +70,10 @@ namespace palpate
    * (its API: surface classification, reparametrisation, Frontal-Delaunay
    * surfaces and Delaunay volumes, then optimisation) and write the volume
    * mesh to @p out_msh as Gmsh 2.2 ASCII in metres (physical volume 1,
-   * boundary triangles with boundary id 1).
+   * boundary triangles with boundary id 1). A uniform mesh whose count is
+   * more than target_nodes_tolerance off is made again at a corrected
+   * size (up to four passes in all); the closest pass is kept, and the
+   * result says whether it is within the tolerance.
    *
    * Gmsh runs in a child process that is killed after @p time_limit
    * seconds, so a bad surface can never hang palpate. Failures (the limit,
