@@ -6,8 +6,8 @@
 //                            [--csv FILE]
 //
 // Real organs at human speed. The shipped liver surface
-// (meshes/liver-tetgen/liver2k-surface.obj, 25 cm) meshed by palpate's own mesher at
-// about 1,500 and 4,000 nodes, touched by the indenter of
+// (meshes/liver-tetgen/liver2k-surface.obj, 25 cm) meshed by palpate's own
+// mesher at about 1,500 and 4,000 nodes, touched by the indenter of
 // parameters/liver-indenter.prm (a 1 cm sphere, the liver on its bed), in
 // neo-Hookean (E = 15465 Pa, nu = 0.49) and incompressible Mooney-Rivlin
 // (P1-P1), the recommended discretisation of benchmarks/run convergence.

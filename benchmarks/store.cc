@@ -87,8 +87,8 @@ main(int argc, char **argv)
                                 "/parameters/paper-stvk.prm");
       auto &p     = scene.parameters;
       if (mesh == "liver2k")
-        p.mesh.file_name = std::string(PALPATE_SOURCE_DIR) +
-                           "/meshes/liver-tetgen/liver2k.msh";
+        p.mesh.file_name =
+          std::string(PALPATE_SOURCE_DIR) + "/meshes/liver-tetgen/liver2k.msh";
       p.state_space.store = "bench-" + mesh + ".h5";
       std::filesystem::remove(p.state_space.store);
 

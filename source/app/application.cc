@@ -128,8 +128,13 @@ namespace palpate
     int
     run_server_rank(const std::vector<std::string> &args,
                     const std::vector<std::string> &settings,
+                    const bool                      dangling_set,
                     std::ostream                   &err)
     {
+      // Rank 0 refuses a '--set' without its value before it starts
+      // anything: a server waiting for it would wait forever.
+      if (dangling_set)
+        return ExitStatus::input_error;
       // palpate precompute and palpate serve under mpirun: the servers
       // compute, rank 0 writes the store or serves the page, whatever the
       // scene's Run / Mode.
@@ -597,7 +602,7 @@ namespace palpate
           }
       }
     if (mpi_rank() > 0)
-      return run_server_rank(args, settings, err);
+      return run_server_rank(args, settings, dangling_set, err);
     try
       {
         if (dangling_set)

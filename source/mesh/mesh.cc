@@ -132,7 +132,9 @@ namespace palpate
       std::uint64_t hash = 1469598103934665603ull; // FNV-1a
       for (const char c :
            bytes + "|" + Utilities::to_string(p.scale_factor, 17) + "|" +
-             std::to_string(p.surface_target_nodes) + "|palpate-mesh-1" +
+             // -2: the mesher's node-count correction changed (within
+             // 10 %); meshes of older builds are made again.
+             std::to_string(p.surface_target_nodes) + "|palpate-mesh-2" +
              (p.surface_fine_size > 0 ?
                 "|graded " + Utilities::to_string(p.surface_fine_size, 17) +
                   " " + Utilities::to_string(p.surface_fine_radius, 17) + " " +
@@ -156,6 +158,9 @@ namespace palpate
                      std::to_string(p.surface_target_nodes) + "-" +
                      std::string(hex).substr(0, 8) + ".msh");
       std::string how = "reused";
+      // A mesh whose node-count corrections the time limit stopped is
+      // used once and not kept: with more time the next run does better.
+      bool keep = true;
       if (std::error_code exists_error; !fs::exists(file, exists_error))
         try
           {
@@ -181,15 +186,22 @@ namespace palpate
             for (const auto &line : report.lines())
               if (line.rfind("warning:", 0) == 0)
                 how += "; " + Utilities::trim(line);
+            keep = !report.meshing.stopped_by_time_limit;
           }
         catch (const InputError &e)
           {
             throw read_by(e, scene, "this surface");
           }
-      return Mesh(read_mesh_file(file.string()),
-                  1.0,
-                  p.file_name + ", meshed by palpate into " + file.string() +
-                    " (" + how + ")");
+      Mesh mesh(read_mesh_file(file.string()),
+                1.0,
+                p.file_name + ", meshed by palpate into " + file.string() +
+                  " (" + how + (keep ? "" : "; not kept") + ")");
+      if (!keep)
+        {
+          std::error_code error;
+          fs::remove(file, error);
+        }
+      return mesh;
     }
 
     std::string

@@ -712,20 +712,6 @@ namespace palpate
     // caught instead of the last one silently winning.
     if (content.empty() || content.back() != '\n')
       content += '\n';
-    // The --set entries are read after the file, as lines of their own
-    // (below its last line, so the actions below tell them apart), and
-    // win over the file's values.
-    const unsigned int file_lines = lines.size();
-    for (const CommandLineSetting &o : overrides)
-      {
-        for (const auto &name : o.path)
-          content += "subsection " + name + "\n";
-        content += "set " + o.name + " = " + o.value + "\n";
-        for (std::size_t i = 0; i < o.path.size(); ++i)
-          content += "end\n";
-        scene.command_line_settings_.push_back(entry_key(o.path, o.name) + "=" +
-                                               o.value);
-      }
     std::istringstream stream(content);
     const auto         line_now = [&]() -> unsigned int {
       const std::streamoff position = stream.tellg();
@@ -738,11 +724,16 @@ namespace palpate
       std::string  key;
       std::string  value;
       unsigned int line;
+      bool         command_line; // a --set, applied after the file
     };
     std::vector<Setting> settings;
+    bool                 applying_command_line = false;
     const std::function<void(const std::string &, const std::string &)> record =
       [&](const std::string &key, const std::string &value) {
-        settings.push_back({key, value, line_now()});
+        settings.push_back({key,
+                            value,
+                            applying_command_line ? 0u : line_now(),
+                            applying_command_line});
       };
     dealii::ParameterHandler prm;
     Parameters::AllParameters::declare_parameters(prm);
@@ -802,11 +793,28 @@ namespace palpate
         throw explain_rejection(
           filename, lines, line_now(), Rejection::other, dealii_message(e));
       }
+    // The --set entries, after the file (whose text they never touch: a
+    // value holding '#' or '\' stays whole, and a file's own mistakes are
+    // reported as before). ParameterHandler::set() runs the same actions as
+    // a line of the file; parse_command_line_settings() checked each value
+    // against its pattern already.
+    applying_command_line = true;
+    for (const CommandLineSetting &o : overrides)
+      {
+        for (const auto &name : o.path)
+          prm.enter_subsection(name);
+        prm.set(o.name, o.value);
+        for (std::size_t i = 0; i < o.path.size(); ++i)
+          prm.leave_subsection();
+        scene.command_line_settings_.push_back(entry_key(o.path, o.name) + "=" +
+                                               o.value);
+      }
+    applying_command_line = false;
 
     std::map<std::string, const Setting *> first_setting;
     for (const Setting &s : settings)
       {
-        if (s.line > file_lines) // a --set: it replaces the file's value
+        if (s.command_line) // a --set: it replaces the file's value
           {
             scene.entry_lines_[s.key]  = 0;
             scene.entry_values_[s.key] = s.value;
@@ -844,8 +852,8 @@ namespace palpate
               const double x   = std::strtod(piece.c_str(), &end);
               if (end != piece.c_str() && errno == ERANGE)
                 throw InputError(
-                  s.line > file_lines ? std::string("command line") : filename,
-                  s.line > file_lines ? 0 : s.line,
+                  s.command_line ? std::string("command line") : filename,
+                  s.command_line ? 0 : s.line,
                   shown_key(s.key) + " = " + s.value,
                   "'" + piece + "' is out of the range of numbers palpate " +
                     "computes with (" +
@@ -1051,10 +1059,21 @@ namespace palpate
         throw error("Effects/" + e.entry, e.problem, e.fix);
       }
 
+    // Whether the scene file or the command line (--set) sets an entry.
+    const auto sets = [this](const std::string &entry) {
+      return line_of(entry) > 0 ||
+             std::any_of(command_line_settings_.begin(),
+                         command_line_settings_.end(),
+                         [&](const std::string &setting) {
+                           return setting.compare(0,
+                                                  entry.size() + 1,
+                                                  entry + "=") == 0;
+                         });
+    };
+
     // An element pair (Taylor-Hood, P1-P1) fixes the displacement degree.
     if (const Formulation f = material->formulation();
-        f.displacement_degree > 0 &&
-        line_of("Discretization/Polynomial degree") > 0 &&
+        f.displacement_degree > 0 && sets("Discretization/Polynomial degree") &&
         p.discretization.polynomial_degree != f.displacement_degree)
       throw error("Discretization/Polynomial degree",
                   m.model_name + "'s element pair " + f.element +
@@ -1107,7 +1126,7 @@ namespace palpate
     // A file named for a generator is a mistake: the run would silently
     // use a beam or blob instead of the organ the user meant.
     if ((p.mesh.source == "beam" || p.mesh.source == "blob") &&
-        !p.mesh.file_name.empty() && line_of("Mesh/File name") > 0)
+        !p.mesh.file_name.empty() && sets("Mesh/File name"))
       throw error("Mesh/File name",
                   "a file is named, but Source = " + p.mesh.source +
                     " generates the mesh and ignores it",
@@ -1268,7 +1287,7 @@ namespace palpate
     }
 
     // The Newton solver's loop counts.
-    const auto  count_bound = [&](const std::string &entry,
+    const auto count_bound = [&](const std::string &entry,
                                  const unsigned int value,
                                  const unsigned int bound,
                                  const std::string &why,

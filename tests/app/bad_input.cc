@@ -429,6 +429,10 @@ main(int argc, char **argv)
   run("--set with a command that reads no scene",
       "mesh surface.stl out.msh --set 'Run/Mode=set-up only'");
   run("--set without its value", "good.prm --set");
+  run("--set of a mesh file while Source = beam",
+      "good.prm --set 'Mesh/File name=liver.msh'");
+  run("--set on a file whose subsection is never closed",
+      "unclosed.prm --set 'Run/Mode=set-up only'");
 
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;

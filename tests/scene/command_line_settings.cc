@@ -88,6 +88,12 @@ main(int argc, char **argv)
                 original.line_of("Material model/Model name") > 0)
           << std::endl;
 
+  // A value is taken whole: '#' starts no comment, as it would in a file.
+  const palpate::Scene hash =
+    palpate::Scene::read(file, {"Output/Directory=run#2"});
+  deallog << "a value holding '#' stays whole: "
+          << ok(hash.parameters.output.directory == "run#2") << std::endl;
+
   const auto a = force(variant), b = force(edited), c = force(original);
   deallog << "force of the variant: (" << palpate::Utilities::to_string(a, 6)
           << ") N" << std::endl;
