@@ -35,6 +35,8 @@
 
 #include "../tests.h"
 
+#include "../mesh_writers.h"
+
 namespace
 {
   using Bytes = std::vector<unsigned char>;
@@ -77,25 +79,6 @@ namespace
     return e == Encoding::base64_zlib || e == Encoding::appended_raw_zlib;
   }
 
-  std::string
-  base64(const Bytes &bytes)
-  {
-    static const char *a =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < bytes.size(); i += 3)
-      {
-        const unsigned int n = (bytes[i] << 16) |
-                               (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0) |
-                               (i + 2 < bytes.size() ? bytes[i + 2] : 0);
-        out += a[(n >> 18) & 63];
-        out += a[(n >> 12) & 63];
-        out += i + 1 < bytes.size() ? a[(n >> 6) & 63] : '=';
-        out += i + 2 < bytes.size() ? a[n & 63] : '=';
-      }
-    return out;
-  }
-
   bool
   host_is_little_endian()
   {
@@ -131,13 +114,6 @@ namespace
       return bytes_of(values, big_endian);
     return bytes_of(std::vector<std::uint32_t>(values.begin(), values.end()),
                     big_endian);
-  }
-
-  Bytes
-  concat(Bytes a, const Bytes &b)
-  {
-    a.insert(a.end(), b.begin(), b.end());
-    return a;
   }
 
   /** One array as VTK stores it: its header, then its (packed) data. */
