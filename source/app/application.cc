@@ -9,6 +9,7 @@
 #include <palpate/app/static_solve.h>
 #include <palpate/app/study.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/engine/mpi_engine.h>
 #include <palpate/haptics/run_summary.h>
 #include <palpate/mesh/mesh.h>
@@ -20,6 +21,8 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -40,7 +43,7 @@ namespace palpate
       "                                  (default: the scene's Prescribed\n"
       "                                  displacement) and print the force\n"
       "  palpate study SCENE.prm [--quick] [--samples N] [--finer-mesh FILE]\n"
-      "                [--csv FILE]\n"
+      "                [--csv FILE] [--time-limit S] [--skip KNOB,...]\n"
       "                                  what accuracy costs in time for this\n"
       "                                  scene: grid spacing, interpolation,\n"
       "                                  tolerance, staging, mesh and element\n"
@@ -153,6 +156,12 @@ namespace palpate
             return ExitStatus::success;
           const Mesh          mesh  = Mesh::create(scene);
           const NodeSelection nodes = NodeSelection::create(scene, mesh);
+          // Ctrl-C on mpirun reaches every rank as SIGTERM. A server that
+          // died of it would take the client's run down with it before the
+          // client wrote its summary and logs; the server rather goes on
+          // until the client, stopping through its normal path, releases
+          // it (mpirun kills what is left after its own grace period).
+          const StopRequest stop;
           return run_solver_server(scene, mesh, nodes) == 0 ?
                    ExitStatus::success :
                    ExitStatus::internal_error;
@@ -199,6 +208,16 @@ namespace palpate
       if (!solve && mode == "interaction")
         {
           const RunSummary summary = run_interaction(out, scene);
+          if (summary.stop_signal != 0)
+            {
+              out.flush();
+              std::cerr << "\npalpate: the interaction was stopped "
+                        << summary.stopped_by
+                        << "; its summary and output files were written. "
+                           "Exit status "
+                        << 128 + summary.stop_signal << ".\n";
+              return 128 + summary.stop_signal;
+            }
           if (summary.lost_servers.empty())
             return ExitStatus::success;
           // mpirun --enable-recovery (needed to survive a dead server)
@@ -530,6 +549,33 @@ namespace palpate
                 options.finer_mesh = args[++i];
               else if (args[i] == "--csv" && has_value)
                 options.csv_file = args[++i];
+              else if (args[i] == "--time-limit" && has_value)
+                options.time_limit = number_argument(
+                  "--time-limit", args[++i], 1, 7 * 86400, "600");
+              else if (args[i] == "--skip" && has_value)
+                {
+                  const std::string           knobs = args[++i];
+                  const std::set<std::string> known = {"grid",
+                                                       "tolerance",
+                                                       "increment",
+                                                       "combined",
+                                                       "mesh",
+                                                       "element"};
+                  std::stringstream           list(knobs);
+                  for (std::string knob; std::getline(list, knob, ',');)
+                    {
+                      if (known.count(knob) == 0)
+                        throw InputError(
+                          "command line",
+                          0,
+                          "--skip " + knobs,
+                          "'" + knob + "' is not one of the study's knobs",
+                          "name some of grid, tolerance, increment, "
+                          "combined, mesh, element, separated by commas: "
+                          "e.g. --skip element,mesh.");
+                      options.skip.push_back(knob);
+                    }
+                }
               else if (args[i] == "--samples" && has_value)
                 {
                   const std::string v   = args[++i];
@@ -564,8 +610,17 @@ namespace palpate
                                "' cannot be read",
                              "give a finer mesh of the same organ, in the "
                              "scene's file unit (its Scale factor applies).");
-          const Scene scene = read_and_report(args[1], settings, out);
-          run_study(out, scene, options);
+          const Scene       scene  = read_and_report(args[1], settings, out);
+          const StudyResult result = run_study(out, scene, options);
+          if (result.stop_signal != 0)
+            {
+              out.flush();
+              std::cerr << "\npalpate: the study was " << result.stopped
+                        << "; what it measured was printed and written to "
+                        << result.csv_file << ". Exit status "
+                        << 128 + result.stop_signal << ".\n";
+              return 128 + result.stop_signal;
+            }
           return ExitStatus::success;
         }
       if (args.size() > 1)
@@ -601,6 +656,7 @@ namespace palpate
             args.push_back(a);
           }
       }
+    ignore_broken_pipes();
     if (mpi_rank() > 0)
       return run_server_rank(args, settings, dangling_set, err);
     try
@@ -612,7 +668,20 @@ namespace palpate
             "--set",
             "--set needs ENTRY=VALUE after it",
             "e.g. --set 'Material model/Model name=Neo-Hookean'.");
-        return dispatch(args, settings, out);
+        const int status = dispatch(args, settings, out);
+        // Output that could not be written (a closed pipe: SIGPIPE is
+        // ignored; /dev/full; a full disk) is an error, not exit 0.
+        out.flush();
+        if (!out && status == ExitStatus::success)
+          {
+            err << "\npalpate: output failed: the standard output could not "
+                   "be written (a closed pipe, or a full disk); what it "
+                   "printed was lost.\n  fix:     send it to a file on a "
+                   "disk with room, or read the run's CSV/JSON summaries "
+                   "(Output / Summary formats).\n";
+            return ExitStatus::output_failed;
+          }
+        return status;
       }
     catch (const InputError &e)
       {

@@ -3,6 +3,7 @@
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/haptics/haptic_loop.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
@@ -150,6 +151,11 @@ namespace palpate
         [&loop] { return loop.motion_time(); },
         p.effects.shape_output_limit * 1048576.0);
 
+    // From here on a stop signal ends the run through the path below, which
+    // writes every output (doc/bad-input.md, "Stops").
+    const StopRequest stop;
+    std::string       stopped_by;
+
     const auto t0 = Clock::now();
     interaction.attach();
     loop.start(duration);
@@ -178,6 +184,24 @@ namespace palpate
         interaction.poll_events(out);
         const double t =
           std::chrono::duration<double>(Clock::now() - t0).count();
+        // A stop signal, or nobody left to read the output (a closed pipe,
+        // a full disk: SIGPIPE is ignored, so the write fails instead):
+        // end the motion here and write what the run has.
+        if (stop.requested() || !out)
+          {
+            const double motion = loop.motion_time();
+            stopped_by =
+              (stop.requested() ? "by " + stop.description() :
+                                  std::string("because standard output "
+                                              "could not be written")) +
+              (motion >= 0 ?
+                 " after " + Utilities::to_string(motion, 3) + " s of the " +
+                   Utilities::to_string(duration, 3) + " s motion" :
+                 " before the motion started (" + Utilities::to_string(t, 3) +
+                   " s into the initial cloud)");
+            loop.join();
+            break;
+          }
         if (!moving && t > next_progress &&
             !interaction.initial_cloud_complete())
           {
@@ -226,6 +250,8 @@ namespace palpate
     RunSummary summary = interaction.summary();
     loop.add_to(summary);
     summary.trajectory             = device.description();
+    summary.stopped_by             = stopped_by;
+    summary.stop_signal            = stop.signal_number();
     summary.initial_cloud_states   = cloud_states;
     summary.initial_cloud_complete = cloud_complete;
     if (shape)

@@ -3,6 +3,7 @@
 
 #include <palpate/app/study.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/material.h>
@@ -73,21 +74,46 @@ namespace palpate
     }
 
     /** A progress bar on stderr (a terminal), else a line per step. */
+    /** Why the study ended before its last knob (Progress::step). */
+    struct StudyCut
+    {
+      std::string why;
+    };
+
     class Progress
     {
     public:
-      Progress(std::ostream &out, const bool enabled, const double total)
+      Progress(std::ostream      &out,
+               const bool         enabled,
+               const double       total,
+               const StopRequest &stop,
+               const double       time_limit)
         : out(out)
         , enabled(enabled)
         , terminal(isatty(2))
         , total(total)
         , start(Clock::now())
+        , stop(stop)
+        , time_limit(time_limit)
       {}
 
+      /**
+       * One piece of work done (a state, a direct solve). Where the study
+       * may be cut short: throws StudyCut after a stop signal, past the
+       * time budget, or when nobody can read the output any more.
+       */
       void
       step(const double amount, const std::string &what)
       {
         done += amount;
+        if (stop.requested())
+          throw StudyCut{"stopped by " + stop.description()};
+        if (time_limit > 0 && seconds_since(start) > time_limit)
+          throw StudyCut{"its time budget (--time-limit " +
+                         std::to_string(static_cast<long>(time_limit)) +
+                         " s) ran out"};
+        if (!out)
+          throw StudyCut{"the standard output could not be written"};
         if (!enabled)
           return;
         const double      fraction = std::min(1.0, done / total);
@@ -126,11 +152,13 @@ namespace palpate
       }
 
     private:
-      std::ostream     &out;
-      bool              enabled, terminal;
-      double            total, done = 0, next_line = 0;
-      std::string       last;
-      Clock::time_point start;
+      std::ostream      &out;
+      bool               enabled, terminal;
+      double             total, done = 0, next_line = 0;
+      std::string        last;
+      Clock::time_point  start;
+      const StopRequest &stop;
+      double             time_limit;
     };
 
     /**
@@ -683,277 +711,349 @@ namespace palpate
       total += 2 * n_disc * (1 + finer_cost);
     if (p2_knob)
       total += 2 * n_disc * p2_cost;
-    Progress progress(out, options.progress, total);
+    // A stop signal or the time budget cuts the study short at the next
+    // state or solve; what was measured until then is reported and written
+    // (the CSV also after every knob setting, so that even a killed study
+    // leaves its finished rows).
+    const StopRequest stop;
+    Progress   progress(out, options.progress, total, stop, options.time_limit);
+    const auto skipped = [&](const std::string &knob) {
+      return std::find(options.skip.begin(), options.skip.end(), knob) !=
+             options.skip.end();
+    };
 
-    // --- Reference: direct solves at every position, tolerance 1e-10.
-    const std::vector<Sample> reference   = direct_solves(base,
-                                                        paths,
-                                                        positions.size(),
-                                                        1e-10,
-                                                        nullptr,
-                                                        progress,
-                                                        1,
-                                                        "reference solves");
-    unsigned int              n_reference = 0;
-    for (const auto &s : reference)
-      n_reference += s.ok;
-    const std::vector<int> node_of_dof =
-      nodes_of_dofs(StateSolver(base.mesh, base.nodes, p0).system());
-
-    // --- One setting of the grid knobs: compute its states, interpolate
-    // with both schemes, compare.
-    const auto grid_setting = [&](const std::string              &knob,
-                                  const std::string              &value,
-                                  const Parameters::AllParameters p) {
-      const StateGrid grid(p.state_space.grid_spacing, p.state_space.extent);
-      const auto      corners     = cell_corners(grid, positions);
-      const auto      needed      = with_neighbours(grid, corners);
-      auto            q           = p;
-      q.state_space.interpolation = "tricubic Hermite"; // stiffness too
-      const GridStates g =
-        compute_grid(base, q, grid, needed, progress, 1, knob + " " + value);
-      StateCache cache(grid, std::size_t(1) << 40);
-      for (const auto &[point, state] : g.states)
-        cache.publish(point, state, cache.generation());
-      for (const unsigned int point : g.failed)
-        cache.publish_failure(point, cache.generation());
-
-      // Cost: state time with and without the stiffness.
-      std::vector<double> plain, with;
-      for (std::size_t i = 0; i < g.times.size(); ++i)
+    result.csv_file = options.csv_file;
+    if (result.csv_file.empty())
+      {
+        std::filesystem::create_directories(p0.output.directory);
+        result.csv_file =
+          (std::filesystem::path(p0.output.directory) /
+           ("study-" + std::filesystem::path(scene.file()).stem().string() +
+            ".csv"))
+            .string();
+      }
+    const auto write_csv = [&] {
+      std::ofstream csv(result.csv_file);
+      csv << "material,knob,value,interpolation,probe,h_mm,samples,covered,"
+             "err_mean_N,err_p95_N,err_max_N,err_mean_pct,err_p95_pct,"
+             "err_max_pct,shape_err_mm,state_ms,states,failures,states_per_cm,"
+             "region_states,precompute_s,memory_MiB,speed_mm_s,recommended\n";
+      for (unsigned int r = 0; r < result.rows.size(); ++r)
         {
-          with.push_back(g.times[i]);
-          plain.push_back(g.times[i] - g.stiffness_times[i]);
+          const auto &row = result.rows[r];
+          csv << result.material << "," << row.knob << ",\"" << row.value
+              << "\"," << row.interpolation << "," << row.probe << ","
+              << row.h_mm << "," << row.samples << "," << row.covered << ","
+              << row.err_mean_N << "," << row.err_p95_N << "," << row.err_max_N
+              << "," << row.err_mean_pct << "," << row.err_p95_pct << ","
+              << row.err_max_pct << "," << row.shape_err_mm << ","
+              << row.state_ms << "," << row.states << "," << row.failures << ","
+              << row.states_per_cm << "," << row.region_states << ","
+              << row.precompute_s << "," << row.memory_MiB << ","
+              << row.speed_mm_s << ","
+              << (int(r) == result.recommended ? "yes" : "no") << "\n";
         }
-      unsigned int region = 0;
-      double       bytes  = 0;
-      for (const unsigned int c : corners)
-        if (const auto i = g.states.find(c); i != g.states.end())
-          {
-            ++region;
-            bytes += state_bytes(*i->second);
-          }
-        else
-          ++region;
-      const double per_cm = states_per_cm(grid.spacing());
+      csv.close();
+      if (!csv)
+        throw OutputError("the study's CSV '" + result.csv_file +
+                          "' could not be written");
+    };
 
-      // Shape: trilinear blend of the corners' displacement fields.
-      std::vector<double> shape;
-      for (std::size_t k = 0; k < positions.size(); ++k)
-        {
-          if (!reference[k].ok)
-            continue;
-          GridIndex             lower;
-          std::array<double, 3> local;
-          if (!grid.locate(positions[k], lower, local))
-            continue;
-          const auto          c = grid.corners(lower);
-          const auto          w = trilinear_weights(local);
-          std::vector<double> u(reference[k].solution.size(), 0.0);
-          bool                complete = true;
-          for (unsigned int j = 0; j < 8 && complete; ++j)
+    std::vector<Sample> reference;
+    unsigned int        n_reference = 0;
+    try
+      {
+        // --- Reference: direct solves at every position, tolerance 1e-10.
+        reference = direct_solves(base,
+                                  paths,
+                                  positions.size(),
+                                  1e-10,
+                                  nullptr,
+                                  progress,
+                                  1,
+                                  "reference solves");
+        for (const auto &s : reference)
+          n_reference += s.ok;
+        const std::vector<int> node_of_dof =
+          nodes_of_dofs(StateSolver(base.mesh, base.nodes, p0).system());
+
+        // --- One setting of the grid knobs: compute its states, interpolate
+        // with both schemes, compare.
+        const auto grid_setting = [&](const std::string              &knob,
+                                      const std::string              &value,
+                                      const Parameters::AllParameters p) {
+          const StateGrid grid(p.state_space.grid_spacing,
+                               p.state_space.extent);
+          const auto      corners     = cell_corners(grid, positions);
+          const auto      needed      = with_neighbours(grid, corners);
+          auto            q           = p;
+          q.state_space.interpolation = "tricubic Hermite"; // stiffness too
+          const GridStates g          = compute_grid(
+            base, q, grid, needed, progress, 1, knob + " " + value);
+          StateCache cache(grid, std::size_t(1) << 40);
+          for (const auto &[point, state] : g.states)
+            cache.publish(point, state, cache.generation());
+          for (const unsigned int point : g.failed)
+            cache.publish_failure(point, cache.generation());
+
+          // Cost: state time with and without the stiffness.
+          std::vector<double> plain, with;
+          for (std::size_t i = 0; i < g.times.size(); ++i)
             {
-              const auto i = g.states.find(c[j]);
-              complete     = i != g.states.end();
-              if (complete)
-                for (std::size_t d = 0; d < u.size(); ++d)
-                  u[d] += w[j] * i->second->solution[d];
+              with.push_back(g.times[i]);
+              plain.push_back(g.times[i] - g.stiffness_times[i]);
             }
-          if (complete)
-            shape.push_back(
-              shape_difference(node_of_dof, u, reference[k].solution));
-        }
+          unsigned int region = 0;
+          double       bytes  = 0;
+          for (const unsigned int c : corners)
+            if (const auto i = g.states.find(c); i != g.states.end())
+              {
+                ++region;
+                bytes += state_bytes(*i->second);
+              }
+            else
+              ++region;
+          const double per_cm = states_per_cm(grid.spacing());
 
-      for (const auto scheme :
-           {Interpolation::trilinear, Interpolation::hermite})
-        {
-          StudyRow row;
-          row.knob  = knob;
-          row.value = value;
-          row.interpolation =
-            scheme == Interpolation::hermite ? "Hermite" : "trilinear";
-          row.h_mm               = grid.spacing() * 1000;
-          row.residual_tolerance = p.nonlinear_solver.residual_tolerance;
-          row.max_increment      = p.nonlinear_solver.max_increment_length;
-          std::vector<double> absolute, relative;
+          // Shape: trilinear blend of the corners' displacement fields.
+          std::vector<double> shape;
           for (std::size_t k = 0; k < positions.size(); ++k)
             {
               if (!reference[k].ok)
                 continue;
-              ++row.samples;
-              const ForceSample s =
-                interpolate_force(grid, cache, positions[k], scheme);
-              if (!s.complete)
+              GridIndex             lower;
+              std::array<double, 3> local;
+              if (!grid.locate(positions[k], lower, local))
                 continue;
-              ++row.covered;
-              absolute.push_back(
-                Utilities::distance(s.force, reference[k].force));
-              relative.push_back(relative_error(s.force, reference[k].force));
+              const auto          c = grid.corners(lower);
+              const auto          w = trilinear_weights(local);
+              std::vector<double> u(reference[k].solution.size(), 0.0);
+              bool                complete = true;
+              for (unsigned int j = 0; j < 8 && complete; ++j)
+                {
+                  const auto i = g.states.find(c[j]);
+                  complete     = i != g.states.end();
+                  if (complete)
+                    for (std::size_t d = 0; d < u.size(); ++d)
+                      u[d] += w[j] * i->second->solution[d];
+                }
+              if (complete)
+                shape.push_back(
+                  shape_difference(node_of_dof, u, reference[k].solution));
             }
-          errors(row, absolute, relative);
-          if (!shape.empty())
-            row.shape_err_mm =
-              1000 * *std::max_element(shape.begin(), shape.end());
-          row.state_ms =
-            1000 *
-            percentile(scheme == Interpolation::hermite ? with : plain, 0.5);
-          row.states            = g.times.size();
-          row.failures          = g.failed.size();
-          row.states_per_cm     = per_cm;
-          row.region_states     = region;
-          const double slowdown = workers > 1 ? two_solver_slowdown : 1.0;
-          row.precompute_s = region * row.state_ms / 1000 * slowdown / workers;
-          row.memory_MiB   = bytes / 1048576.0;
-          // The engine keeps up while it computes the corners ahead as
-          // fast as the HIP reaches them: workers / (state time) states
-          // per second, per_cm states per cm (doc/accuracy-vs-time.md
-          // compares it with benchmarks/run max-speed).
-          row.speed_mm_s =
-            workers / (row.state_ms / 1000 * slowdown) / per_cm * 10;
-          result.rows.push_back(row);
-        }
-    };
 
-    for (const double h : spacings)
-      {
-        auto p                     = p0;
-        p.state_space.grid_spacing = h;
-        grid_setting("grid", mm(h), p);
-      }
-    for (const double t : tolerances)
-      {
-        auto p                                = p0;
-        p.nonlinear_solver.residual_tolerance = t;
-        grid_setting("tolerance", scientific(t), p);
-      }
-    for (const double l : increments)
-      {
-        auto p                                  = p0;
-        p.nonlinear_solver.max_increment_length = l;
-        grid_setting("increment", mm(l), p);
-      }
-
-    // The knobs together: the fastest grid setting that passes, with the
-    // loosest tolerance that passes at the scene's spacing with the same
-    // interpolation.
-    {
-      const StudyRow *best_grid = nullptr;
-      double          loosest   = p0.nonlinear_solver.residual_tolerance;
-      for (const auto &row : result.rows)
-        if (passes(row, result.threshold_pct) && row.knob == "grid" &&
-            (best_grid == nullptr || row.speed_mm_s > best_grid->speed_mm_s))
-          best_grid = &row;
-      if (best_grid != nullptr)
-        for (const auto &row : result.rows)
-          if (passes(row, result.threshold_pct) && row.knob == "tolerance" &&
-              row.interpolation == best_grid->interpolation)
-            loosest = std::max(loosest, row.residual_tolerance);
-      if (best_grid != nullptr &&
-          (best_grid->h_mm / 1000 != h0 ||
-           loosest != p0.nonlinear_solver.residual_tolerance))
-        {
-          auto p                                = p0;
-          p.state_space.grid_spacing            = best_grid->h_mm / 1000;
-          p.nonlinear_solver.residual_tolerance = loosest;
-          const std::string value =
-            mm(p.state_space.grid_spacing) + ", " + scientific(loosest);
-          grid_setting("combined", value, p);
-        }
-    }
-
-    // --- Discretisation knobs: direct solves at the first n_disc
-    // positions, against the finest setting of the knob, with the point
-    // probe and with a rigid tip.
-    const auto discretisation = [&](const std::string              &knob,
-                                    const std::vector<Scene>       &variants,
-                                    const std::vector<std::string> &names,
-                                    const std::vector<double>      &cost) {
-      for (const double radius : {0.0, tip})
-        {
-          std::vector<std::vector<Sample>> forces;
-          std::vector<std::vector<double>> times(variants.size());
-          for (unsigned int v = 0; v < variants.size(); ++v)
-            {
-              Scene s           = variants[v];
-              auto &active      = s.parameters.boundary_conditions.active_node;
-              active.tip_radius = radius;
-              // The scene's sphere stays a sphere; otherwise a finite
-              // radius is a glued tip.
-              if (active.tip != Parameters::ActiveNode::Tip::sphere)
-                active.tip = radius > 0 ?
-                               Parameters::ActiveNode::Tip::glued_nodes :
-                               Parameters::ActiveNode::Tip::point;
-              else if (!(radius > 0))
-                active.tip = Parameters::ActiveNode::Tip::point;
-              const Body body(s);
-              forces.push_back(direct_solves(
-                body,
-                paths,
-                std::min<unsigned>(n_disc, positions.size()),
-                p0.nonlinear_solver.residual_tolerance,
-                &times[v],
-                progress,
-                cost[v],
-                knob + " " + names[v] +
-                  (radius > 0 ? ", tip " + mm(radius) : ", point probe")));
-            }
-          const auto &finest = forces.back();
-          for (unsigned int v = 0; v < variants.size(); ++v)
+          for (const auto scheme :
+               {Interpolation::trilinear, Interpolation::hermite})
             {
               StudyRow row;
-              row.knob          = knob;
-              row.value         = names[v];
-              row.interpolation = "direct";
-              row.probe         = radius > 0 ? "tip " + mm(radius) : "point";
-              row.h_mm          = 0;
+              row.knob  = knob;
+              row.value = value;
+              row.interpolation =
+                scheme == Interpolation::hermite ? "Hermite" : "trilinear";
+              row.h_mm               = grid.spacing() * 1000;
+              row.residual_tolerance = p.nonlinear_solver.residual_tolerance;
+              row.max_increment      = p.nonlinear_solver.max_increment_length;
               std::vector<double> absolute, relative;
-              for (std::size_t k = 0; k < finest.size(); ++k)
+              for (std::size_t k = 0; k < positions.size(); ++k)
                 {
+                  if (!reference[k].ok)
+                    continue;
                   ++row.samples;
-                  if (!finest[k].ok || !forces[v][k].ok)
-                    {
-                      row.failures += !forces[v][k].ok;
-                      continue;
-                    }
+                  const ForceSample s =
+                    interpolate_force(grid, cache, positions[k], scheme);
+                  if (!s.complete)
+                    continue;
                   ++row.covered;
                   absolute.push_back(
-                    Utilities::distance(forces[v][k].force, finest[k].force));
+                    Utilities::distance(s.force, reference[k].force));
                   relative.push_back(
-                    relative_error(forces[v][k].force, finest[k].force));
+                    relative_error(s.force, reference[k].force));
                 }
               errors(row, absolute, relative);
-              row.state_ms = 1000 * percentile(times[v], 0.5);
-              row.states   = times[v].size();
+              if (!shape.empty())
+                row.shape_err_mm =
+                  1000 * *std::max_element(shape.begin(), shape.end());
+              row.state_ms =
+                1000 *
+                percentile(scheme == Interpolation::hermite ? with : plain,
+                           0.5);
+              row.states            = g.times.size();
+              row.failures          = g.failed.size();
+              row.states_per_cm     = per_cm;
+              row.region_states     = region;
+              const double slowdown = workers > 1 ? two_solver_slowdown : 1.0;
+              row.precompute_s =
+                region * row.state_ms / 1000 * slowdown / workers;
+              row.memory_MiB = bytes / 1048576.0;
+              // The engine keeps up while it computes the corners ahead as
+              // fast as the HIP reaches them: workers / (state time) states
+              // per second, per_cm states per cm (doc/accuracy-vs-time.md
+              // compares it with benchmarks/run max-speed).
+              row.speed_mm_s =
+                workers / (row.state_ms / 1000 * slowdown) / per_cm * 10;
               result.rows.push_back(row);
             }
+          write_csv();
+        };
+
+        if (!skipped("grid"))
+          for (const double h : spacings)
+            {
+              auto p                     = p0;
+              p.state_space.grid_spacing = h;
+              grid_setting("grid", mm(h), p);
+            }
+        if (!skipped("tolerance"))
+          for (const double t : tolerances)
+            {
+              auto p                                = p0;
+              p.nonlinear_solver.residual_tolerance = t;
+              grid_setting("tolerance", scientific(t), p);
+            }
+        if (!skipped("increment"))
+          for (const double l : increments)
+            {
+              auto p                                  = p0;
+              p.nonlinear_solver.max_increment_length = l;
+              grid_setting("increment", mm(l), p);
+            }
+
+        // The knobs together: the fastest grid setting that passes, with the
+        // loosest tolerance that passes at the scene's spacing with the same
+        // interpolation.
+        {
+          const StudyRow *best_grid = nullptr;
+          double          loosest   = p0.nonlinear_solver.residual_tolerance;
+          for (const auto &row : result.rows)
+            if (passes(row, result.threshold_pct) && row.knob == "grid" &&
+                (best_grid == nullptr ||
+                 row.speed_mm_s > best_grid->speed_mm_s))
+              best_grid = &row;
+          if (best_grid != nullptr)
+            for (const auto &row : result.rows)
+              if (passes(row, result.threshold_pct) &&
+                  row.knob == "tolerance" &&
+                  row.interpolation == best_grid->interpolation)
+                loosest = std::max(loosest, row.residual_tolerance);
+          if (best_grid != nullptr && !skipped("combined") &&
+              (best_grid->h_mm / 1000 != h0 ||
+               loosest != p0.nonlinear_solver.residual_tolerance))
+            {
+              auto p                                = p0;
+              p.state_space.grid_spacing            = best_grid->h_mm / 1000;
+              p.nonlinear_solver.residual_tolerance = loosest;
+              const std::string value =
+                mm(p.state_space.grid_spacing) + ", " + scientific(loosest);
+              grid_setting("combined", value, p);
+            }
         }
-    };
-    if (finer)
-      discretisation("mesh",
-                     {scene, *finer},
-                     {coarse_name, finer_name},
-                     {1, finer_cost});
-    if (p2_knob)
+
+        // --- Discretisation knobs: direct solves at the first n_disc
+        // positions, against the finest setting of the knob, with the point
+        // probe and with a rigid tip.
+        const auto discretisation = [&](const std::string        &knob,
+                                        const std::vector<Scene> &variants,
+                                        const std::vector<std::string> &names,
+                                        const std::vector<double>      &cost) {
+          for (const double radius : {0.0, tip})
+            {
+              std::vector<std::vector<Sample>> forces;
+              std::vector<std::vector<double>> times(variants.size());
+              for (unsigned int v = 0; v < variants.size(); ++v)
+                {
+                  Scene s      = variants[v];
+                  auto &active = s.parameters.boundary_conditions.active_node;
+                  active.tip_radius = radius;
+                  // The scene's sphere stays a sphere; otherwise a finite
+                  // radius is a glued tip.
+                  if (active.tip != Parameters::ActiveNode::Tip::sphere)
+                    active.tip = radius > 0 ?
+                                   Parameters::ActiveNode::Tip::glued_nodes :
+                                   Parameters::ActiveNode::Tip::point;
+                  else if (!(radius > 0))
+                    active.tip = Parameters::ActiveNode::Tip::point;
+                  const Body body(s);
+                  forces.push_back(direct_solves(
+                    body,
+                    paths,
+                    std::min<unsigned>(n_disc, positions.size()),
+                    p0.nonlinear_solver.residual_tolerance,
+                    &times[v],
+                    progress,
+                    cost[v],
+                    knob + " " + names[v] +
+                      (radius > 0 ? ", tip " + mm(radius) : ", point probe")));
+                }
+              const auto &finest = forces.back();
+              for (unsigned int v = 0; v < variants.size(); ++v)
+                {
+                  StudyRow row;
+                  row.knob          = knob;
+                  row.value         = names[v];
+                  row.interpolation = "direct";
+                  row.probe = radius > 0 ? "tip " + mm(radius) : "point";
+                  row.h_mm  = 0;
+                  std::vector<double> absolute, relative;
+                  for (std::size_t k = 0; k < finest.size(); ++k)
+                    {
+                      ++row.samples;
+                      if (!finest[k].ok || !forces[v][k].ok)
+                        {
+                          row.failures += !forces[v][k].ok;
+                          continue;
+                        }
+                      ++row.covered;
+                      absolute.push_back(Utilities::distance(forces[v][k].force,
+                                                             finest[k].force));
+                      relative.push_back(
+                        relative_error(forces[v][k].force, finest[k].force));
+                    }
+                  errors(row, absolute, relative);
+                  row.state_ms = 1000 * percentile(times[v], 0.5);
+                  row.states   = times[v].size();
+                  result.rows.push_back(row);
+                }
+              write_csv();
+            }
+        };
+        if (finer && !skipped("mesh"))
+          discretisation("mesh",
+                         {scene, *finer},
+                         {coarse_name, finer_name},
+                         {1, finer_cost});
+        if (p2_knob && !skipped("element"))
+          {
+            // An incompressible plug-in's element pair fixes the degree: the
+            // knob is its Element entry (P1-P1 -> Taylor-Hood).
+            Scene      p2   = scene;
+            auto      &m    = p2.parameters.material_model;
+            const auto f    = Material::create(m)->formulation();
+            const bool pair = f.displacement_degree > 0;
+            if (pair)
+              m.set(m.model_name, "Element", "Taylor-Hood");
+            else
+              p2.parameters.discretization.polynomial_degree = 2;
+            const std::string  low    = pair ? "P1-P1" : "P1";
+            const std::string  high   = pair ? "Taylor-Hood P2-P1" : "P2";
+            const unsigned int degree = f.displacement_degree > 0 ?
+                                          f.displacement_degree :
+                                          p0.discretization.polynomial_degree;
+            if (degree == 1)
+              discretisation("element", {scene, p2}, {low, high}, {1, p2_cost});
+          }
+      }
+    catch (const StudyCut &cut)
       {
-        // An incompressible plug-in's element pair fixes the degree: the
-        // knob is its Element entry (P1-P1 -> Taylor-Hood).
-        Scene      p2   = scene;
-        auto      &m    = p2.parameters.material_model;
-        const auto f    = Material::create(m)->formulation();
-        const bool pair = f.displacement_degree > 0;
-        if (pair)
-          m.set(m.model_name, "Element", "Taylor-Hood");
-        else
-          p2.parameters.discretization.polynomial_degree = 2;
-        const std::string  low    = pair ? "P1-P1" : "P1";
-        const std::string  high   = pair ? "Taylor-Hood P2-P1" : "P2";
-        const unsigned int degree = f.displacement_degree > 0 ?
-                                      f.displacement_degree :
-                                      p0.discretization.polynomial_degree;
-        if (degree == 1)
-          discretisation("element", {scene, p2}, {low, high}, {1, p2_cost});
+        result.stopped     = cut.why;
+        result.stop_signal = stop.signal_number();
       }
     progress.finish();
+    if (!result.stopped.empty())
+      out << "\nThe study ended early: " << result.stopped << " after "
+          << fixed(seconds_since(study_start), 0) << " s. What it measured "
+          << "until then follows (" << result.rows.size()
+          << " rows); the knobs and values not reached are not in it, and "
+             "the recommendation is among the rows measured.\n";
 
     // --- The discretisation error of the scene's own mesh and element,
     // for the scene's own probe: the largest p95 difference to the finer
@@ -1130,40 +1230,8 @@ namespace palpate
                   " %; use a finer mesh or element.\n" :
                 ": use a finer grid or Hermite.\n");
 
-    // --- CSV.
-    result.csv_file = options.csv_file;
-    if (result.csv_file.empty())
-      {
-        std::filesystem::create_directories(p0.output.directory);
-        result.csv_file =
-          (std::filesystem::path(p0.output.directory) /
-           ("study-" + std::filesystem::path(scene.file()).stem().string() +
-            ".csv"))
-            .string();
-      }
-    std::ofstream csv(result.csv_file);
-    csv << "material,knob,value,interpolation,probe,h_mm,samples,covered,"
-           "err_mean_N,err_p95_N,err_max_N,err_mean_pct,err_p95_pct,"
-           "err_max_pct,shape_err_mm,state_ms,states,failures,states_per_cm,"
-           "region_states,precompute_s,memory_MiB,speed_mm_s,recommended\n";
-    for (unsigned int r = 0; r < result.rows.size(); ++r)
-      {
-        const auto &row = result.rows[r];
-        csv << result.material << "," << row.knob << ",\"" << row.value << "\","
-            << row.interpolation << "," << row.probe << "," << row.h_mm << ","
-            << row.samples << "," << row.covered << "," << row.err_mean_N << ","
-            << row.err_p95_N << "," << row.err_max_N << "," << row.err_mean_pct
-            << "," << row.err_p95_pct << "," << row.err_max_pct << ","
-            << row.shape_err_mm << "," << row.state_ms << "," << row.states
-            << "," << row.failures << "," << row.states_per_cm << ","
-            << row.region_states << "," << row.precompute_s << ","
-            << row.memory_MiB << "," << row.speed_mm_s << ","
-            << (int(r) == result.recommended ? "yes" : "no") << "\n";
-      }
-    csv.close();
-    if (!csv)
-      throw OutputError("the study's CSV '" + result.csv_file +
-                        "' could not be written");
+    // --- CSV, with the recommendation marked.
+    write_csv();
     out << "\nThe table as CSV: " << result.csv_file << "\n";
 
     // --- The Pareto plot, by the plotting script of the source tree

@@ -252,7 +252,8 @@ namespace palpate
               real("interpolation_p999_us", s.interpolation_p999_us),
               count("initial_cloud_states", s.initial_cloud_states),
               boolean("initial_cloud_complete", s.initial_cloud_complete),
-              count("shape_frames", s.shape_frames)};
+              count("shape_frames", s.shape_frames),
+              text("stopped_by", s.stopped_by)};
     }
   } // namespace
 
@@ -331,6 +332,9 @@ namespace palpate
         << "\n";
     if (shape_frames > 0)
       s << "  shape output:      " << shape_frames << " frames\n";
+    if (!stopped_by.empty())
+      s << "  STOPPED:           " << stopped_by
+        << "; everything above is what ran until then\n";
     out << s.str();
   }
 

@@ -26,7 +26,9 @@ namespace palpate
     constexpr int server_lost = 5;
     /** The run finished, but an output file could not be written. */
     constexpr int output_failed = 6;
-    /** The run was interrupted (Ctrl-C); what it finished is kept. */
+    /** The run was stopped by SIGINT (Ctrl-C); what it finished is kept
+     * and its outputs are written. SIGTERM and SIGHUP give 128 + their
+     * number (143, 129), the shells' convention (StopRequest). */
     constexpr int interrupted = 130;
   } // namespace ExitStatus
 

@@ -33,6 +33,14 @@ namespace palpate
     bool plot = true;
     /** Show a progress bar on stderr (a line per step if not a terminal). */
     bool progress = true;
+    /**
+     * A time budget (s; 0: none). Past it the study ends at the next state
+     * or solve and reports the knobs measured until then, as after Ctrl-C.
+     */
+    double time_limit = 0;
+    /** Knobs not to measure: grid, tolerance, increment, combined, mesh,
+     * element (e.g. the element knob's P2 solves on a big organ). */
+    std::vector<std::string> skip;
   };
 
   /** One setting of one knob, both sides measured. */
@@ -98,6 +106,11 @@ namespace palpate
     std::string csv_file, plot_file;
     /** Wall time of the study (s). */
     double seconds = 0;
+    /** Why the study ended before its last knob ("stopped by SIGINT
+     * (Ctrl-C)", "its time budget ... ran out"); empty if it did not. */
+    std::string stopped;
+    /** The signal that stopped it (0 if none). */
+    int stop_signal = 0;
   };
 
   /**

@@ -71,6 +71,12 @@ namespace palpate
     unsigned int initial_cloud_states   = 0;
     bool         initial_cloud_complete = false;
 
+    /** Why the run ended before its motion did ("by SIGINT (Ctrl-C) after
+     * 2.1 s of the 8 s motion"; empty when it ran to the end), and the
+     * signal's number (0 if none: e.g. standard output was closed). */
+    std::string stopped_by;
+    int         stop_signal = 0;
+
     // Shape output.
     unsigned int shape_frames = 0;
 

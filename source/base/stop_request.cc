@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/base/stop_request.h>
+
+#include <signal.h>
+
+#include <atomic>
+#include <csignal>
+
+namespace palpate
+{
+  namespace
+  {
+    // The first stop signal's number. A lock-free atomic is
+    // async-signal-safe; the handler touches nothing else.
+    std::atomic<int> received{0};
+    static_assert(std::atomic<int>::is_always_lock_free);
+
+    constexpr int stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
+
+    struct sigaction previous[3];
+
+    void
+    on_stop_signal(const int signal)
+    {
+      int expected = 0;
+      if (!received.compare_exchange_strong(expected, signal))
+        {
+          // The second one: the default action, now (sigaction and raise
+          // are async-signal-safe).
+          struct sigaction default_action
+          {};
+          default_action.sa_handler = SIG_DFL;
+          sigemptyset(&default_action.sa_mask);
+          sigaction(signal, &default_action, nullptr);
+          raise(signal);
+        }
+    }
+  } // namespace
+
+
+
+  StopRequest::StopRequest()
+  {
+    received.store(0);
+    struct sigaction action
+    {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    // SA_RESTART: a read or write interrupted by Ctrl-C goes on; the
+    // driver sees the flag at its next poll.
+    action.sa_flags = SA_RESTART;
+    for (unsigned int i = 0; i < 3; ++i)
+      sigaction(stop_signals[i], &action, &previous[i]);
+  }
+
+
+
+  StopRequest::~StopRequest()
+  {
+    for (unsigned int i = 0; i < 3; ++i)
+      sigaction(stop_signals[i], &previous[i], nullptr);
+  }
+
+
+
+  bool
+  StopRequest::requested() const noexcept
+  {
+    return received.load() != 0;
+  }
+
+
+
+  int
+  StopRequest::signal_number() const noexcept
+  {
+    return received.load();
+  }
+
+
+
+  std::string
+  StopRequest::description() const
+  {
+    switch (received.load())
+      {
+        case 0:
+          return "";
+        case SIGINT:
+          return "SIGINT (Ctrl-C)";
+        case SIGTERM:
+          return "SIGTERM";
+        case SIGHUP:
+          return "SIGHUP (the terminal closed)";
+        default:
+          return "signal " + std::to_string(received.load());
+      }
+  }
+
+
+
+  int
+  StopRequest::exit_status() const noexcept
+  {
+    return 128 + received.load();
+  }
+
+
+
+  void
+  StopRequest::request(const int signal) noexcept
+  {
+    int expected = 0;
+    received.compare_exchange_strong(expected, signal);
+  }
+
+
+
+  void
+  ignore_broken_pipes() noexcept
+  {
+    std::signal(SIGPIPE, SIG_IGN);
+  }
+} // namespace palpate

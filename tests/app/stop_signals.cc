@@ -1,0 +1,310 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// A stop loses nothing (issue 26): SIGINT, SIGTERM and SIGHUP in the middle
+// of an interaction end it through its normal path - the run summary with a
+// STOPPED line, the force log up to the stop, the CSV/JSON summaries and a
+// closed PVD index whose frame count is the summary's - and the exit status
+// is 128 + the signal. A closed pipe on standard output (what `| head -1`
+// does) and /dev/full are output errors (status 6) that still write the
+// files. `palpate study` stopped by SIGINT, or past --time-limit, prints
+// and writes (CSV) the rows it measured.
+//
+// The program runs as a child with its standard output in a file; the
+// signal is sent once the output says the motion started (or, for the
+// study, once a knob's first state was computed).
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "../tests.h"
+
+namespace
+{
+  /** Start palpate with @p args, its stdout in @p out_file (or /dev/full),
+   * stderr in @p err_file. */
+  pid_t
+  start(const std::vector<std::string> &args,
+        const std::string              &out_file,
+        const std::string              &err_file)
+  {
+    const pid_t pid = fork();
+    if (pid == 0)
+      {
+        const int out =
+          open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int err =
+          open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(out, 1);
+        dup2(err, 2);
+        std::vector<char *> argv;
+        argv.push_back(const_cast<char *>(palpate_executable.c_str()));
+        for (const auto &a : args)
+          argv.push_back(const_cast<char *>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(argv[0], argv.data());
+        _exit(127);
+      }
+    return pid;
+  }
+
+  int
+  wait_status(const pid_t pid)
+  {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) :
+                               1000 + WTERMSIG(status); // killed: a failure
+  }
+
+  /** Wait (at most 120 s) until @p file contains @p text. */
+  bool
+  wait_for(const std::string &file, const std::string &text)
+  {
+    for (unsigned int i = 0; i < 1200; ++i)
+      {
+        if (read_file(file).find(text) != std::string::npos)
+          return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+    return false;
+  }
+
+  std::string
+  line_with(const std::string &text, const std::string &what)
+  {
+    const auto at = text.find(what);
+    if (at == std::string::npos)
+      return "(none)";
+    return text.substr(at, text.find('\n', at) - at);
+  }
+
+  /** The last force-log row's time (s), and the number of rows. */
+  std::pair<double, unsigned int>
+  force_log(const std::string &file)
+  {
+    std::ifstream in(file);
+    std::string   line;
+    double        last = -1;
+    unsigned int  rows = 0;
+    std::getline(in, line); // the header
+    while (std::getline(in, line))
+      if (!line.empty())
+        {
+          last = std::stod(line);
+          ++rows;
+        }
+    return {last, rows};
+  }
+
+  unsigned int
+  count(const std::string &text, const std::string &what)
+  {
+    unsigned int n = 0;
+    for (auto at = text.find(what); at != std::string::npos;
+         at      = text.find(what, at + 1))
+      ++n;
+    return n;
+  }
+} // namespace
+
+
+
+int
+main()
+{
+  initlog();
+  const std::string dir = std::filesystem::absolute("stop-signals").string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string scene = palpate_source_dir + "/parameters/paper-stvk.prm";
+  // A 30 s stroke at 1 mm/s, every output on.
+  const std::vector<std::string> interaction = {
+    scene,
+    "--set",
+    "Haptics/Trajectory/Speed=0.001",
+    "--set",
+    "Haptics/Trajectory/Duration=30",
+    "--set",
+    "Effects/Force log=true",
+    "--set",
+    "Effects/Shape output=true",
+    "--set",
+    "Output/Summary formats=csv,json",
+    "--set",
+    "Output/Directory=" + dir};
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+
+  for (const auto &[signal, name] : std::vector<std::pair<int, std::string>>{
+         {SIGINT, "SIGINT"}, {SIGTERM, "SIGTERM"}, {SIGHUP, "SIGHUP"}})
+    {
+      for (const auto &f : std::filesystem::directory_iterator(dir))
+        if (f.path().extension() != ".txt")
+          std::filesystem::remove(f.path());
+      std::filesystem::remove(out); // not the last run's "motion starts"
+      const pid_t pid     = start(interaction, out, err);
+      const bool  started = wait_for(out, "; motion starts");
+      std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+      kill(pid, signal);
+      const int         status = wait_status(pid);
+      const std::string text   = read_file(out);
+      const auto [last, rows]  = force_log(dir + "/paper-stvk-forces.csv");
+      const std::string pvd    = read_file(dir + "/paper-stvk-shape.pvd");
+      const std::string json   = read_file(dir + "/paper-stvk-summary.json");
+      const std::string frames = line_with(text, "shape output:");
+      deallog << name << ": motion started " << ok(started) << ", exit status "
+              << status << " (128 + " << signal << ": "
+              << ok(status == 128 + signal) << ")" << std::endl;
+      deallog << "  summary printed "
+              << ok(text.find("Run summary") != std::string::npos)
+              << ", STOPPED line "
+              << ok(line_with(text, "STOPPED:").find("by " + name) !=
+                    std::string::npos)
+              << ", stderr says so "
+              << ok(read_file(err).find("stopped by " + name) !=
+                    std::string::npos)
+              << std::endl;
+      // The force log runs until the stop (more than the 1.5 s waited,
+      // far less than the 30 s planned), a row per tick.
+      deallog << "  force log: last row at t in (1, 25) s "
+              << ok(last > 1 && last < 25) << ", rows " << ok(rows > 1000)
+              << std::endl;
+      deallog << "  JSON summary names the stop "
+              << ok(json.find("\"stopped_by\": \"by " + name) !=
+                    std::string::npos)
+              << ", CSV summary written "
+              << ok(std::filesystem::exists(dir + "/paper-stvk-summary.csv"))
+              << std::endl;
+      // The PVD index is complete and lists as many frames as the summary
+      // says were written.
+      const unsigned int listed = count(pvd, "<DataSet");
+      deallog << "  PVD index closed "
+              << ok(pvd.find("</VTKFile>") != std::string::npos)
+              << ", frames listed = summary's "
+              << ok(listed > 0 && frames.find(" " + std::to_string(listed) +
+                                              " frames") != std::string::npos)
+              << std::endl;
+    }
+
+  // Standard output closed (a reader that went away, `| head -1`): the
+  // write fails instead of SIGPIPE killing the program; the run stops,
+  // writes its files and exits with status 6.
+  {
+    std::filesystem::remove(dir + "/paper-stvk-forces.csv");
+    int fds[2];
+    if (pipe(fds) != 0)
+      return 1;
+    const pid_t pid = fork();
+    if (pid == 0)
+      {
+        close(fds[0]);
+        dup2(fds[1], 1);
+        const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(e, 2);
+        std::vector<std::string> args = interaction;
+        std::vector<char *>      argv;
+        argv.push_back(const_cast<char *>(palpate_executable.c_str()));
+        for (const auto &a : args)
+          argv.push_back(const_cast<char *>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(argv[0], argv.data());
+        _exit(127);
+      }
+    close(fds[1]);
+    char c = 0;
+    while (read(fds[0], &c, 1) == 1 && c != '\n')
+      {} // the first line, as head -1 reads it
+    close(fds[0]);
+    const int status = wait_status(pid);
+    deallog << "closed pipe: exit status " << status << " " << ok(status == 6)
+            << ", message "
+            << ok(read_file(err).find("standard output could not be written") !=
+                  std::string::npos)
+            << ", force log written "
+            << ok(std::filesystem::exists(dir + "/paper-stvk-forces.csv"))
+            << std::endl;
+  }
+
+  // Standard output on a full device.
+  {
+    std::filesystem::remove(dir + "/paper-stvk-forces.csv");
+    const pid_t pid    = start(interaction, "/dev/full", err);
+    const int   status = wait_status(pid);
+    deallog << "/dev/full: exit status " << status << " " << ok(status == 6)
+            << ", message "
+            << ok(read_file(err).find("standard output could not be written") !=
+                  std::string::npos)
+            << ", force log written "
+            << ok(std::filesystem::exists(dir + "/paper-stvk-forces.csv"))
+            << std::endl;
+  }
+
+  // The study, stopped by SIGINT once a grid knob's states are being
+  // computed: the rows measured until then are printed and in the CSV.
+  {
+    const std::string csv = dir + "/study.csv";
+    std::filesystem::remove(out);
+    const pid_t pid     = start({"study",
+                                 scene,
+                                 "--quick",
+                                 "--csv",
+                                 csv,
+                                 "--set",
+                                 "Output/Directory=" + dir},
+                            out,
+                            err);
+    const bool  started = wait_for(out, "  ... ");
+    // Past the reference solves, into the grid knob's states.
+    const bool in_grid = wait_for(out, ": grid ");
+    std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+    kill(pid, SIGINT);
+    const int          status = wait_status(pid);
+    const std::string  text   = read_file(out);
+    const unsigned int printed =
+      count(text, "| trilinear |") + count(text, "|       Hermite |");
+    const unsigned int in_csv = count(read_file(csv), "\n") - 1;
+    deallog << "study, SIGINT: progress seen " << ok(started && in_grid)
+            << ", exit status " << status << " " << ok(status == 130)
+            << ", says it ended early "
+            << ok(text.find("The study ended early: stopped by SIGINT") !=
+                  std::string::npos)
+            << ", rows printed = rows in the CSV " << ok(printed == in_csv)
+            << std::endl;
+  }
+
+  // The study's time budget: the same path, exit status 0.
+  {
+    const std::string csv    = dir + "/study-budget.csv";
+    const pid_t       pid    = start({"study",
+                                      scene,
+                                      "--quick",
+                                      "--skip",
+                                      "element,mesh",
+                                      "--time-limit",
+                                      "1",
+                                      "--csv",
+                                      csv,
+                                      "--set",
+                                      "Output/Directory=" + dir},
+                            out,
+                            err);
+    const int         status = wait_status(pid);
+    const std::string text   = read_file(out);
+    deallog << "study, --time-limit 1: exit status " << status << " "
+            << ok(status == 0) << ", says why "
+            << ok(text.find("time budget (--time-limit 1 s) ran out") !=
+                  std::string::npos)
+            << ", CSV written " << ok(std::filesystem::exists(csv))
+            << ", no element rows "
+            << ok(text.find("Element order") == std::string::npos) << std::endl;
+  }
+  std::filesystem::remove_all(dir);
+}
