@@ -3,6 +3,7 @@
 
 #include <palpate/base/exceptions.h>
 
+#include <filesystem>
 #include <sstream>
 
 namespace palpate
@@ -50,4 +51,40 @@ namespace palpate
                          "\n  " +
                          where)
   {}
+} // namespace palpate
+
+namespace palpate
+{
+  void
+  check_file_size(const std::string   &file,
+                  const std::string   &entry,
+                  const std::uintmax_t max_bytes,
+                  const std::string   &typical)
+  {
+    namespace fs = std::filesystem;
+    std::error_code       error;
+    const fs::file_status status = fs::status(file, error);
+    if (error || !fs::exists(status) || fs::is_directory(status))
+      return; // the reader says what is wrong with it
+    if (!fs::is_regular_file(status))
+      throw InputError(file,
+                       0,
+                       entry,
+                       "this is not a regular file but a device, a pipe or "
+                       "a socket: it would be read without end",
+                       "name the file itself.");
+    const std::uintmax_t size = fs::file_size(file, error);
+    if (!error && size > max_bytes)
+      throw InputError(file,
+                       0,
+                       entry,
+                       "the file has " + std::to_string(size >> 20) +
+                         " MiB, more than the " +
+                         std::to_string(max_bytes >> 20) +
+                         " MiB palpate reads for it (" + typical + ")",
+                       "check that this is the right file; a body with more "
+                       "nodes than a few hundred thousand cannot be solved "
+                       "at haptic rates: make a coarser mesh (palpate mesh "
+                       "SURFACE OUT.msh --nodes 4000).");
+  }
 } // namespace palpate

@@ -4,11 +4,14 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh.h>
+#include <palpate/mesh/mesh_file.h>
 #include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
 #include <deal.II/grid/tria.h>
 #include <deal.II/grid/tria_description.h>
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -109,6 +112,18 @@ namespace palpate
       const auto  path = scene.resolve_path(p.file_name);
       std::string bytes;
       {
+        try
+          {
+            check_file_size(path,
+                            "surface file",
+                            max_mesh_file_bytes,
+                            "an organ's surface of 100,000 triangles has "
+                            "about 5 MiB");
+          }
+        catch (const InputError &e)
+          {
+            throw scene.error("Mesh/File name", e.problem(), e.fix());
+          }
         std::ifstream in(path, std::ios::binary);
         // error_code: a name the file system refuses (too long, a loop of
         // links) is a missing file, not an internal error.
@@ -458,70 +473,138 @@ namespace palpate
 
 
 
+  namespace
+  {
+    /** The mesh a scene describes, before the memory check. */
+    Mesh
+    create_unchecked(const Scene &scene)
+    {
+      // A body palpate can touch is between a few millimetres (a small
+      // sample) and about a metre (the largest organs) across: anything else
+      // is a mesh read in the wrong unit, and would run with nonsense
+      // forces and a state space of the wrong size.
+      const auto check_size = [](const Scene &scene, const Mesh &mesh) {
+        const double size = mesh.diameter();
+        if (size >= 0.002 && size <= 2)
+          return;
+        const double factor = scene.parameters.mesh.scale_factor;
+        throw scene.error(
+          "Mesh/Scale factor",
+          "with this scale factor the body is " +
+            Utilities::to_string(size, 3) +
+            " m across (the diagonal of its bounding box); a body to palpate "
+            "is between 0.002 and 2 m: the mesh file's unit is not the one "
+            "the scale factor assumes",
+          "set Scale factor to the metres per mesh-file unit: 0.001 for "
+          "millimetres, 0.01 for centimetres; for this mesh to be 0.25 m "
+          "across (a liver), " +
+            Utilities::to_string(factor * 0.25 / size, 4) + ".");
+      };
+      const auto &p = scene.parameters.mesh;
+      if (p.source == "beam")
+        return Mesh(generate_beam(p), 1.0, "the beam generator");
+      if (p.source == "blob")
+        return Mesh(generate_blob(p), 1.0, "the blob generator");
+
+      if (p.source == "surface")
+        {
+          auto mesh = from_surface(scene);
+          check_size(scene, mesh);
+          return mesh;
+        }
+
+      const std::string path = scene.resolve_path(p.file_name);
+      // error_code: a name the file system refuses (too long, a loop of
+      // links) is reported below as a file that cannot be read.
+      std::error_code exists_error;
+      if (!std::filesystem::exists(path, exists_error) && !exists_error)
+        throw scene.error(
+          "Mesh/File name",
+          "the mesh file '" + p.file_name + "' was not found: looked for " +
+            scene.where_looked(p.file_name),
+          "a relative path is relative to the scene file's directory; the "
+          "example organs are in the project's meshes/ (its README), e.g. "
+          "'../meshes/liver-tetgen/liver501.msh' from parameters/. Or use "
+          "Source = blob, which needs no file.");
+      std::unique_ptr<Mesh> mesh;
+      try
+        {
+          // Errors about the file's content name the file as the scene
+          // writes it (and the report shows it that way too).
+          mesh = std::make_unique<Mesh>(read_mesh_file(path),
+                                        p.scale_factor,
+                                        p.file_name);
+        }
+      catch (const InputError &e)
+        {
+          throw read_by(e, scene, "this file");
+        }
+      check_size(scene, *mesh);
+      return std::move(*mesh);
+    }
+  } // namespace
+
+
+
+  namespace
+  {
+    /**
+     * That one direct solve on @p mesh fits in this machine's memory: an
+     * InputError naming the mesh (or the element degree) otherwise, before
+     * anything large is allocated. A 205,379-node mesh was accepted and the
+     * solve grew past 15 GB without a word.
+     *
+     * The estimate: MUMPS's factor of a 3-D finite element matrix has about
+     * unknowns^(4/3) entries under nested dissection (the separators of a
+     * 3-D mesh); measured on this project's livers with P1 (1,921, 7,877
+     * and 11,499 nodes: 41, 211 and 434 MB above the program's 170 MB),
+     * 310-410 bytes per unknowns^(4/3). 500 bytes are assumed, so the
+     * refusal errs towards letting a mesh through. P2 adds a node on every
+     * edge (about nodes + tetrahedra edges).
+     */
+    void
+    check_memory(const Scene &scene, const Mesh &mesh)
+    {
+      const unsigned int degree =
+        scene.parameters.discretization.polynomial_degree;
+      const double nodes     = mesh.n_vertices();
+      const double dof_nodes = degree >= 2 ? 2 * nodes + mesh.n_cells() : nodes;
+      const double unknowns  = 3 * dof_nodes;
+      const double bytes     = 170e6 + 500 * std::pow(unknowns, 4.0 / 3.0);
+      const double memory =
+        double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+      if (!(memory > 0) || bytes <= memory)
+        return;
+      const auto gib = [](const double b) {
+        return Utilities::to_string(b / 1073741824.0, 3) + " GiB";
+      };
+      const std::string problem =
+        "the mesh has " + std::to_string(mesh.n_vertices()) + " nodes and " +
+        std::to_string(mesh.n_cells()) + " tetrahedra; with degree " +
+        std::to_string(degree) + " elements that is about " +
+        Utilities::to_string(unknowns, 3) +
+        " unknowns, and one direct solve would need about " + gib(bytes) +
+        " of memory (an estimate), more than this machine's " + gib(memory);
+      const std::string fix =
+        "use a coarser mesh: palpate mesh SURFACE OUT.msh --nodes 4000 makes "
+        "one of about 4,000 nodes (enough for a liver's force to converge "
+        "with a sphere probe)" +
+        std::string(degree >= 2 ? ", or degree 1 elements" : "") + ".";
+      throw scene.error(degree >= 2 ? "Discretization/Polynomial degree" :
+                                      "Mesh/File name",
+                        problem,
+                        fix);
+    }
+  } // namespace
+
+
+
   Mesh
   Mesh::create(const Scene &scene)
   {
-    // A body palpate can touch is between a few millimetres (a small
-    // sample) and about a metre (the largest organs) across: anything else
-    // is a mesh read in the wrong unit, and would run with nonsense
-    // forces and a state space of the wrong size.
-    const auto check_size = [](const Scene &scene, const Mesh &mesh) {
-      const double size = mesh.diameter();
-      if (size >= 0.002 && size <= 2)
-        return;
-      const double factor = scene.parameters.mesh.scale_factor;
-      throw scene.error(
-        "Mesh/Scale factor",
-        "with this scale factor the body is " + Utilities::to_string(size, 3) +
-          " m across (the diagonal of its bounding box); a body to palpate "
-          "is between 0.002 and 2 m: the mesh file's unit is not the one "
-          "the scale factor assumes",
-        "set Scale factor to the metres per mesh-file unit: 0.001 for "
-        "millimetres, 0.01 for centimetres; for this mesh to be 0.25 m "
-        "across (a liver), " +
-          Utilities::to_string(factor * 0.25 / size, 4) + ".");
-    };
-    const auto &p = scene.parameters.mesh;
-    if (p.source == "beam")
-      return Mesh(generate_beam(p), 1.0, "the beam generator");
-    if (p.source == "blob")
-      return Mesh(generate_blob(p), 1.0, "the blob generator");
-
-    if (p.source == "surface")
-      {
-        auto mesh = from_surface(scene);
-        check_size(scene, mesh);
-        return mesh;
-      }
-
-    const std::string path = scene.resolve_path(p.file_name);
-    // error_code: a name the file system refuses (too long, a loop of
-    // links) is reported below as a file that cannot be read.
-    std::error_code exists_error;
-    if (!std::filesystem::exists(path, exists_error) && !exists_error)
-      throw scene.error(
-        "Mesh/File name",
-        "the mesh file '" + p.file_name + "' was not found: looked for " +
-          scene.where_looked(p.file_name),
-        "a relative path is relative to the scene file's directory; the "
-        "example organs are in the project's meshes/ (its README), e.g. "
-        "'../meshes/liver-tetgen/liver501.msh' from parameters/. Or use "
-        "Source = blob, which needs no file.");
-    std::unique_ptr<Mesh> mesh;
-    try
-      {
-        // Errors about the file's content name the file as the scene
-        // writes it (and the report shows it that way too).
-        mesh = std::make_unique<Mesh>(read_mesh_file(path),
-                                      p.scale_factor,
-                                      p.file_name);
-      }
-    catch (const InputError &e)
-      {
-        throw read_by(e, scene, "this file");
-      }
-    check_size(scene, *mesh);
-    return std::move(*mesh);
+    Mesh mesh = create_unchecked(scene);
+    check_memory(scene, mesh);
+    return mesh;
   }
 
 

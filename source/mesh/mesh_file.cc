@@ -1498,6 +1498,11 @@ namespace palpate
                              " mesh files in it, e.g. '" + meshes.front() +
                              "'.");
       }
+    check_file_size(filename,
+                    "mesh file",
+                    max_mesh_file_bytes,
+                    "a liver of 8,000 nodes has about 2 MiB as .msh; 512 MiB "
+                    "hold about two million nodes");
     {
       errno = 0;
       std::ifstream probe(filename);

@@ -136,6 +136,11 @@ namespace palpate
     std::string
     contents(const std::string &filename)
     {
+      check_file_size(filename,
+                      "surface file",
+                      max_mesh_file_bytes,
+                      "an organ's surface of 100,000 triangles has about "
+                      "5 MiB");
       std::ifstream in(filename, std::ios::binary);
       if (!in)
         throw bad(filename,

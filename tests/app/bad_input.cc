@@ -55,6 +55,10 @@ namespace
       for (auto at = message.find(path); at != std::string::npos;
            at      = message.find(path, at))
         message.replace(at, path.size(), shown);
+    // And the machine's memory.
+    if (const auto at = message.find("this machine's ");
+        at != std::string::npos)
+      message.replace(at + 15, message.find(" GiB", at) - at - 15, "<memory>");
     deallog << message << std::endl;
   }
 
@@ -433,6 +437,30 @@ main(int argc, char **argv)
       "good.prm --set 'Mesh/File name=liver.msh'");
   run("--set on a file whose subsection is never closed",
       "unclosed.prm --set 'Run/Mode=set-up only'");
+
+  // Files read whole are refused before any allocation when they cannot
+  // be a mesh (issue 26): a device, a file of 600 MiB (sparse: no disk
+  // used), a surface that is a device; and a mesh too big for this
+  // machine's memory.
+  std::filesystem::remove("zero.msh");
+  std::filesystem::create_symlink("/dev/zero", "zero.msh");
+  run("a mesh file that is /dev/zero",
+      "solve good.prm --set 'Mesh/Source=file' --set 'Mesh/File "
+      "name=zero.msh'");
+  {
+    std::ofstream("huge.msh").close();
+    std::filesystem::resize_file("huge.msh", std::uintmax_t(600) << 20);
+  }
+  run("a mesh file of 600 MiB",
+      "solve good.prm --set 'Mesh/Source=file' --set 'Mesh/File "
+      "name=huge.msh'");
+  std::filesystem::remove("huge.msh");
+  std::filesystem::remove("zero.obj");
+  std::filesystem::create_symlink("/dev/zero", "zero.obj");
+  run("a surface file that is /dev/zero", "mesh zero.obj out.msh");
+  run("a mesh whose direct solve needs more memory than the machine has",
+      "solve good.prm --set 'Mesh/Beam/Subdivisions=100,30,30' --set "
+      "'Discretization/Polynomial degree=2'");
 
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;

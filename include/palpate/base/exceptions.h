@@ -4,6 +4,7 @@
 #ifndef palpate_base_exceptions_h
 #define palpate_base_exceptions_h
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -88,6 +89,21 @@ namespace palpate
     std::string  problem_;
     std::string  fix_;
   };
+
+  /**
+   * Before a file other than the scene is read whole (a mesh, a surface, a
+   * recording): throws an InputError naming @p file and @p entry if it is
+   * not a regular file (a device such as /dev/zero, a pipe, a directory
+   * would be read without end) or has more than @p max_bytes, with
+   * @p typical ("a liver of 8,000 nodes has about 2 MiB") in the message.
+   * A file that does not exist or cannot be examined passes: the reader's
+   * own message says so. Nothing is allocated before this check.
+   */
+  void
+  check_file_size(const std::string   &file,
+                  const std::string   &entry,
+                  const std::uintmax_t max_bytes,
+                  const std::string   &typical);
 
   /**
    * A capability that a scene asks for but that this version of palpate

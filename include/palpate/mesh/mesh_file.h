@@ -7,6 +7,7 @@
 #include <palpate/base/utilities.h>
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,14 @@ namespace palpate
     /** A short description of the format, e.g. "Gmsh 2.2 ASCII". */
     std::string format;
   };
+
+  /**
+   * The largest mesh or surface file palpate reads (bytes): 512 MiB, about
+   * two million nodes as .msh, far beyond what a state can be computed on
+   * at haptic rates; a device or a mistaken file is refused before
+   * anything is allocated (check_file_size()).
+   */
+  constexpr std::uintmax_t max_mesh_file_bytes = std::uintmax_t(512) << 20;
 
   /**
    * Read a mesh file: Gmsh .msh (format 2.2 or the old v1, ASCII), legacy
