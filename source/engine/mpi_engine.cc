@@ -193,14 +193,18 @@ namespace palpate
     mutable std::mutex      mutex;
     std::condition_variable stopped;
     std::atomic<bool>       attached{false}, quit{false};
-    unsigned int            busy            = 0;
-    bool                    nothing_to_plan = false, replan = false;
-    std::uint64_t           finished = 0, finished_at_plan = 0;
-    BridgeMemory            bridge;
-    Clock::time_point       next_tick;
-    std::thread             thread;
-    Clock::time_point       t0;
-    EngineStatistics        stats;
+    /** A server silent past its heartbeats, or one lost within the last
+     * 3 s (degraded()); and when the last one was lost. */
+    std::atomic<bool> trouble{false};
+    Clock::time_point last_loss{};
+    unsigned int      busy            = 0;
+    bool              nothing_to_plan = false, replan = false;
+    std::uint64_t     finished = 0, finished_at_plan = 0;
+    BridgeMemory      bridge;
+    Clock::time_point next_tick;
+    std::thread       thread;
+    Clock::time_point t0;
+    EngineStatistics  stats;
   };
 
 
@@ -265,7 +269,8 @@ namespace palpate
     Server &s = servers[rank];
     if (s.lost)
       return;
-    s.lost = true;
+    s.lost    = true;
+    last_loss = Clock::now();
     Environment::peer_lost();
     std::ostringstream what;
     what << "solver server " << rank << " lost at t = " << std::fixed
@@ -604,7 +609,8 @@ namespace palpate
           fetch_wanted_states();
 
           // Liveness: silence, or a task that never ends.
-          const auto t = Clock::now();
+          const auto t       = Clock::now();
+          bool       silence = false;
           for (unsigned int r = 1; r < servers.size(); ++r)
             {
               Server &s = servers[r];
@@ -612,6 +618,9 @@ namespace palpate
                 continue;
               const double silent =
                 std::chrono::duration<double>(t - s.last_heard).count();
+              // Heartbeats come every 0.1 s: three missed is trouble long
+              // before Engine / Server timeout declares the server lost.
+              silence = silence || (s.ready && silent > 0.3);
               if (silent > parameters.engine.server_timeout)
                 lose(r,
                      "it sent nothing for " + Utilities::to_string(silent, 3) +
@@ -624,6 +633,12 @@ namespace palpate
                        Utilities::to_string(parameters.engine.task_timeout, 3) +
                        " s)");
             }
+
+          trouble.store(
+            silence ||
+              (last_loss != Clock::time_point{} &&
+               std::chrono::duration<double>(t - last_loss).count() < 3.0),
+            std::memory_order_relaxed);
 
           if (attached && (replan || t >= next_tick))
             {
@@ -792,6 +807,14 @@ namespace palpate
   MpiEngine::n_workers() const
   {
     return impl->servers.size() - 1;
+  }
+
+
+
+  bool
+  MpiEngine::degraded() const noexcept
+  {
+    return impl->trouble.load(std::memory_order_relaxed);
   }
 
 

@@ -162,8 +162,10 @@ namespace palpate
     mutable std::atomic<bool> initial_done{false};
     std::atomic<std::uint64_t> corner_reads{0}, corner_hits{0},
       missing_events{0}, missing_nanoseconds{0}, non_finite{0};
-    // Held force, by cause: [0] failure region, [1] outside the state space.
-    std::atomic<std::uint64_t> held_events[2] = {}, held_nanoseconds[2] = {};
+    // Held force: [0] in failure regions, [1] outside the state space,
+    // [2] while a solver server was silent or lost (PrecomputationEngine::
+    // degraded()).
+    std::atomic<std::uint64_t> held_events[3] = {}, held_nanoseconds[3] = {};
     std::atomic<std::uint8_t>  event_cause{0}, last_cause{0};
     std::atomic<double>        event_stiffness{0};
     std::atomic<double>        largest_force{0}, largest_change{0};
@@ -338,17 +340,25 @@ namespace palpate
     Utilities::Point3 target = sample.force;
     bool              render = complete;
     s.stiffness = complete ? sample.stiffness : std::array<double, 9>{};
+    // States late because a solver server stopped answering or was lost
+    // (not because the hand is fast) may stay missing for the server
+    // timeout and the re-planning after it: held too, not faded.
+    const bool server_trouble =
+      cause == MissingCause::not_computed && s.engine->degraded();
     if (s.in_contact && cause != MissingCause::none)
       {
         const bool held =
-          cause != MissingCause::not_computed && finite && s.hold.valid();
+          (cause != MissingCause::not_computed || server_trouble) && finite &&
+          s.hold.valid();
         if (held)
           {
             target      = s.hold.force(position);
             render      = true;
             s.stiffness = s.hold.stiffness_matrix(position);
           }
-        const unsigned int slot = cause == MissingCause::failure_region ? 0 : 1;
+        const unsigned int slot = cause == MissingCause::failure_region ? 0 :
+                                  cause == MissingCause::outside        ? 1 :
+                                                                          2;
         if (cause != s.previous_cause)
           {
             for (unsigned int d = 0; d < 3; ++d)
@@ -573,7 +583,8 @@ namespace palpate
     const std::uint64_t events =
       s.missing_events.load(std::memory_order_acquire) +
       s.held_events[0].load(std::memory_order_acquire) +
-      s.held_events[1].load(std::memory_order_acquire);
+      s.held_events[1].load(std::memory_order_acquire) +
+      s.held_events[2].load(std::memory_order_acquire);
     if (events == s.reported_events)
       return 0;
     const unsigned int n = events - s.reported_events;
@@ -595,7 +606,9 @@ namespace palpate
           Utilities::to_string(1000 * s.grid.half_width() * s.grid.spacing(),
                                4) +
           " mm)" :
-         "the states of the HIP's cell are not computed yet";
+       held ? "the states of the HIP's cell are late: a solver server is silent "
+              "or was lost, and its work is planned again" :
+              "the states of the HIP's cell are not computed yet";
     const std::string what =
       held ? "the force is held from the last computed cell, " +
                Utilities::to_string(
@@ -675,6 +688,8 @@ namespace palpate
     r.failure_region_seconds = 1e-9 * s.held_nanoseconds[0].load();
     r.outside_events         = s.held_events[1].load();
     r.outside_seconds        = 1e-9 * s.held_nanoseconds[1].load();
+    r.server_hold_events     = s.held_events[2].load();
+    r.server_hold_seconds    = 1e-9 * s.held_nanoseconds[2].load();
     r.non_finite_forces      = s.non_finite.load();
     r.largest_force          = s.largest_force.load();
     r.largest_force_change   = s.largest_change.load();

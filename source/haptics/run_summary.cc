@@ -232,6 +232,8 @@ namespace palpate
               real("failure_region_seconds", s.failure_region_seconds),
               count("outside_events", s.outside_events),
               real("outside_seconds", s.outside_seconds),
+              count("server_hold_events", s.server_hold_events),
+              real("server_hold_seconds", s.server_hold_seconds),
               count("non_finite_forces", s.non_finite_forces),
               real("largest_force_N", s.largest_force),
               real("largest_force_change_N", s.largest_force_change),
@@ -286,6 +288,10 @@ namespace palpate
         << " times in failure regions (" << failure_region_seconds << " s), "
         << outside_events << " times outside the state space ("
         << outside_seconds << " s)  <-- no state can exist there\n";
+    if (server_hold_events > 0)
+      s << "  held force:        " << server_hold_events
+        << " times while a solver server was silent or lost ("
+        << server_hold_seconds << " s)  <-- its states were late\n";
     s << "  forces:            largest " << largest_force
       << " N, largest change per tick " << largest_force_change
       << " N, non-finite " << non_finite_forces << "\n";

@@ -11,6 +11,9 @@
 //   by number, and its task is planned again;
 // - the survivor computes the whole cloud; no force is non-finite;
 // - the haptic side's interpolated forces stay finite throughout;
+// - the engine says it is degraded (PrecomputationEngine::degraded(): the
+//   haptic side then holds the force instead of fading it) while the dead
+//   server is silent, and not before it died nor 3 s after it was lost;
 // - the client shuts the survivor down and finishes cleanly.
 
 #include <palpate/engine/hip_channel.h>
@@ -61,14 +64,20 @@ main(int argc, char **argv)
     engine.start();
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     // Interpolate as the haptic loop would, while the engine works.
-    unsigned int non_finite = 0;
-    const auto   start      = Clock::now();
-    bool         finished   = false;
+    unsigned int non_finite            = 0;
+    const auto   start                 = Clock::now();
+    bool         finished              = false;
+    bool         degraded_while_silent = false;
     while (Clock::now() - start < std::chrono::minutes(3))
       {
         const auto sample = palpate::interpolate_force(grid, cache, x);
         for (unsigned int d = 0; d < 3; ++d)
           non_finite += !std::isfinite(sample.force[d]);
+        // Server 2 dies on its second task, within the first wave; it is
+        // silent from then until it is declared lost 1 s later.
+        const bool lost = !engine.statistics().lost_servers.empty();
+        if (!lost && engine.degraded())
+          degraded_while_silent = true;
         if (engine.idle())
           {
             finished = true;
@@ -76,8 +85,15 @@ main(int argc, char **argv)
           }
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
+    // 3 s after the loss the re-planned work is done: no longer degraded.
+    std::this_thread::sleep_for(std::chrono::milliseconds(3500));
+    const bool degraded_after = engine.degraded();
     engine.stop();
     const auto stats = engine.statistics();
+    deallog << "degraded while server 2 was silent: "
+            << (degraded_while_silent ? "yes" : "NO")
+            << "; 3.5 s after the loss: " << (degraded_after ? "STILL" : "no")
+            << std::endl;
     deallog << "engine idle (cloud done) within 3 minutes: "
             << (finished ? "yes" : "NO") << std::endl;
     deallog << "servers lost: " << stats.lost_servers.size() << std::endl;

@@ -134,6 +134,22 @@ namespace palpate
     virtual unsigned int
     n_workers() const = 0;
 
+    /**
+     * Whether a worker is in trouble: a solver server has been silent for
+     * longer than its heartbeats allow (0.3 s), or one was lost in the
+     * last 3 s and its work is being re-planned. States missing then are
+     * late for a reason that is not the hand's speed, and may stay missing
+     * for the Server timeout: the haptic side holds the force from the
+     * last complete cell instead of letting it fade (issue 26: a stopped
+     * server let the force fade to zero for 10 s). Real-time safe (an
+     * atomic read). The threaded engine's workers cannot vanish: false.
+     */
+    virtual bool
+    degraded() const noexcept
+    {
+      return false;
+    }
+
     /** A description, e.g. "2 solver threads". */
     virtual std::string
     description() const = 0;

@@ -76,6 +76,9 @@ namespace palpate
     unsigned int
     n_workers() const override;
 
+    bool
+    degraded() const noexcept override;
+
     std::string
     description() const override;
 

@@ -51,7 +51,11 @@ namespace palpate
      * regions, and outside the state space. */
     std::uint64_t failure_region_events = 0, outside_events = 0;
     double        failure_region_seconds = 0, outside_seconds = 0;
-    std::uint64_t non_finite_forces = 0;
+    /** Held too while a solver server was silent or just lost
+     * (PrecomputationEngine::degraded()): its states were late. */
+    std::uint64_t server_hold_events  = 0;
+    double        server_hold_seconds = 0;
+    std::uint64_t non_finite_forces   = 0;
     double        largest_force = 0, largest_force_change = 0;
 
     // The built-in haptic loop (zero if the host application ran its own).
