@@ -240,6 +240,30 @@ namespace palpate
                  "to solve.\n";
           return ExitStatus::success;
         }
+      // A push longer than the body is across is a typing mistake (mm for
+      // m), not a failure point after 1000 increments.
+      if (Utilities::norm(*target) > mesh.diameter())
+        {
+          const std::string size = Utilities::to_string(mesh.diameter(), 3);
+          const std::string push =
+            Utilities::to_string(Utilities::norm(*target), 3);
+          if (target != prescribed)
+            throw InputError("command line",
+                             0,
+                             "--to " + Utilities::to_string(*target, 6),
+                             "the probe would move " + push +
+                               " m, more than the body is across (" + size +
+                               " m, its bounding box's diagonal)",
+                             "give the displacement in metres, e.g. --to "
+                             "0,0,-0.01 for 1 cm down.");
+          throw scene.error("Boundary conditions/Active node/Prescribed "
+                            "displacement",
+                            "the probe would move " + push +
+                              " m, more than the body is across (" + size +
+                              " m, its bounding box's diagonal)",
+                            "give the displacement in metres, e.g. 0, 0, "
+                            "-0.01 for 1 cm down.");
+        }
       out << "\n";
       return run_static_solve(out, scene, mesh, nodes, *target) ?
                ExitStatus::success :

@@ -140,6 +140,14 @@ namespace palpate
       out << "  FAILURE POINT:  " << to_string(state.status) << ": "
           << state.message << "\n  (no force is reported for a failure point)\n"
           << (state.status == SolveStatus::inverted_element &&
+                  (scene.parameters.effects.on("Gravity") ||
+                   scene.parameters.effects.on("Surface traction")) ?
+                "  hint:           the scene's loads are on (Effects / "
+                "Gravity, Surface traction): a load too large for the "
+                "material inverts elements however the probe moves. Check "
+                "Gravitational acceleration (m/s^2) and Traction (Pa) against "
+                "the material's modulus, or solve without them.\n" :
+              state.status == SolveStatus::inverted_element &&
                   scene.parameters.material_model.model_name ==
                     "St.Venant-Kirchhoff" ?
                 "  hint:           St.Venant-Kirchhoff collapses under deep "

@@ -247,6 +247,20 @@ namespace palpate
                   "palpate needs a volume mesh of linear tetrahedra; a "
                   "surface mesh must first be meshed, e.g. with TetGen.");
 
+    // One wild coordinate (1e308) would make every size below nonsense,
+    // and the first element using it look degenerate: name the node.
+    if (const long far = far_outlier(data.nodes); far >= 0)
+      throw error(0,
+                  "node " + std::to_string(far < long(data.node_ids.size()) ?
+                                             data.node_ids[far] :
+                                             far + 1),
+                  "the node at (" + Utilities::to_string(data.nodes[far], 6) +
+                    ") (file units) lies more than 1000 times farther from "
+                    "the body's centre than the median node: a mistyped or "
+                    "corrupted coordinate",
+                  "correct that node's coordinates in the file, or export "
+                  "the mesh again.");
+
     // Nodes with identical coordinates are one node: files written cell by
     // cell (deal.II's GridOut and DataOut, some VTU exporters) repeat every
     // vertex once per cell.

@@ -1461,6 +1461,44 @@ namespace palpate
 
 
 
+  long
+  far_outlier(const std::vector<Utilities::Point3> &points)
+  {
+    if (points.size() < 4)
+      return -1;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      for (const double x : points[i])
+        if (!std::isfinite(x))
+          return i;
+    // The median point, and the median distance from it: robust to a few
+    // wild points, unlike the mean and the bounding box.
+    Utilities::Point3 centre;
+    for (unsigned int d = 0; d < 3; ++d)
+      {
+        std::vector<double> c(points.size());
+        for (std::size_t i = 0; i < points.size(); ++i)
+          c[i] = points[i][d];
+        std::nth_element(c.begin(), c.begin() + c.size() / 2, c.end());
+        centre[d] = c[c.size() / 2];
+      }
+    std::vector<double> distance(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      distance[i] = Utilities::distance(points[i], centre);
+    std::vector<double> sorted = distance;
+    std::nth_element(sorted.begin(),
+                     sorted.begin() + sorted.size() / 2,
+                     sorted.end());
+    const double typical = sorted[sorted.size() / 2];
+    const auto   far     = std::max_element(distance.begin(), distance.end());
+    if (typical > 0 && std::isfinite(*far) && *far <= 1000 * typical)
+      return -1;
+    if (!(typical > 0) && !(*far > 0))
+      return -1; // all in one point: another check says so
+    return far - distance.begin();
+  }
+
+
+
   MeshData
   read_mesh_file(const std::string &filename)
   {

@@ -512,6 +512,20 @@ namespace palpate
     report.diameter     = s.diameter();
     report.box          = s.bounding_box();
     report.area         = s.area();
+    // One wild vertex (1e308) is not a unit mistake: name it, rather than
+    // advise a scale factor of 0.
+    if (const long far = far_outlier(s.vertices); far >= 0)
+      throw InputError(surface_file,
+                       0,
+                       "vertex " + std::to_string(far + 1),
+                       "the vertex at (" +
+                         Utilities::to_string(
+                           Utilities::scaled(s.vertices[far], 1 / scale), 6) +
+                         ") (file units) lies more than 1000 times farther "
+                         "from the surface's centre than the median vertex: "
+                         "a mistyped or corrupted coordinate",
+                       "correct that vertex in the file, or export the "
+                       "surface again.");
     // An organ is 2 cm to 1 m across: anything else is a unit mistake.
     if (const std::string advice = unit_advice(report.diameter, scale);
         !advice.empty())

@@ -199,6 +199,15 @@ namespace palpate
             return "a whole number >= " + m[1].str();
           return "a whole number from " + m[1].str() + " to " + m[2].str();
         }
+      if (std::regex_search(
+            description,
+            m,
+            std::regex(
+              R"(^\[List of <\[Double (\S+)\.\.\.(\S+) .*of length 3\.\.\.3)")))
+        return "three numbers separated by commas (x, y, z)" +
+               (m[1].str() == "-MAX_DOUBLE" && m[2].str() == "MAX_DOUBLE" ?
+                  std::string() :
+                  ", each from " + m[1].str() + " to " + m[2].str());
       if (std::regex_search(description,
                             std::regex(
                               R"(^\[List of <\[Double.*of length 3\.\.\.3)")))
@@ -551,8 +560,13 @@ namespace palpate
                              path_to_string(std::vector<std::string>(
                                s.path.begin(), s.path.begin() + i)),
                            suggestion(s.path[i], here->subsection_names()) +
-                             "The subsections there are: " +
-                             join(here->subsection_names(), ", ") + ". " +
+                             (here->subsection_names().empty() ?
+                                path_to_string(std::vector<std::string>(
+                                  s.path.begin(), s.path.begin() + i)) +
+                                  " has no subsections; its entries are: " +
+                                  join(here->entry_names(), ", ") + ". " :
+                                "The subsections there are: " +
+                                  join(here->subsection_names(), ", ") + ". ") +
                              example);
               here = next;
             }

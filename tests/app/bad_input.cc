@@ -462,6 +462,57 @@ main(int argc, char **argv)
       "solve good.prm --set 'Mesh/Beam/Subdivisions=100,30,30' --set "
       "'Discretization/Polynomial degree=2'");
 
+  // Messages that blamed the wrong thing (issue 26): a huge load blamed
+  // the material, a wild coordinate a healthy element or the scale factor,
+  // a push of a kilometre ended as a failure point.
+  run("gravity of 1e6 m/s^2",
+      "solve good.prm --set 'Effects/Gravity=true' --set "
+      "'Effects/Gravitational acceleration=0,0,-1e6'");
+  run("a traction of 1e9 Pa",
+      "solve good.prm --set 'Effects/Surface traction=true' --set "
+      "'Effects/Traction=0,0,-1e9'");
+  run("solve --to 1000,0,0 (metres)", "solve good.prm --to 1000,0,0");
+  {
+    std::ifstream in(palpate_meshes_dir + "/liver-tetgen/liver501.msh");
+    std::ofstream out("wild-node.msh");
+    std::string   line;
+    bool          first_node = false;
+    while (std::getline(in, line))
+      {
+        if (first_node && line.find(' ') != std::string::npos)
+          {
+            line       = line.substr(0, line.find(' ')) + " 1e308 0 0";
+            first_node = false;
+          }
+        if (line == "$Nodes")
+          {
+            out << line << "\n";
+            std::getline(in, line); // the count
+            first_node = true;
+          }
+        out << line << "\n";
+      }
+  }
+  run("a mesh node at 1e308",
+      "solve good.prm --set 'Mesh/Source=file' --set 'Mesh/File "
+      "name=wild-node.msh' --set 'Mesh/Scale factor=0.039'");
+  {
+    std::ifstream in(palpate_meshes_dir + "/liver-tetgen/liver501-surface.obj");
+    std::ofstream out("wild-vertex.obj");
+    std::string   line;
+    bool          done = false;
+    while (std::getline(in, line))
+      {
+        if (!done && line.rfind("v ", 0) == 0)
+          {
+            line = "v 1e308 0 0";
+            done = true;
+          }
+        out << line << "\n";
+      }
+  }
+  run("a surface vertex at 1e308", "mesh wild-vertex.obj out.msh");
+
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;
 }

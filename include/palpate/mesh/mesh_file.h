@@ -53,6 +53,17 @@ namespace palpate
   constexpr std::uintmax_t max_mesh_file_bytes = std::uintmax_t(512) << 20;
 
   /**
+   * The index of a point far away from all the others - a coordinate
+   * mistyped or corrupted (1e308 in a mesh of a liver), more than 1000
+   * times farther from the points' median than the median point is, or
+   * not finite - or -1 if there is none. Such a point makes the bounding
+   * box, and every message about the body's size, nonsense: the readers'
+   * callers name it instead.
+   */
+  long
+  far_outlier(const std::vector<Utilities::Point3> &points);
+
+  /**
    * Read a mesh file: Gmsh .msh (format 2.2 or the old v1, ASCII), legacy
    * VTK .vtk (ASCII UNSTRUCTURED_GRID, classic or OFFSETS/CONNECTIVITY
    * cells) or VTK XML .vtu (ascii, base64 binary or appended data, raw or

@@ -32,8 +32,12 @@ namespace palpate
         prm.declare_entry(
           "Gravitational acceleration",
           "0, 0, -9.81",
-          dealii::Patterns::List(dealii::Patterns::Double(), 3, 3, ","),
-          "Gravitational acceleration vector g (m/s^2).");
+          // 100 g at most in each direction: beyond, no tissue holds its
+          // own weight, and a failure would seem to be the material's.
+          dealii::Patterns::List(
+            dealii::Patterns::Double(-1000, 1000), 3, 3, ","),
+          "Gravitational acceleration vector g (m/s^2), each component "
+          "between -1000 and 1000 (100 g; Earth's is 9.81).");
       }
 
       static std::unique_ptr<Effect>

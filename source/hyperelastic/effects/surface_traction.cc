@@ -44,8 +44,13 @@ namespace palpate
         prm.declare_entry(
           "Traction",
           "0, 0, 0",
-          dealii::Patterns::List(dealii::Patterns::Double(), 3, 3, ","),
-          "The traction vector t (Pa = N/m^2) on those faces.");
+          // 1 MPa at most: about 100 times the stiffest soft tissue's
+          // modulus; beyond, the load and not the material fails a solve.
+          dealii::Patterns::List(
+            dealii::Patterns::Double(-1e6, 1e6), 3, 3, ","),
+          "The traction vector t (Pa = N/m^2) on those faces, each component "
+          "between -1e6 and 1e6 Pa (1 MPa; a neighbouring organ's weight is "
+          "of the order of 100 Pa).");
       }
 
       static std::unique_ptr<Effect>
