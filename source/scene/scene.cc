@@ -1052,16 +1052,26 @@ namespace palpate
                       "such moduli only overflow the solver's force scale",
                     "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
                     "(liver: E = 15465 Pa).");
-      else if (value > 0 && value < min_modulus)
-        throw error("Material model/" + m.model_name +
-                      (entry.empty() ? "" : "/" + entry),
-                    "at least " + Utilities::to_string(min_modulus, 3) +
-                      " Pa (or 0 where the model allows it): softer than "
-                      "any tissue (fat is about 1e2 Pa), so that the forces "
-                      "fall below round-off and Newton 'converges' on any "
-                      "state",
-                    "give the modulus in Pa: soft tissue is 1e2 - 1e7 Pa "
-                    "(liver: E = 15465 Pa).");
+    // The lower bound holds for the stiffness scale (Young's modulus of the
+    // small-strain limit, 6 (C10 + C01) for Mooney-Rivlin), not for each
+    // constant: a tiny C01 beside a liver's C10 is a valid law.
+    if (const double E = material->youngs_modulus(); E > 0 && E < min_modulus)
+      {
+        const auto        moduli = material->moduli();
+        const std::string entry =
+          moduli.empty() || moduli.front().first.empty() ?
+            "" :
+            "/" + moduli.front().first;
+        throw error("Material model/" + m.model_name + entry,
+                    "the material's small-strain Young's modulus is " +
+                      Utilities::to_string(E, 3) + " Pa; at least " +
+                      Utilities::to_string(min_modulus, 3) +
+                      " Pa: softer than any tissue (fat is about 1e2 Pa), so "
+                      "that the forces fall below round-off and Newton "
+                      "'converges' on any state",
+                    "give the moduli in Pa: soft tissue is 1e2 - 1e7 Pa "
+                    "(liver: E = 15465 Pa, or C10 = 2148, C01 = 430).");
+      }
 
     // Effects: each plug-in checks its entries.
     try

@@ -513,6 +513,18 @@ main(int argc, char **argv)
   }
   run("a surface vertex at 1e308", "mesh wild-vertex.obj out.msh");
 
+  // The lower bound is on the stiffness scale: a tiny C01 beside a
+  // liver's C10 is a valid Mooney-Rivlin law (exit 0), both tiny is not.
+  run("Mooney-Rivlin with C01 = 1e-4 Pa beside C10 = 2148 Pa (valid)",
+      "--set 'Run/Mode=set-up only' " + palpate_source_dir +
+        "/parameters/paper-mooney-rivlin.prm --set 'Material "
+        "model/Mooney-Rivlin/C01=1e-4'");
+  run("Mooney-Rivlin with C10 = C01 = 1e-5 Pa",
+      palpate_source_dir +
+        "/parameters/paper-mooney-rivlin.prm --set 'Material "
+        "model/Mooney-Rivlin/C01=1e-5' --set 'Material "
+        "model/Mooney-Rivlin/C10=1e-5'");
+
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;
 }
