@@ -87,7 +87,8 @@ namespace palpate
                   const unsigned int target,
                   const std::string &out,
                   const MeshGrading &grading,
-                  const double       time_limit)
+                  const double       time_limit,
+                  const int          progress_fd)
     {
       const auto   start  = Clock::now();
       const double volume = s.volume();
@@ -221,7 +222,10 @@ namespace palpate
                     {
                       gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
                       gmsh::option::setNumber("Mesh.Binary", 0);
-                      gmsh::write(out);
+                      // Written aside and renamed: a child killed while
+                      // writing leaves the last complete mesh in @p out.
+                      gmsh::write(out + ".pass.msh");
+                      std::rename((out + ".pass.msh").c_str(), out.c_str());
                     }
                   meshed = true;
                 }
@@ -250,6 +254,20 @@ namespace palpate
           const Pass this_pass{h, nodes, tets, triangles};
           if (best.nodes == 0 || off(nodes) < off(best.nodes))
             best = this_pass;
+          // The best mesh so far is in @p out: say so at once, so that if
+          // the next pass overruns the time limit and the parent kills this
+          // process, the parent keeps this one instead of failing.
+          {
+            std::ostringstream r;
+            r.precision(17);
+            r << "PASS " << best.nodes << ' ' << best.tetrahedra << ' '
+              << best.triangles << ' ' << best.h << ' ' << attempts << ' '
+              << passes << ' ' << (off(best.nodes) <= target_nodes_tolerance)
+              << " 1\n";
+            const std::string line = r.str();
+            if (::write(progress_fd, line.data(), line.size()) < 0)
+              {} // the parent is gone: nothing to tell
+          }
           if (off(best.nodes) <= target_nodes_tolerance ||
               pass + 1 == max_passes)
             break;
@@ -307,8 +325,8 @@ namespace palpate
         std::string report;
         try
           {
-            report =
-              mesh_in_child(surface, target_nodes, tmp, grading, time_limit);
+            report = mesh_in_child(
+              surface, target_nodes, tmp, grading, time_limit, channel[1]);
           }
         catch (const std::exception &e)
           {
@@ -368,8 +386,27 @@ namespace palpate
     const auto fail = [&](const std::string &problem, const std::string &fix) {
       std::error_code ec;
       std::filesystem::remove(tmp, ec);
+      std::filesystem::remove(tmp + ".pass.msh", ec);
       return InputError(surface_name, 0, "surface", problem, fix);
     };
+    // Killed while a correction pass overran the limit: the last pass the
+    // child reported is in the file, and good enough to keep.
+    if (!finished)
+      if (const auto at = report.rfind("PASS "); at != std::string::npos)
+        {
+          report   = report.substr(at + 5);
+          finished = true;
+        }
+    // A finished child's last line is its report.
+    if (finished)
+      if (const auto at = report.rfind("\n"); at != std::string::npos)
+        {
+          if (at + 1 < report.size())
+            report = report.substr(at + 1);
+          else if (const auto pass = report.rfind("PASS ");
+                   pass != std::string::npos)
+            report = report.substr(pass + 5);
+        }
     if (!finished || report.empty())
       throw fail("meshing did not finish within the time limit of " +
                    Utilities::to_string(time_limit, 3) +
