@@ -22,89 +22,9 @@
 
 #include "../tests.h"
 
+#include "../fuzz.h"
 #include "../mesh_writers.h"
 
-namespace
-{
-  const std::vector<std::string> numbers = {"nan",
-                                            "inf",
-                                            "-inf",
-                                            "1e308",
-                                            "-1",
-                                            "0",
-                                            "4294967295",
-                                            "4294967296",
-                                            "99999999999999999999",
-                                            "-2147483648",
-                                            "1e-320",
-                                            "3.5",
-                                            "abc",
-                                            ""};
-
-  std::size_t
-  pick(std::mt19937 &rng, const std::size_t n)
-  {
-    return n == 0 ? 0 : rng() % n;
-  }
-
-  std::string
-  mutate(std::string s, std::mt19937 &rng)
-  {
-    const unsigned int n = 1 + pick(rng, 3);
-    for (unsigned int m = 0; m < n && !s.empty(); ++m)
-      switch (pick(rng, 7))
-        {
-          case 0: // flip a byte
-            s[pick(rng, s.size())] = static_cast<char>(pick(rng, 256));
-            break;
-          case 1: // delete a range
-            s.erase(pick(rng, s.size()), 1 + pick(rng, 64));
-            break;
-          case 2: // repeat a range
-            {
-              const auto at = pick(rng, s.size());
-              s.insert(at, s.substr(at, 1 + pick(rng, 64)));
-              break;
-            }
-          case 3: // drop a line
-            {
-              const auto at  = s.find('\n', pick(rng, s.size()));
-              const auto end = at == std::string::npos ? std::string::npos :
-                                                         s.find('\n', at + 1);
-              if (at != std::string::npos)
-                s.erase(at, end == std::string::npos ? end : end - at);
-              break;
-            }
-          case 4: // duplicate a line
-            {
-              const auto at  = s.find('\n', pick(rng, s.size()));
-              const auto end = at == std::string::npos ? std::string::npos :
-                                                         s.find('\n', at + 1);
-              if (end != std::string::npos)
-                s.insert(at, s.substr(at, end - at));
-              break;
-            }
-          case 5: // a nasty number in place of one
-            {
-              auto at = pick(rng, s.size());
-              while (at < s.size() &&
-                     !std::isdigit(static_cast<unsigned char>(s[at])))
-                ++at;
-              auto end = at;
-              while (end < s.size() &&
-                     (std::isdigit(static_cast<unsigned char>(s[end])) ||
-                      s[end] == '.' || s[end] == 'e' || s[end] == '-'))
-                ++end;
-              if (at < s.size())
-                s.replace(at, end - at, numbers[pick(rng, numbers.size())]);
-              break;
-            }
-          default: // truncate
-            s.resize(pick(rng, s.size()));
-        }
-    return s;
-  }
-} // namespace
 
 int
 main(int argc, char **argv)
@@ -129,7 +49,7 @@ main(int argc, char **argv)
       unsigned int      valid = 0, rejected = 0, other = 0, slow = 0;
       for (unsigned int i = 0; i < per_seed; ++i)
         {
-          write_file(file, mutate(text, rng));
+          write_file(file, fuzz::mutate(text, rng));
           const auto start = std::chrono::steady_clock::now();
           try
             {
