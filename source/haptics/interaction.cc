@@ -472,16 +472,11 @@ namespace palpate
     // What the grid, the cache, the mesh and the engine's threads were
     // built for cannot change here.
     const Parameters::AllParameters &o = s.scene.parameters;
-    const auto                      &m = o.mesh, &n = parameters.mesh;
-    const char                      *fixed = nullptr;
-    if (m.source != n.source || m.file_name != n.file_name ||
-        m.scale_factor != n.scale_factor || m.beam_length != n.beam_length ||
-        m.beam_width != n.beam_width || m.beam_height != n.beam_height ||
-        m.beam_subdivisions_length != n.beam_subdivisions_length ||
-        m.beam_subdivisions_width != n.beam_subdivisions_width ||
-        m.beam_subdivisions_height != n.beam_subdivisions_height ||
-        m.blob_semi_axes != n.blob_semi_axes ||
-        m.blob_refinements != n.blob_refinements)
+    // The Mesh subsection is compared as a whole: field by field, the
+    // surface settings were left out, and a live change of them was
+    // accepted and then ignored.
+    const char *fixed = nullptr;
+    if (o.mesh != parameters.mesh)
       fixed = "Mesh";
     else if (o.state_space.grid_spacing !=
                parameters.state_space.grid_spacing ||

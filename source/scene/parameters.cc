@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace palpate
 {
@@ -172,6 +173,32 @@ namespace palpate
         prm.leave_subsection();
       }
       prm.leave_subsection();
+    }
+
+
+
+    bool
+    Mesh::operator==(const Mesh &o) const
+    {
+      const auto entries = [](const Mesh &m) {
+        return std::tie(m.source,
+                        m.file_name,
+                        m.scale_factor,
+                        m.beam_length,
+                        m.beam_width,
+                        m.beam_height,
+                        m.beam_subdivisions_length,
+                        m.beam_subdivisions_width,
+                        m.beam_subdivisions_height,
+                        m.blob_semi_axes,
+                        m.blob_refinements,
+                        m.surface_target_nodes,
+                        m.surface_time_limit,
+                        m.surface_mesh_directory,
+                        m.surface_fine_size,
+                        m.surface_fine_radius);
+      };
+      return entries(*this) == entries(o);
     }
 
 

@@ -177,6 +177,23 @@ main(int argc, char **argv)
     {
       deallog << "grid change refused: " << e.what() << std::endl;
     }
+  // Every Mesh entry counts, the surface mesher's too (it was compared
+  // field by field, without them: the change was accepted and ignored).
+  palpate::Parameters::AllParameters other_surface = changed;
+  other_surface.mesh.surface_target_nodes += 1000;
+  try
+    {
+      interaction.change_parameters(other_surface);
+      deallog << "surface setting change ACCEPTED" << std::endl;
+    }
+  catch (const std::invalid_argument &e)
+    {
+      deallog << "surface setting change refused: "
+              << (std::string(e.what()).find("'Mesh'") != std::string::npos ?
+                    "names Mesh" :
+                    "DOES NOT NAME Mesh")
+              << std::endl;
+    }
   palpate::Parameters::AllParameters no_fixed_nodes           = changed;
   no_fixed_nodes.boundary_conditions.fixed_nodes.boundary_ids = {7};
   try

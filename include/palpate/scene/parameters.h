@@ -58,6 +58,17 @@ namespace palpate
       double surface_fine_size   = 0;
       double surface_fine_radius = 0.02;
 
+      /** Whether every entry is the same: the mesh built from @p other would
+       * be this one's (Interaction::change_parameters() refuses a change).
+       * A new entry must be compared here too. */
+      bool
+      operator==(const Mesh &other) const;
+      bool
+      operator!=(const Mesh &other) const
+      {
+        return !(*this == other);
+      }
+
       static void
       declare_parameters(dealii::ParameterHandler &prm);
       void
