@@ -11,12 +11,6 @@
 namespace palpate
 {
   /**
-   * An error in what the user gave us: a scene file, a mesh file, a command
-   * line. It always says where (file and, if known, line), which entry, what
-   * is wrong with it, and what to do about it. `main()` prints it as a banner
-   * and exits with status 2; tests print it verbatim.
-   */
-  /**
    * palpate could not write an output file (the directory removed, the disk
    * full) after the work itself was done: the message names the file and
    * the reason; what was computed is reported before it.
@@ -29,6 +23,12 @@ namespace palpate
 
 
 
+  /**
+   * An error in what the user gave us: a scene file, a mesh file, a command
+   * line. It always says where (file and, if known, line), which entry, what
+   * is wrong with it, and what to do about it. `main()` prints it as a banner
+   * and exits with status 2; tests print it verbatim.
+   */
   class InputError : public std::runtime_error
   {
   public:

@@ -100,7 +100,8 @@ namespace palpate
     double            radius, omega, length;
   };
 
-  /*   * A smooth random motion: per axis, a sum of three sinusoids with random
+  /**
+   * A smooth random motion: per axis, a sum of three sinusoids with random
    * amplitudes, phases and frequencies (seeded), shifted to start at rest,
    * staying within @p radius of it, with root-mean-square speed @p speed
    * (over a long run; the speed itself varies smoothly).
