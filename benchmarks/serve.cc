@@ -65,7 +65,7 @@ namespace
     std::ostringstream body;
     body << std::setprecision(17) << "Young's modulus=" << E;
     const auto start = Clock::now();
-    client.Post("/material", body.str(), "text/plain");
+    client.Post("/material", body.str(), LiveServer::command_type);
     while (!server.interaction().initial_cloud_complete())
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     return seconds_since(start);
@@ -83,6 +83,8 @@ namespace
     Result          r;
     LiveServer      server(scene, "127.0.0.1", 0);
     httplib::Client client("127.0.0.1", server.port());
+    // Changes carry the run's token, as the page sends it.
+    client.set_default_headers({{LiveServer::token_header, server.token()}});
     client.set_read_timeout(600, 0);
     while (!server.interaction().initial_cloud_complete())
       std::this_thread::sleep_for(std::chrono::milliseconds(1));

@@ -4,27 +4,40 @@
 #include <palpate/app/application.h>
 #include <palpate/app/serve.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/engine/engine.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/material.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
+#include <arpa/inet.h>
 #include <httplib.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
-#include <csignal>
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
 #include <functional>
+#include <iomanip>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <random>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <thread>
@@ -135,16 +148,358 @@ namespace palpate
       const double length = Utilities::norm(n);
       return length > 0 ? Utilities::scaled(n, 1 / length) : n;
     }
+
+    /** The run's secret: 128 bits from /dev/urandom (the kernel's
+     * cryptographic generator; libstdc++'s random_device reads it when
+     * named), as 32 hexadecimal digits. */
+    std::string
+    make_token()
+    {
+      std::random_device urandom("/dev/urandom");
+      std::ostringstream token;
+      token << std::hex;
+      for (unsigned int k = 0; k < 4; ++k)
+        {
+          const std::uint32_t bits = urandom();
+          for (int shift = 28; shift >= 0; shift -= 4)
+            token << ((bits >> shift) & 0xF);
+        }
+      return token.str();
+    }
+
+    /** Whether @p given is @p secret, in a time that does not depend on
+     * where they differ: an attacker who can time the answers learns
+     * nothing from them about the secret's digits. */
+    bool
+    same_secret(const std::string &given, const std::string &secret)
+    {
+      if (given.size() != secret.size())
+        return false;
+      volatile unsigned char difference = 0;
+      for (std::size_t i = 0; i < secret.size(); ++i)
+        difference = difference | (static_cast<unsigned char>(given[i]) ^
+                                   static_cast<unsigned char>(secret[i]));
+      return difference == 0;
+    }
+
+    /** @p text as it may be printed: what a client sent is shown to the
+     * user, so control characters (a terminal's escape sequences) become
+     * '?', and it is cut to @p most characters. */
+    std::string
+    printable(const std::string &text, const std::size_t most = 80)
+    {
+      std::string shown;
+      for (const char c : text.substr(0, most))
+        shown += static_cast<unsigned char>(c) >= 0x20 &&
+                     static_cast<unsigned char>(c) < 0x7F ?
+                   c :
+                   '?';
+      return shown + (text.size() > most ? "..." : "");
+    }
+
+    std::string
+    lower_case(std::string text)
+    {
+      for (char &c : text)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      return text;
+    }
+
+    /** The host (lower case; an IPv6 address in brackets) and port of a
+     * Host header or of an origin after its "http://". */
+    struct Authority
+    {
+      std::string host;
+      int         port;
+
+      bool
+      operator==(const Authority &other) const
+      {
+        return host == other.host && port == other.port;
+      }
+    };
+
+    /** "host", "host:port", "[v6]" or "[v6]:port" (the port 80 if none,
+     * as browsers leave it out then), or nothing if @p text is not one of
+     * these (a user name, a path or a second colon included). */
+    std::optional<Authority>
+    parse_authority(const std::string &text)
+    {
+      std::string host, port;
+      if (!text.empty() && text[0] == '[')
+        {
+          const auto close = text.find(']');
+          if (close == std::string::npos)
+            return {};
+          host = text.substr(0, close + 1);
+          if (close + 1 < text.size())
+            {
+              if (text[close + 1] != ':')
+                return {};
+              port = text.substr(close + 2);
+            }
+          if (host.find_first_not_of("[]0123456789abcdefABCDEF:.") !=
+              std::string::npos)
+            return {};
+        }
+      else
+        {
+          const auto colon = text.find(':');
+          host             = text.substr(0, colon);
+          if (colon != std::string::npos)
+            port = text.substr(colon + 1);
+          if (host.find_first_not_of(
+                "abcdefghijklmnopqrstuvwxyz"
+                "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789.-_") != std::string::npos)
+            return {};
+        }
+      if (host.empty() || host == "[]")
+        return {};
+      int number = 80;
+      if (!port.empty() || text.back() == ':')
+        {
+          if (port.empty() || port.size() > 5 ||
+              port.find_first_not_of("0123456789") != std::string::npos)
+            return {};
+          number = std::stoi(port);
+          if (number < 1 || number > 65535)
+            return {};
+        }
+      return Authority{lower_case(host), number};
+    }
+
+    /** @p host as a Host header names it: IPv6 addresses in brackets. */
+    std::string
+    as_url_host(const std::string &host)
+    {
+      return host.find(':') != std::string::npos && host[0] != '[' ?
+               "[" + lower_case(host) + "]" :
+               lower_case(host);
+    }
+
+    /** Whether --host @p host means every interface. */
+    bool
+    every_interface(const std::string &host)
+    {
+      return host == "0.0.0.0" || host == "::" || host == "[::]";
+    }
+
+    /** Whether --host @p host is this machine's loopback interface. */
+    bool
+    loopback(const std::string &host)
+    {
+      return host == "localhost" || host == "::1" || host == "[::1]" ||
+             host.rfind("127.", 0) == 0;
+    }
+
+    /** This machine's name and the addresses of its interfaces now, as a
+     * Host header gives them: a browser that opens the view listening on
+     * every interface names it by one of these. */
+    std::vector<std::string>
+    machine_names()
+    {
+      std::vector<std::string> names;
+      char                     name[256] = {};
+      if (gethostname(name, sizeof name - 1) == 0 && name[0] != 0)
+        names.push_back(lower_case(name));
+      ifaddrs *list = nullptr;
+      if (getifaddrs(&list) == 0)
+        {
+          for (const ifaddrs *a = list; a != nullptr; a = a->ifa_next)
+            {
+              if (a->ifa_addr == nullptr)
+                continue;
+              char text[INET6_ADDRSTRLEN] = {};
+              if (a->ifa_addr->sa_family == AF_INET &&
+                  inet_ntop(AF_INET,
+                            &reinterpret_cast<const sockaddr_in *>(a->ifa_addr)
+                               ->sin_addr,
+                            text,
+                            sizeof text) != nullptr)
+                names.emplace_back(text);
+              else if (a->ifa_addr->sa_family == AF_INET6 &&
+                       inet_ntop(AF_INET6,
+                                 &reinterpret_cast<const sockaddr_in6 *>(
+                                    a->ifa_addr)
+                                    ->sin6_addr,
+                                 text,
+                                 sizeof text) != nullptr)
+                names.push_back("[" + std::string(text) + "]");
+            }
+          freeifaddrs(list);
+        }
+      return names;
+    }
+
+    /** The media type of a Content-Type header, without its parameters
+     * ("; charset=..."), in lower case. */
+    std::string
+    media_type(const std::string &content_type)
+    {
+      return lower_case(
+        Utilities::trim(content_type.substr(0, content_type.find(';'))));
+    }
+
+    /** @p value as the change lines print numbers (6 digits), or as it is
+     * if it is not one. */
+    std::string
+    number_text(const std::string &value)
+    {
+      try
+        {
+          std::size_t  used = 0;
+          const double x    = std::stod(value, &used);
+          if (used == value.size())
+            {
+              std::ostringstream s;
+              s << x;
+              return s.str();
+            }
+        }
+      catch (const std::exception &)
+        {}
+      return value;
+    }
+
+    /**
+     * cpp-httplib's task queue for the server: each connection is served
+     * on a thread of its own, up to @p most at once (more wait for one to
+     * end), so that a client that holds a connection without finishing
+     * its request (slow, idle, or on purpose: a "slow loris") holds one
+     * thread and nobody waits for it. cpp-httplib's ThreadPool has a
+     * fixed number of threads (the live view had 8): nine clients that
+     * sent a header line every 3 s made /frame wait more than a minute.
+     * The read timeout (LiveServer) ends each such connection after a
+     * pause of 2 s; a client must keep sending to keep its thread, and
+     * @p most of them at once to make the view wait. Threads beyond @p
+     * keep end after 10 s without work.
+     */
+    class ConnectionThreads : public httplib::TaskQueue
+    {
+    public:
+      ConnectionThreads(const std::size_t keep, const std::size_t most)
+        : keep(keep)
+        , most(most)
+      {}
+
+      ~ConnectionThreads() override
+      {
+        shutdown();
+      }
+
+      void
+      enqueue(std::function<void()> job) override
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        reap();
+        jobs.push_back(std::move(job));
+        // A thread of its own, unless one is waiting for work.
+        if (jobs.size() > waiting && threads.size() < most)
+          try
+            {
+              std::thread thread([this] { work(); });
+              const auto  id = thread.get_id();
+              threads.emplace(id, std::move(thread));
+              return;
+            }
+          catch (const std::system_error &)
+            {
+              // No more threads to be had: it waits for one.
+            }
+        wake.notify_one();
+      }
+
+      void
+      shutdown() override
+      {
+        std::map<std::thread::id, std::thread> all;
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          stopping = true;
+          all.swap(threads);
+        }
+        // The connections accepted and not served yet are closed by the
+        // threads on their way out.
+        wake.notify_all();
+        for (auto &thread : all)
+          thread.second.join();
+      }
+
+      void
+      on_idle() override
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        reap();
+      }
+
+    private:
+      void
+      work()
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        for (;;)
+          {
+            ++waiting;
+            const bool woken =
+              wake.wait_for(lock, std::chrono::seconds(10), [this] {
+                return !jobs.empty() || stopping;
+              });
+            --waiting;
+            if (!jobs.empty())
+              {
+                auto job = std::move(jobs.front());
+                jobs.pop_front();
+                lock.unlock();
+                job();
+                lock.lock();
+              }
+            else if (stopping ||
+                     (!woken && threads.size() - finished.size() > keep))
+              {
+                // Joined by reap() or shutdown(); the lock is released
+                // on the way out, and nothing after it is touched.
+                finished.push_back(std::this_thread::get_id());
+                return;
+              }
+          }
+      }
+
+      /** Join the threads that ended (mutex held). */
+      void
+      reap()
+      {
+        for (const auto id : finished)
+          if (const auto it = threads.find(id); it != threads.end())
+            {
+              it->second.join();
+              threads.erase(it);
+            }
+        finished.clear();
+      }
+
+      const std::size_t                      keep, most;
+      std::mutex                             mutex;
+      std::condition_variable                wake;
+      std::deque<std::function<void()>>      jobs;
+      std::map<std::thread::id, std::thread> threads;
+      std::vector<std::thread::id>           finished;
+      std::size_t                            waiting  = 0;
+      bool                                   stopping = false;
+    };
   } // namespace
 
 
 
   struct LiveServer::Impl
   {
-    Impl(const Scene &scene, const double max_speed)
+    Impl(const Scene &scene, const double max_speed, std::ostream *log)
       : interaction(scene)
       , max_speed(max_speed)
       , rate(scene.parameters.haptics.loop_rate)
+      , token(make_token())
+      , log(log)
+      , scene_material(material_description())
+      , scene_active(active_description())
     {
       for (auto &a : {&target, &hip, &force})
         for (auto &x : *a)
@@ -208,6 +563,16 @@ namespace palpate
       mesh_json = m.str();
       describe_active();
       displacement.assign(3 * surface.size(), 0.0);
+
+      // The page with the run's token in it (its <meta name=
+      // "palpate-token">): the page sends it back with every change.
+      page                          = live_view_page;
+      const std::string placeholder = "{{palpate-token}}";
+      const auto        at          = page.find(placeholder);
+      if (at == std::string::npos)
+        throw std::logic_error("the live view's page has no place for its "
+                               "token");
+      page.replace(at, placeholder.size(), token);
 
       if (live_view_assets::three_module().empty())
         throw NotAvailableError(
@@ -431,9 +796,159 @@ namespace palpate
     // Mesh vertex -> its index among the surface's vertices.
     std::map<unsigned int, unsigned int> surface_index;
 
-    /** Change the scene's parameters on the fly: detach, change (the
-     * cache is invalidated and the states are computed again), attach.
-     * Returns "" or the reason the change was refused. */
+    // Who gets in. The run's secret, and the page that carries it.
+    const std::string token;
+    std::string       page;
+    // The port it listens on (and the listening socket); the host names a
+    // request's Host header may give with it (lower case, IPv6 in
+    // brackets); the address to open.
+    int                   bound = 0, listening = -1;
+    std::set<std::string> hosts;
+    std::string           address;
+
+    // What happened, for the user: the log, when the server started, the
+    // changes made through the view and the requests refused, by kind
+    // (record_mutex). The material and the active node at the start.
+    std::ostream *const                 log;
+    const Clock::time_point             started = Clock::now();
+    mutable std::mutex                  record_mutex;
+    std::vector<LiveServer::Change>     changes;
+    std::map<std::string, unsigned int> refusals;
+    const std::string                   scene_material, scene_active;
+
+    /** The material model and its constants now, as the scene report
+     * gives them: "St.Venant-Kirchhoff, E = 15465 Pa, nu = 0.49". */
+    std::string
+    material_description() const
+    {
+      const auto &material = interaction.scene().parameters.material_model;
+      return material.model_name + ", " +
+             Material::create(material)->description();
+    }
+
+    /** The active node now: "node 87 at (100, 0, 10) mm". */
+    std::string
+    active_description() const
+    {
+      const auto &mesh = interaction.mesh();
+      const auto  v    = interaction.nodes().active_vertex;
+      if (v == NodeSelection::no_active_node)
+        return "none";
+      return "node " + std::to_string(mesh.node_id(v)) + " at (" +
+             Utilities::to_string(Utilities::scaled(mesh.vertices()[v], 1000),
+                                  4) +
+             ") mm";
+    }
+
+    /** A change made through the view: printed on the log as it is made
+     * and kept for the summary. */
+    void
+    record(const std::string &what)
+    {
+      std::lock_guard<std::mutex> lock(record_mutex);
+      changes.push_back(
+        {std::chrono::duration<double>(Clock::now() - started).count(), what});
+      if (log != nullptr)
+        *log << "live view: " << what << std::endl;
+    }
+
+    /**
+     * Why @p request must be refused, with its kind (LiveServer::refused()),
+     * or "" if it may go on. Every request must name this server by an
+     * address it listens on (DNS rebinding: a page of another site whose
+     * name was made to point to this machine names that site). A POST
+     * changes the model: it must come from the page this run served, which
+     * is what its token proves; no Origin but this server's (browsers send
+     * one with every POST; "null" from sandboxed frames and files), and
+     * none of the content types a form or a script of another site may
+     * send without asking first (a CORS preflight, which is refused here:
+     * so a script of another site cannot send the token's header either).
+     */
+    std::string
+    refusal(const httplib::Request &request, std::string &kind) const
+    {
+      const std::string host      = request.get_header_value("Host");
+      const auto        authority = parse_authority(host);
+      if (request.headers.count("Host") != 1 || !authority ||
+          authority->port != bound || hosts.count(authority->host) == 0)
+        {
+          kind = "Host";
+          return "this live view answers only requests addressed to it (" +
+                 address + "), not to '" + printable(host) +
+                 "' (a page of another site whose name was made to point "
+                 "here, DNS rebinding, gets nothing)";
+        }
+      if (request.method == "OPTIONS")
+        {
+          kind = "preflight";
+          return "the live view allows no requests from other sites (a CORS "
+                 "preflight is never answered yes)";
+        }
+      if (request.method != "POST")
+        return "";
+      if (request.has_header("Origin"))
+        {
+          const std::string origin = request.get_header_value("Origin");
+          const auto        from   = origin.rfind("http://", 0) == 0 ?
+                                       parse_authority(origin.substr(7)) :
+                                       std::nullopt;
+          if (request.headers.count("Origin") != 1 || !from ||
+              !(*from == *authority))
+            {
+              kind = "Origin";
+              return "a change sent by a page of another site (Origin: " +
+                     printable(origin) +
+                     "); the live view takes changes from its own page only";
+            }
+        }
+      const std::string site = request.get_header_value("Sec-Fetch-Site");
+      if (!site.empty() && site != "same-origin")
+        {
+          kind = "Origin";
+          return "a change sent by a page of another site (Sec-Fetch-Site: " +
+                 printable(site) +
+                 "); the live view takes changes from its own page only";
+        }
+      const std::string type = request.get_header_value("Content-Type");
+      if (media_type(type) != LiveServer::command_type)
+        {
+          kind = "content type";
+          return "a change must be sent as Content-Type: " +
+                 std::string(LiveServer::command_type) + ", not '" +
+                 printable(type) +
+                 "' (the types a form or a script of another site can send "
+                 "are refused)";
+        }
+      if (request.headers.count(LiveServer::token_header) != 1 ||
+          !same_secret(request.get_header_value(LiveServer::token_header),
+                       token))
+        {
+          kind = "token";
+          return std::string(request.has_header(LiveServer::token_header) ?
+                               "a wrong " :
+                               "no ") +
+                 LiveServer::token_header +
+                 ": changes need the token of the page this run served (a "
+                 "page from an earlier run: reload it, " +
+                 address + ")";
+        }
+      return "";
+    }
+
+    /** Count a refused request; print the first of each kind. */
+    void
+    refuse(const httplib::Request &request,
+           const std::string      &kind,
+           const std::string      &reason)
+    {
+      std::lock_guard<std::mutex> lock(record_mutex);
+      if (++refusals[kind] == 1 && log != nullptr)
+        *log << "live view: refused " << printable(request.method, 10) << " "
+             << printable(request.path) << ": " << reason
+             << " [more of this kind are counted in the summary, not printed]"
+             << std::endl;
+    }
+
     /** The material model and its constants as they are now (the m key's
      * prompt). */
     std::string
@@ -459,12 +974,19 @@ namespace palpate
       return m.str();
     }
 
+    /** Change the scene's parameters on the fly: detach, change (the
+     * cache is invalidated and the states are computed again), attach.
+     * If it was made, the line describe() returns is recorded (printed
+     * and kept for the summary) in the order the changes were made.
+     * Returns "" or the reason the change was refused. */
     std::string
     change(const std::function<void(Parameters::AllParameters &)> &edit,
-           const bool                                              rest = false)
+           const bool                                              rest,
+           const std::function<std::string()>                     &describe)
     {
-      // One change, attach or detach at a time (the HTTP pool has 8
-      // threads); the device runs on while detaching (the force fades).
+      // One change, attach or detach at a time (connections are served
+      // in parallel); the device runs on while detaching (the force
+      // fades).
       std::lock_guard<std::mutex> control(control_mutex);
       Parameters::AllParameters   p = interaction.scene().parameters;
       edit(p);
@@ -494,12 +1016,13 @@ namespace palpate
           refused = e.what();
         }
       interaction.attach();
+      if (refused.empty())
+        record(describe());
       return refused;
     }
 
     httplib::Server server;
     std::thread     http, device;
-    int             bound = 0;
   };
 
 
@@ -507,13 +1030,40 @@ namespace palpate
   LiveServer::LiveServer(const Scene       &scene,
                          const std::string &host,
                          const int          port,
-                         const double       max_speed)
-    : impl(std::make_unique<Impl>(scene, max_speed))
+                         const double       max_speed,
+                         std::ostream      *log)
+    : impl(std::make_unique<Impl>(scene, max_speed, log))
   {
     Impl &s      = *impl;
     auto &server = s.server;
-    server.Get("/", [](const httplib::Request &, httplib::Response &res) {
-      res.set_content(live_view_page, "text/html");
+    // Before any handler, and before a POST's body is read: who may ask
+    // (Impl::refusal()). A refused client's connection is closed (the body
+    // it sent, unread, is not taken for another request).
+    server.set_pre_routing_handler(
+      [&s](const httplib::Request &req, httplib::Response &res) {
+        std::string       kind;
+        const std::string reason = s.refusal(req, kind);
+        if (reason.empty())
+          return httplib::Server::HandlerResponse::Unhandled;
+        s.refuse(req, kind, reason);
+        res.status = 403;
+        res.set_header("Connection", "close");
+        res.set_content("refused: " + reason + "\n", "text/plain");
+        return httplib::Server::HandlerResponse::Handled;
+      });
+    // On every answer: never read by a page of another site as a script or
+    // an image (no-cors), nor guessed as another type than it says.
+    server.set_default_headers({{"Cross-Origin-Resource-Policy", "same-origin"},
+                                {"X-Content-Type-Options", "nosniff"}});
+    server.Get("/", [&s](const httplib::Request &, httplib::Response &res) {
+      // The page holds the run's token: not kept by the browser's cache
+      // (a page from an earlier run would send a stale one), and never
+      // shown in a frame of another site's page (a click there would be a
+      // click on the view: clickjacking).
+      res.set_header("Cache-Control", "no-store");
+      res.set_header("X-Frame-Options", "DENY");
+      res.set_header("Content-Security-Policy", "frame-ancestors 'none'");
+      res.set_content(s.page, "text/html");
     });
     server.Get("/favicon.ico",
                [](const httplib::Request &, httplib::Response &res) {
@@ -588,12 +1138,36 @@ namespace palpate
           }
         const std::string entry = Utilities::trim(req.body.substr(0, eq));
         const std::string value = Utilities::trim(req.body.substr(eq + 1));
-        std::string       refused;
+        std::string       refused, before;
         try
           {
-            refused = s.change([&](Parameters::AllParameters &p) {
-              p.material_model.set(p.material_model.model_name, entry, value);
-            });
+            refused = s.change(
+              [&](Parameters::AllParameters &p) {
+                auto &material = p.material_model;
+                try
+                  {
+                    before = material.get(material.model_name, entry);
+                  }
+                catch (const std::exception &)
+                  {
+                    // An entry the model does not have: set() says so.
+                  }
+                material.set(material.model_name, entry, value);
+              },
+              false,
+              [&] {
+                // "Young's modulus 15465 -> 20000 Pa": the value in force
+                // now, as the model read it; pascals for its moduli.
+                const auto &material =
+                  s.interaction.scene().parameters.material_model;
+                std::string unit;
+                for (const auto &modulus : Material::create(material)->moduli())
+                  if (modulus.first == entry)
+                    unit = " Pa";
+                return entry + " " + number_text(before) + " -> " +
+                       number_text(material.get(material.model_name, entry)) +
+                       unit;
+              });
           }
         catch (const std::exception &e)
           {
@@ -610,6 +1184,13 @@ namespace palpate
     server.Post(
       "/active", [&s](const httplib::Request &req, httplib::Response &res) {
         std::string refused;
+        // "active node: node 87 at (...) mm -> node 45 at (...) mm": the
+        // active node before (read by the edit, under change()'s lock)
+        // and after.
+        std::string before;
+        const auto  describe = [&] {
+          return "active node: " + before + " -> " + s.active_description();
+        };
         try
           {
             const std::string body = Utilities::trim(req.body);
@@ -633,10 +1214,12 @@ namespace palpate
                                               "' is not a node number");
                 refused = s.change(
                   [&](Parameters::AllParameters &p) {
+                    before = s.active_description();
                     p.boundary_conditions.active_node.selection = "node id";
                     p.boundary_conditions.active_node.node_id   = id;
                   },
-                  true);
+                  true,
+                  describe);
               }
             else
               {
@@ -656,11 +1239,13 @@ namespace palpate
                       Utilities::to_string(high, 6) + ") m)");
                 refused = s.change(
                   [&](Parameters::AllParameters &p) {
+                    before = s.active_description();
                     p.boundary_conditions.active_node.selection =
                       "nearest surface node";
                     p.boundary_conditions.active_node.point = point;
                   },
-                  true);
+                  true,
+                  describe);
               }
           }
         catch (const std::invalid_argument &e)
@@ -691,30 +1276,53 @@ namespace palpate
         res.status = 400;
         res.set_content("refused: " + refused, "text/plain");
       });
+    // Attach and detach are recorded when they change something (a
+    // second d changes nothing).
     server.Post("/attach",
                 [&s](const httplib::Request &, httplib::Response &res) {
                   std::lock_guard<std::mutex> lock(s.control_mutex);
-                  s.interaction.attach();
+                  if (!s.interaction.attached())
+                    {
+                      s.interaction.attach();
+                      s.record("attached");
+                    }
                   res.set_content("ok", "text/plain");
                 });
     server.Post("/detach",
                 [&s](const httplib::Request &, httplib::Response &res) {
                   std::lock_guard<std::mutex> lock(s.control_mutex);
-                  s.interaction.detach();
+                  if (s.interaction.attached())
+                    {
+                      s.interaction.detach();
+                      s.record("detached (the force fades to zero)");
+                    }
                   res.set_content("ok", "text/plain");
                 });
     server.Post("/reset",
                 [&s](const httplib::Request &, httplib::Response &res) {
                   for (auto &t : s.target)
                     t.store(0);
+                  s.record("the probe sent back to rest");
                   res.set_content("ok", "text/plain");
                 });
     server.set_payload_max_length(4096);
-    // A browser keeps connections open: with cpp-httplib's default pool
-    // (one thread per core less one: one here) a kept-alive connection
-    // would hold back every other request for its 5 s timeout.
-    server.new_task_queue = [] { return new httplib::ThreadPool(8); };
+    // Slow or idle clients cannot keep the page waiting. Each connection
+    // has a thread of its own (ConnectionThreads: a browser keeps several
+    // open, and with a fixed pool nine clients that sent a header line
+    // every 3 s held every thread); one that sends nothing for 1 s
+    // before a request, or pauses 2 s within one (the page's requests
+    // come whole; cpp-httplib's default would wait 5 s), or does not take
+    // an answer for 5 s, is closed. A kept-alive connection serves up to
+    // 100 requests (the page asks 30 times a second; the default, 5, made
+    // it connect again six times a second).
+    server.new_task_queue = [] { return new ConnectionThreads(8, 256); };
     server.set_keep_alive_timeout(1);
+    server.set_keep_alive_max_count(100);
+    server.set_read_timeout(2, 0);
+    server.set_write_timeout(5, 0);
+    // Without connections, the threads that ended are joined once a
+    // second (ConnectionThreads::on_idle()).
+    server.set_idle_interval(1, 0);
     // The reply's header and body go in two writes: with Nagle's algorithm
     // the second waits for the browser's delayed ACK of the first, 40 ms,
     // and the page's frames came at 20 Hz instead of 30 (measured in
@@ -724,12 +1332,20 @@ namespace palpate
     // palpate serve on the same port binds too and the kernel shares the
     // connections between the two: only SO_REUSEADDR (a restart can bind
     // at once), so a port in use is an error that says so.
-    server.set_socket_options([](const socket_t sock) {
+    server.set_socket_options([&s](const socket_t sock) {
       const int yes = 1;
       setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+      s.listening = sock;
     });
     s.bound = port == 0 ? server.bind_to_any_port(host) :
                           (server.bind_to_port(host, port) ? port : -1);
+    // cpp-httplib listens with a backlog of 5 connections: the kernel drops
+    // the next ones that arrive before they are accepted, and their
+    // clients try again after 1 s (then 3 s, 7 s). A burst of connections
+    // (a page's first requests, or clients that mean harm) made the others
+    // wait. Listening again on the same socket sets a longer queue.
+    if (s.bound > 0 && s.listening >= 0)
+      ::listen(s.listening, SOMAXCONN);
     if (s.bound <= 0)
       throw InputError("command line",
                        0,
@@ -737,6 +1353,25 @@ namespace palpate
                        "cannot listen on " + host + ":" + std::to_string(port) +
                          " (in use, or not allowed)",
                        "choose another port, e.g. --port 8081.");
+    // The names a request may address it by (Impl::refusal()): the host
+    // it was given; on the loopback interface, or on every interface,
+    // also the loopback's names; on every interface, this machine's name
+    // and addresses (as they are now).
+    s.hosts.insert(as_url_host(host));
+    if (loopback(host) || every_interface(host))
+      s.hosts.insert({"127.0.0.1", "localhost", "[::1]"});
+    if (every_interface(host))
+      for (const auto &name : machine_names())
+        s.hosts.insert(name);
+    std::string here = as_url_host(host);
+    if (every_interface(host))
+      {
+        char name[256] = {};
+        here = gethostname(name, sizeof name - 1) == 0 && name[0] != 0 ?
+                 lower_case(name) :
+                 "127.0.0.1";
+      }
+    s.address = "http://" + here + ":" + std::to_string(s.bound) + "/";
     s.interaction.attach();
     s.device = std::thread([&s] { s.run_device(); });
     s.http   = std::thread([&s] { s.server.listen_after_bind(); });
@@ -775,6 +1410,106 @@ namespace palpate
 
 
 
+  const std::string &
+  LiveServer::token() const
+  {
+    return impl->token;
+  }
+
+
+
+  const std::string &
+  LiveServer::address() const
+  {
+    return impl->address;
+  }
+
+
+
+  std::vector<std::string>
+  LiveServer::accepted_hosts() const
+  {
+    return {impl->hosts.begin(), impl->hosts.end()};
+  }
+
+
+
+  std::vector<LiveServer::Change>
+  LiveServer::changes() const
+  {
+    std::lock_guard<std::mutex> lock(impl->record_mutex);
+    return impl->changes;
+  }
+
+
+
+  std::map<std::string, unsigned int>
+  LiveServer::refused() const
+  {
+    std::lock_guard<std::mutex> lock(impl->record_mutex);
+    return impl->refusals;
+  }
+
+
+
+  void
+  LiveServer::print_summary(std::ostream &out) const
+  {
+    Impl &s = *impl;
+    // The material and the active node now, under the lock changes take.
+    std::string material, active;
+    {
+      std::lock_guard<std::mutex> lock(s.control_mutex);
+      material = s.material_description();
+      active   = s.active_description();
+    }
+    const auto         made    = changes();
+    const auto         refusal = refused();
+    std::ostringstream o;
+    o << "Live view\n"
+      << "  material:          " << material
+      << (material == s.scene_material ?
+            " (the scene's)" :
+            " (the scene's: " + s.scene_material + ")")
+      << "\n"
+      << "  active node:       " << active
+      << (active == s.scene_active ? " (the scene's)" :
+                                     " (the scene's: " + s.scene_active + ")")
+      << "\n"
+      << "  changes:           ";
+    if (made.empty())
+      o << "none made through the view\n";
+    else
+      {
+        o << made.size() << " made through the view, in order:\n";
+        // A long session's list is cut: every change was printed as it
+        // was made.
+        const std::size_t shown = 50;
+        for (std::size_t i = 0; i < made.size(); ++i)
+          if (i < shown || i == made.size() - 1)
+            o << "    " << std::fixed << std::setprecision(1) << made[i].time
+              << " s: " << made[i].what << "\n";
+          else if (i == shown)
+            o << "    ... " << made.size() - shown - 1
+              << " more (printed above as they were made)\n";
+      }
+    unsigned int total = 0;
+    for (const auto &[kind, count] : refusal)
+      total += count;
+    o << "  refused:           " << total << " requests";
+    if (total > 0)
+      {
+        o << " (403; by what was wrong:";
+        for (const auto &[kind, count] : refusal)
+          o << " " << kind << " " << count
+            << (&kind == &refusal.rbegin()->first ? ")" : ",");
+      }
+    o << "\n";
+    out << o.str();
+  }
+
+
+
   const Interaction &
   LiveServer::interaction() const
   {
@@ -795,38 +1530,26 @@ namespace palpate
 
 
 
-  namespace
-  {
-    std::atomic<bool> stop_serving{false};
-
-    extern "C" void
-    on_stop(int)
-    {
-      stop_serving.store(true);
-    }
-  } // namespace
-
-
-
   int
   run_serve(std::ostream      &out,
             const Scene       &scene,
             const std::string &host,
             const int          port)
   {
-    LiveServer server(scene, host, port);
-    // Listening on every interface: the address to open is this machine's.
-    std::string where = host;
-    if (host == "0.0.0.0" || host == "::")
+    LiveServer server(scene, host, port, 0.05, &out);
+    // Listening on every interface: the address to open is this machine's
+    // (LiveServer::address()); the others it answers to are listed, since
+    // a request that names it otherwise is refused.
+    out << "Live view: open " << server.address();
+    if (every_interface(host))
       {
-        char name[256] = {};
-        where = gethostname(name, sizeof name - 1) == 0 && name[0] != 0 ?
-                  std::string(name) :
-                  "THIS-MACHINE";
+        out << " (listening on every interface; it answers requests "
+               "addressed to";
+        for (const auto &name : server.accepted_hosts())
+          out << " " << name;
+        out << ", port " << server.port() << ")";
       }
-    out << "Live view: open http://" << where << ":" << server.port() << "/"
-        << (where != host ? " (listening on every interface)" : "")
-        << " in a browser. A drag on the organ moves the probe in the view "
+    out << " in a browser. A drag on the organ moves the probe in the view "
            "plane (with Alt held, in depth); a drag elsewhere or with the "
            "right button turns the view, the middle button (or Shift and "
            "the right) pans it, the wheel zooms; keys: f look at the probe, "
@@ -834,18 +1557,54 @@ namespace palpate
            "material constant, shift-click another active node. Ctrl-C "
            "ends.\n"
         << std::flush;
-    stop_serving.store(false);
-    auto *const previous_int  = std::signal(SIGINT, on_stop);
-    auto *const previous_term = std::signal(SIGTERM, on_stop);
-    while (!stop_serving.load())
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    std::signal(SIGINT, previous_int);
-    std::signal(SIGTERM, previous_term);
+    // The view runs until a stop signal (Ctrl-C, SIGTERM, SIGHUP: its
+    // normal end, status 0) or until nobody can read what it prints.
+    {
+      const StopRequest stop;
+      while (!stop.requested() && out)
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
     server.stop();
     out << "Live view ended.\n";
     RunSummary summary = server.interaction().summary();
     summary.trajectory = "the browser's mouse (palpate serve)";
     summary.print(out);
+    server.print_summary(out);
+
+    // The machine-readable summaries, as after an interaction.
+    const auto       &p = scene.parameters;
+    const std::string stem =
+      scene.file().empty() ?
+        "default" :
+        std::filesystem::path(scene.file()).stem().string();
+    std::vector<std::string> failures;
+    for (const auto &format : p.output.summary_formats)
+      {
+        const std::string file =
+          p.output.directory + "/" + stem + "-serve-summary." + format;
+        try
+          {
+            std::filesystem::create_directories(p.output.directory);
+            if (format == "csv")
+              summary.write_csv(file);
+            else
+              summary.write_json(file);
+            out << "  wrote " << file << "\n";
+          }
+        catch (const std::exception &e)
+          {
+            failures.push_back(file + ": " + e.what());
+          }
+      }
+    if (!failures.empty())
+      {
+        std::string what;
+        for (const auto &f : failures)
+          what += "\n  " + f;
+        throw OutputError("the live view ended (its summary is above), but " +
+                          std::to_string(failures.size()) +
+                          " summary file(s) could not be written:" + what);
+      }
     return ExitStatus::success;
   }
 } // namespace palpate

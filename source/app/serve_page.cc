@@ -13,6 +13,9 @@ namespace palpate
 <html>
 <head>
 <meta charset="utf-8">
+<!-- The run's secret, written in by the server: the page sends it back
+     with every change (below, post()). -->
+<meta name="palpate-token" content="{{palpate-token}}">
 <title>palpate live view</title>
 <style>
   body { margin: 0; overflow: hidden; font: 13px sans-serif; background: #20242b; }
@@ -93,14 +96,24 @@ const cloudColors = [[0.55, 0.55, 0.55], [0.25, 0.9, 0.35], [1.0, 0.2, 0.2], [1.
   return [linear.r, linear.g, linear.b];
 });
 
-// A request to the server: its answer as text, or (logged) why there is
-// none; never an unhandled rejection.
+// A change sent to the server: its answer as text, or (logged) why there
+// is none; never an unhandled rejection. Every change carries the run's
+// token (which only this page holds: a page of another site cannot read
+// it) in a header of its own, with the live view's own content type: the
+// server refuses anything else (a page served by an earlier run, whose
+// token is stale, is told to reload).
+const token = document.querySelector('meta[name="palpate-token"]').content;
 function post(path, body) {
-  return fetch(path, { method: "POST", body: body || "" }).then(r => r.text()).catch(e => {
-    const text = path + ": the server does not answer (" + e.message + ")";
-    logEvent(text);
-    return text;
-  });
+  return fetch(path, { method: "POST", body: body || "",
+                       headers: { "Content-Type": "application/x-palpate", "X-Palpate-Token": token } })
+    .then(r => r.text().then(text => {
+      if (r.status === 403) logEvent(path + ": " + text);
+      return text;
+    })).catch(e => {
+      const text = path + ": the server does not answer (" + e.message + ")";
+      logEvent(text);
+      return text;
+    });
 }
 
 // The surface, then the frames; a server not up yet is asked again.

@@ -159,6 +159,11 @@ main(int argc, char **argv)
   const palpate::Scene scene = small_beam_scene();
   palpate::LiveServer  server(scene, "127.0.0.1", 0, 0.05);
   httplib::Client      client("127.0.0.1", server.port());
+  // Every change carries the run's token with the live view's content
+  // type, as the page sends them (app/serve_security: what happens to
+  // requests without them).
+  client.set_default_headers(
+    {{palpate::LiveServer::token_header, server.token()}});
   client.set_read_timeout(10, 0);
 
   const auto  page   = client.Get("/");
@@ -245,7 +250,7 @@ main(int argc, char **argv)
   const auto sent_at = std::chrono::steady_clock::now();
   const auto sent    = client.Post("/hip",
                                 palpate::Utilities::to_string(target, 17),
-                                "text/plain");
+                                palpate::LiveServer::command_type);
   // The motion, sampled: smooth (from rest, at most 1 m/s^2: within t of
   // sending, at most a t^2 / 2, with 2 ms for the request and 20 um to
   // spare; without the smoothing 5 cm/s at once) and at most 5 cm/s. Each
@@ -288,12 +293,16 @@ main(int argc, char **argv)
           << std::endl;
 
   // Garbage, a flood, a silent client.
-  const auto   garbage  = client.Post("/hip", "not a point", "text/plain");
-  const auto   nan      = client.Post("/hip", "nan,0,0", "text/plain");
-  const auto   far      = client.Post("/hip", "5,0,0", "text/plain");
+  const auto garbage =
+    client.Post("/hip", "not a point", palpate::LiveServer::command_type);
+  const auto nan =
+    client.Post("/hip", "nan,0,0", palpate::LiveServer::command_type);
+  const auto far =
+    client.Post("/hip", "5,0,0", palpate::LiveServer::command_type);
   unsigned int accepted = 0;
   for (unsigned int k = 0; k < 300; ++k)
-    if (const auto r = client.Post("/hip", "0,0,-0.001", "text/plain");
+    if (const auto r =
+          client.Post("/hip", "0,0,-0.001", palpate::LiveServer::command_type);
         r && r->status == 200)
       ++accepted;
   {
@@ -310,14 +319,19 @@ main(int argc, char **argv)
           << std::endl;
 
   // On the fly: Young's modulus doubled. Back to the same target.
-  const double before = palpate::Utilities::norm(state->force);
-  const auto   changed =
-    client.Post("/material", "Young's modulus=2e5", "text/plain");
-  const auto refused =
-    client.Post("/material", "Young's modulus=-1", "text/plain");
-  const auto unknown =
-    client.Post("/material", "Youngs modulus=3", "text/plain");
-  client.Post("/hip", palpate::Utilities::to_string(target, 17), "text/plain");
+  const double before  = palpate::Utilities::norm(state->force);
+  const auto   changed = client.Post("/material",
+                                   "Young's modulus=2e5",
+                                   palpate::LiveServer::command_type);
+  const auto   refused = client.Post("/material",
+                                   "Young's modulus=-1",
+                                   palpate::LiveServer::command_type);
+  const auto   unknown = client.Post("/material",
+                                   "Youngs modulus=3",
+                                   palpate::LiveServer::command_type);
+  client.Post("/hip",
+              palpate::Utilities::to_string(target, 17),
+              palpate::LiveServer::command_type);
   std::shared_ptr<const palpate::State> again;
   for (unsigned int k = 0; k < 1200 && !again; ++k)
     {
@@ -338,9 +352,11 @@ main(int argc, char **argv)
                 unknown->body.find("its entries are: Poisson's ratio, "
                                    "Young's modulus") != std::string::npos)
           << std::endl;
-  const auto picked = client.Post("/active", "0.1,0.01,0.01", "text/plain");
-  const auto last   = client.Get("/frame");
-  const auto off    = client.Post("/active", "1e200,0,0", "text/plain");
+  const auto picked =
+    client.Post("/active", "0.1,0.01,0.01", palpate::LiveServer::command_type);
+  const auto last = client.Get("/frame");
+  const auto off =
+    client.Post("/active", "1e200,0,0", palpate::LiveServer::command_type);
   deallog << "another active node picked: "
           << ok(picked && picked->status == 200 && last &&
                 integer(last->body, "active") ==
@@ -350,22 +366,27 @@ main(int argc, char **argv)
                 off->body.find("is not on the organ") != std::string::npos)
           << std::endl;
   const auto [other, inside] = other_nodes(body, reported);
-  const auto by_number =
-    client.Post("/active", "node " + std::to_string(other), "text/plain");
+  const auto by_number       = client.Post("/active",
+                                     "node " + std::to_string(other),
+                                     palpate::LiveServer::command_type);
   deallog
     << "\"node N\" picks node N: "
     << ok(picked_node(by_number, client, body, other) &&
           reported_active_node(server.interaction()) == other)
     << ", a node inside refused: "
-    << ok(
-         inside >= 0 &&
-         client.Post("/active", "node " + std::to_string(inside), "text/plain")
-             ->body.find("is inside the body") != std::string::npos)
+    << ok(inside >= 0 &&
+          client
+              .Post("/active",
+                    "node " + std::to_string(inside),
+                    palpate::LiveServer::command_type)
+              ->body.find("is inside the body") != std::string::npos)
     << ", a number the mesh does not have refused: "
-    << ok(client.Post("/active", "node 100000", "text/plain")
+    << ok(client
+            .Post("/active", "node 100000", palpate::LiveServer::command_type)
             ->body.find("the mesh has no node 100000") != std::string::npos)
     << ", \"node 3x\" refused: "
-    << ok(client.Post("/active", "node 3x", "text/plain")->status == 400)
+    << ok(client.Post("/active", "node 3x", palpate::LiveServer::command_type)
+            ->status == 400)
     << std::endl;
 
   // Several clients at once, as a page's keys and clicks can come: d, a,
@@ -376,6 +397,8 @@ main(int argc, char **argv)
     for (unsigned int c = 0; c < 4; ++c)
       clients.emplace_back([&, c] {
         httplib::Client each("127.0.0.1", server.port());
+        each.set_default_headers(
+          {{palpate::LiveServer::token_header, server.token()}});
         each.set_read_timeout(60, 0);
         for (unsigned int round = 0; round < 3; ++round)
           {
@@ -387,7 +410,8 @@ main(int argc, char **argv)
               c == 2 ? (round % 2 == 0 ? "0.1,0.01,0.01" : "0.09,0,0.01") :
               c == 3 ? "Young's modulus=" + std::to_string(1 + round) + "e5" :
                        "";
-            const auto r = each.Post(paths[c], body, "text/plain");
+            const auto r =
+              each.Post(paths[c], body, palpate::LiveServer::command_type);
             answered += r ? 1 : 0;
             if (r && c >= 2 && r->status == 200)
               ++changes_made;
@@ -396,7 +420,7 @@ main(int argc, char **argv)
     for (auto &t : clients)
       t.join();
   }
-  client.Post("/attach", "", "text/plain");
+  client.Post("/attach", "", palpate::LiveServer::command_type);
   const auto still = client.Get("/frame");
   deallog << "requests from 4 clients at once answered: "
           << ok(answered.load() == 12)
@@ -466,6 +490,8 @@ main(int argc, char **argv)
         expected = tag(i);
     palpate::LiveServer numbered(from_file, "127.0.0.1", 0, 0.05);
     httplib::Client     to_numbered("127.0.0.1", numbered.port());
+    to_numbered.set_default_headers(
+      {{palpate::LiveServer::token_header, numbered.token()}});
     to_numbered.set_read_timeout(60, 0);
     const auto &m     = numbered.interaction().mesh();
     const long  named = reported_active_node(numbered.interaction());
@@ -483,7 +509,7 @@ main(int argc, char **argv)
     const auto other_node  = other_nodes(m, named).first;
     const auto pick        = to_numbered.Post("/active",
                                        "node " + std::to_string(other_node),
-                                       "text/plain");
+                                       palpate::LiveServer::command_type);
     deallog << "a Gmsh file's numbers: the scene report names its active "
                "node "
             << ok(named == expected) << " (node " << expected
@@ -511,6 +537,8 @@ main(int argc, char **argv)
   touch_beam_with_sphere(sphere, 0.01);
   palpate::LiveServer indenter(sphere, "127.0.0.1", 0, 0.05);
   httplib::Client     to_indenter("127.0.0.1", indenter.port());
+  to_indenter.set_default_headers(
+    {{palpate::LiveServer::token_header, indenter.token()}});
   to_indenter.set_read_timeout(10, 0);
   const auto  drawn  = numbers(to_indenter.Get("/mesh")->body, "sphere");
   const auto &centre = indenter.interaction().nodes().sphere_center;
@@ -528,7 +556,7 @@ main(int argc, char **argv)
   const auto  into        = sphere_grid.position(pressed);
   to_indenter.Post("/hip",
                    palpate::Utilities::to_string(into, 17),
-                   "text/plain");
+                   palpate::LiveServer::command_type);
   for (unsigned int k = 0; k < 300; ++k)
     {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -563,7 +591,7 @@ main(int argc, char **argv)
     }
   const auto moved    = to_indenter.Post("/active",
                                       "node " + std::to_string(top_node),
-                                      "text/plain");
+                                      palpate::LiveServer::command_type);
   const auto moved_to = numbers(to_indenter.Get("/frame")->body, "sphere");
   deallog << "another active node moves the sphere, and the frames say where: "
           << ok(moved && moved->status == 200 && moved_to.size() == 4 &&

@@ -41,6 +41,8 @@ main(int argc, char **argv)
 
   palpate::LiveServer server(scene, "127.0.0.1", 0, 0.05);
   httplib::Client     client("127.0.0.1", server.port());
+  client.set_default_headers(
+    {{palpate::LiveServer::token_header, server.token()}});
   client.set_read_timeout(10, 0);
   const auto start = std::chrono::steady_clock::now();
   while (!server.interaction().initial_cloud_complete() &&
@@ -50,7 +52,9 @@ main(int argc, char **argv)
   const auto &grid   = server.interaction().grid();
   const auto  point  = grid.linear({{0, -1, 0}});
   const auto  target = grid.position(point);
-  client.Post("/hip", palpate::Utilities::to_string(target, 17), "text/plain");
+  client.Post("/hip",
+              palpate::Utilities::to_string(target, 17),
+              palpate::LiveServer::command_type);
   palpate::Utilities::Point3 hip, force;
   std::string                frame;
   for (unsigned int k = 0; k < 500; ++k)
@@ -83,9 +87,10 @@ main(int argc, char **argv)
           << ok(frame.find("\"load\":{\"workers\":2,") != std::string::npos)
           << std::endl;
 
-  const auto refused =
-    client.Post("/material", "Young's modulus=2e5", "text/plain");
-  const auto after = client.Get("/frame");
+  const auto refused = client.Post("/material",
+                                   "Young's modulus=2e5",
+                                   palpate::LiveServer::command_type);
+  const auto after   = client.Get("/frame");
   deallog << "a material change refused with the reason: "
           << ok(refused && refused->status == 400 &&
                 refused->body.find("Engine / Type = mpi") != std::string::npos)

@@ -12,12 +12,17 @@
 // the probe, the keys m (a material constant, through the page's prompt),
 // d and a (detach, attach), Alt and the depth button (the probe in
 // depth), shift-click (another active node), v (the first view), then a
-// reload (a client that leaves and comes back). What the page shows is printed, one
+// reload (a client that leaves and comes back). Then a page of another site
+// (served by a second HTTP server here, as http://evil.test:PORT2, a name
+// the browser is told is this machine) tries to change the model and to
+// read it, and the same name on the live view's port (DNS rebinding) tries
+// again. What the page shows is printed, one
 // "KEY value..." line each, for the C++ side to check against the API; the
 // page's own numbers come from window.palpate (the state the page draws).
 // A screenshot is kept. Nothing here decides pass or fail except a timeout
 // or a page error, which end the script with status 1.
 "use strict";
+const http = require("http");
 const puppeteer = require("puppeteer-core");
 
 const [chromium, port, screenshot] = process.argv.slice(2);
@@ -30,7 +35,10 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
     executablePath: chromium,
     headless: "new",
     args: ["--no-sandbox", "--use-gl=swiftshader", "--enable-unsafe-swiftshader",
-           "--ignore-gpu-blocklist"]
+           "--ignore-gpu-blocklist",
+           // Another site on this machine: evil.test is 127.0.0.1 to this
+           // browser (as a rebinding attacker's name would be).
+           "--host-resolver-rules=MAP evil.test 127.0.0.1"]
   });
   const page = await browser.newPage();
   await page.setViewport({ width: 960, height: 640 });
@@ -336,6 +344,68 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
     return n / (d.length / 4);
   });
   out("DRAWN", drawn);
+
+  // A page of another site, in another tab: its scripts and its form try
+  // to change the model (Young's modulus to 1e13, another active node,
+  // detach), to read a frame, and to show the view in a frame of its own
+  // (where a click would be a click on the view). Each outcome as the
+  // page of the other site sees it: "blocked" (the browser did not send
+  // it, or did not give the page the answer: CORS, and for no-cors
+  // requests the live view's Cross-Origin-Resource-Policy), "opaque"
+  // (sent, the answer hidden), or the status.
+  const live = `http://127.0.0.1:${port}`;
+  const other = http.createServer((req, res) => {
+    res.writeHead(200, { "Content-Type": "text/html" });
+    res.end(`<!doctype html><html><body>
+<form id="form" method="POST" action="${live}/material" enctype="text/plain">
+<input name="Young's modulus" value="1e13"></form>
+<iframe id="framed" src="${live}/"></iframe>
+</body></html>`);
+  });
+  await new Promise(r => other.listen(0, "127.0.0.1", r));
+  const material = await page.evaluate(() => fetch("/material").then(r => r.json()));
+  const evil = await browser.newPage();
+  await evil.goto(`http://evil.test:${other.address().port}/`);
+  await sleep(1000);  // the frame's answer
+  const attempts = await evil.evaluate(async live => {
+    const outcome = p => p.then(r => r.type === "opaque" ? "opaque" : "status_" + r.status, () => "blocked");
+    const post = (path, init) => outcome(fetch(live + path, Object.assign({ method: "POST" }, init)));
+    return [
+      // As a script may send it without asking first (no preflight).
+      await post("/material", { headers: { "Content-Type": "text/plain" }, body: "Young's modulus=1e13" }),
+      await post("/active", { mode: "no-cors", headers: { "Content-Type": "text/plain" }, body: "node 1" }),
+      // With the live view's headers (a guessed token): a preflight first.
+      await post("/detach", { headers: { "Content-Type": "application/x-palpate",
+                                          "X-Palpate-Token": "0".repeat(32) }, body: "" }),
+      // A read.
+      await outcome(fetch(live + "/frame"))
+    ];
+  }, live);
+  const frame = evil.frames().find(f => f !== evil.mainFrame());
+  const framed = frame ? await frame.evaluate(() => window.palpate ? "shown" : "not_shown").catch(() => "not_shown")
+                       : "no_frame";
+  out("OTHER_SITE", ...attempts, framed);
+  // Its form, sent: the browser goes to the live view's answer.
+  await Promise.all([evil.waitForNavigation({ timeout: 10000 }),
+                     evil.evaluate(() => document.getElementById("form").submit())]);
+  out("OTHER_SITE_FORM", await evil.evaluate(() => document.body.innerText.trim()));
+  // DNS rebinding: the other site's name, now this machine, on the live
+  // view's port; its page then asks its "own" server.
+  const rebound = await evil.goto(`http://evil.test:${port}/`);
+  const asked = await evil.evaluate(async () => {
+    const status = p => p.then(r => "status_" + r.status, () => "blocked");
+    return [
+      await status(fetch("/frame")),
+      await status(fetch("/material", { method: "POST", body: "Young's modulus=1e13",
+                                        headers: { "Content-Type": "application/x-palpate",
+                                                   "X-Palpate-Token": "0".repeat(32) } }))
+    ];
+  });
+  out("REBINDING", "status_" + rebound.status(), ...asked);
+  await evil.close();
+  other.close();
+  const materialAfter = await page.evaluate(() => fetch("/material").then(r => r.json()));
+  out("YOUNGS_MODULUS", material.constants["Young's modulus"], materialAfter.constants["Young's modulus"]);
   out("PAGE_ERRORS", errors.length, ...errors.map(e => JSON.stringify(e)));
   await browser.close();
   process.exit(errors.length ? 1 : 0);

@@ -37,6 +37,18 @@
 //   numbers it, of the vertex clicked, which the page names and the server
 //   then has; v brings back the first view;
 // - a reloaded page (a client that leaves and comes back) is served;
+// - a page of another site (a second HTTP server on another port, under
+//   the name evil.test, which the browser resolves to this machine) cannot
+//   change the model nor read it: its POST of text/plain (as a script may
+//   send it without asking) and its no-cors POST reach the server and are
+//   refused (counted by the server), the answers hidden from it (CORS;
+//   for no-cors, Cross-Origin-Resource-Policy); its POST with the
+//   live view's headers is never sent (the CORS preflight is refused); its
+//   read of /frame is blocked (no CORS header); the view does not show in
+//   its frame; its form's POST is answered with the refusal. Through DNS
+//   rebinding (evil.test on the live view's port) the page, /frame and a
+//   POST are refused (403). Young's modulus is still the page's 2e5, and
+//   the changes the server recorded are the page's four, in order;
 // - the view is drawn (more than 5 % of its pixels are not background) and
 //   a screenshot is kept: PALPATE_ARTEFACT_DIR/live-view.png.
 
@@ -52,6 +64,8 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "../tests.h"
 
@@ -346,6 +360,59 @@ main(int argc, char **argv)
           << ok(near(again, 0, 0, 1e-9) && near(again, 1, 0, 1e-9))
           << ", a reloaded page is served: "
           << ok(value("RECONNECTED") == "yes") << std::endl;
+
+  // The other site's attempts, as it saw them, and as the server counted
+  // them.
+  std::vector<std::string> attempts;
+  {
+    std::istringstream words(value("OTHER_SITE"));
+    std::string        word;
+    while (words >> word)
+      attempts.push_back(word);
+  }
+  const auto refused = server.refused();
+  const auto count   = [&](const std::string &kind) {
+    const auto it = refused.find(kind);
+    return it == refused.end() ? 0u : it->second;
+  };
+  deallog << "a page of another site: its POSTs refused (a script's and a "
+             "no-cors one, their answers hidden from it): "
+          << ok(attempts.size() == 5 && attempts[0] == "blocked" &&
+                attempts[1] == "blocked" && count("Origin") >= 3)
+          << ", its POST with the live view's headers never sent (the "
+             "preflight refused): "
+          << ok(attempts.size() == 5 && attempts[2] == "blocked" &&
+                count("preflight") >= 1)
+          << ", its read of /frame blocked: "
+          << ok(attempts.size() == 5 && attempts[3] == "blocked")
+          << ", the view not shown in its frame: "
+          << ok(attempts.size() == 5 && attempts[4] == "not_shown")
+          << std::endl;
+  deallog << "its form's POST answered with the refusal: "
+          << ok(value("OTHER_SITE_FORM")
+                  .rfind("refused: a change sent by a page of another site "
+                         "(Origin: http://evil.test:",
+                         0) == 0)
+          << "; by DNS rebinding the page, /frame and a change refused (403): "
+          << ok(value("REBINDING") == "status_403 status_403 status_403" &&
+                count("Host") >= 3)
+          << std::endl;
+  const auto  made     = server.changes();
+  const auto &material = server.interaction().scene().parameters.material_model;
+  deallog << "Young's modulus still the page's 2e5: "
+          << ok(value("YOUNGS_MODULUS") == "2e5 2e5" &&
+                material.get_double(material.model_name, "Young's modulus") ==
+                  2e5)
+          << ", the changes the server recorded are the page's four, in "
+             "order: "
+          << ok(made.size() == 4 &&
+                made[0].what == "Young's modulus 100000 -> 200000 Pa" &&
+                made[1].what == "detached (the force fades to zero)" &&
+                made[2].what == "attached" &&
+                made[3].what.rfind("active node: node " +
+                                     std::to_string(reported) + " at (",
+                                   0) == 0)
+          << std::endl;
 
   const auto drawn = numbers_in(value("DRAWN"));
   deallog << "the view is drawn: " << ok(!drawn.empty() && drawn[0] > 0.05)

@@ -6,9 +6,11 @@
 
 #include <palpate/base/utilities.h>
 
+#include <map>
 #include <memory>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace palpate
 {
@@ -42,21 +44,95 @@ namespace palpate
    * "x,y,z" (m: its nearest surface node), POST /attach, /detach, /reset.
    * Nodes are named everywhere as the mesh file numbers them
    * (Mesh::node_id()), as the scene report and Active node / Node id do.
+   *
+   * Only its user gets in (doc/serve.md). Every request must name the
+   * server by an address it listens on in its Host header (127.0.0.1:PORT,
+   * localhost:PORT, [::1]:PORT, the --host given, and listening on every
+   * interface this machine's name and addresses): a page of another site
+   * whose name was made to point here (DNS rebinding) is refused. Every
+   * POST must carry the run's secret token(), which only the page served
+   * in this run holds, in the header token_header, with the content type
+   * command_type, and no Origin but the server's own: a page of another
+   * site, or a form on it, can neither send the token (it cannot read the
+   * page) nor these headers (they need a CORS preflight, which is always
+   * refused). Refusals are 403 with the reason as plain text; the first of
+   * each kind is printed. Connections are read with timeouts, each on its
+   * own thread (up to 256 at once), so that slow or idle clients cannot
+   * keep the page waiting.
+   *
+   * Every change made through the view (a material constant, the active
+   * node, attach, detach, back to rest) is printed on the log as it is
+   * made, kept (changes()), and listed by print_summary() with the
+   * constants in force at the end.
    */
   class LiveServer
   {
   public:
+    /** The header every POST carries the run's token() in. */
+    static constexpr const char *token_header = "X-Palpate-Token";
+
+    /** The content type of every POST (its body is the plain-text command
+     * described above). None of the types a form or a script of another
+     * site may send without a CORS preflight (text/plain,
+     * application/x-www-form-urlencoded, multipart/form-data). */
+    static constexpr const char *command_type = "application/x-palpate";
+
+    /** One change made through the view. */
+    struct Change
+    {
+      /** When, in seconds since the server started. */
+      double time;
+      /** What, e.g. "Young's modulus 15465 -> 20000 Pa". */
+      std::string what;
+    };
+
     /** Set up the interaction and listen on @p host:@p port (0: any free
-     * port). Throws InputError if the port cannot be bound. */
+     * port). Each change made through the view is printed on @p log as it
+     * is made ("live view: ...", one line; none if null), and so is the
+     * first refused request of each kind. Throws InputError if the port
+     * cannot be bound. */
     LiveServer(const Scene       &scene,
                const std::string &host,
                const int          port,
-               const double       max_speed = 0.05);
+               const double       max_speed = 0.05,
+               std::ostream      *log       = nullptr);
     ~LiveServer();
 
     /** The port it listens on. */
     int
     port() const;
+
+    /** The run's secret: 32 hexadecimal digits (128 random bits from
+     * /dev/urandom), made anew by each server and written into the page
+     * it serves. Every POST must carry it in token_header. */
+    const std::string &
+    token() const;
+
+    /** The address to open in a browser, "http://127.0.0.1:8080/"
+     * (listening on every interface, with this machine's name). */
+    const std::string &
+    address() const;
+
+    /** The host names (lower case, IPv6 addresses in brackets) a request's
+     * Host header may give, with the port(). */
+    std::vector<std::string>
+    accepted_hosts() const;
+
+    /** The changes made through the view so far, in order. */
+    std::vector<Change>
+    changes() const;
+
+    /** The requests refused so far (403), by kind: "Host" (not an address
+     * it listens on), "Origin" (another site, or null), "preflight" (a
+     * CORS preflight), "content type", "token" (missing or wrong). */
+    std::map<std::string, unsigned int>
+    refused() const;
+
+    /** The live view's part of the run summary: the material and the
+     * active node in force now (and the scene's, if they differ), the
+     * changes made through the view, and the requests refused. */
+    void
+    print_summary(std::ostream &out) const;
 
     /** The interaction (for tests: its cache and grid). */
     const Interaction &
@@ -76,7 +152,9 @@ namespace palpate
   };
 
   /** `palpate serve SCENE.prm [--port P] [--host H]`: serve until
-   * interrupted (Ctrl-C). Returns an ExitStatus. */
+   * interrupted (Ctrl-C), printing each change made through the view on
+   * @p out, then the run summary with the live view's part
+   * (LiveServer::print_summary()). Returns an ExitStatus. */
   int
   run_serve(std::ostream      &out,
             const Scene       &scene,

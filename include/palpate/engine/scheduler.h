@@ -157,7 +157,8 @@ namespace palpate
               const double     cloud_radius,
               const double     look_ahead_time);
 
-    /*     * The most urgent tasks (at most @p max_tasks) for the HIP at @p hip
+    /**
+     * The most urgent tasks (at most @p max_tasks) for the HIP at @p hip
      * moving with @p velocity (m/s), given what is known about each point.
      * The bridge is built only if @p allow_bridge.
      */
