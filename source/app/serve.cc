@@ -19,6 +19,7 @@
 #include <arpa/inet.h>
 #include <httplib.h>
 #include <ifaddrs.h>
+#include <netdb.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -26,9 +27,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <functional>
@@ -45,6 +48,78 @@
 
 namespace palpate
 {
+  namespace
+  {
+    /**
+     * Why @p host : @p port cannot be listened on, blaming the right one:
+     * a name that does not resolve or an address this machine does not
+     * have is --host's fault, a port in use or reserved is --port's (the
+     * server library only says "no").
+     */
+    InputError
+    cannot_listen(const std::string &host, const int port)
+    {
+      const std::string where = host + ":" + std::to_string(port);
+      addrinfo          hints{};
+      hints.ai_family   = AF_UNSPEC;
+      hints.ai_socktype = SOCK_STREAM;
+      hints.ai_flags    = AI_PASSIVE;
+      addrinfo *found   = nullptr;
+      if (::getaddrinfo(
+            host.c_str(), std::to_string(port).c_str(), &hints, &found) != 0 ||
+          found == nullptr)
+        return InputError("command line",
+                          0,
+                          "--host " + host,
+                          "'" + host +
+                            "' is not an address or a name this machine can "
+                            "resolve",
+                          "give one of this machine's addresses: 127.0.0.1 "
+                          "(the default: this machine only), 0.0.0.0 (every "
+                          "interface), or an interface's address (ip addr).");
+      int error = 0;
+      for (addrinfo *a = found; a != nullptr && error == 0; a = a->ai_next)
+        {
+          const int fd = ::socket(a->ai_family, a->ai_socktype, 0);
+          if (fd < 0)
+            continue;
+          const int yes = 1;
+          ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+          if (::bind(fd, a->ai_addr, a->ai_addrlen) != 0)
+            error = errno;
+          ::close(fd);
+        }
+      ::freeaddrinfo(found);
+      if (error == EADDRNOTAVAIL)
+        return InputError("command line",
+                          0,
+                          "--host " + host,
+                          "'" + host + "' is not an address of this machine",
+                          "give one of this machine's addresses: 127.0.0.1 "
+                          "(the default), 0.0.0.0 (every interface), or an "
+                          "interface's address (ip addr).");
+      if (error == EACCES)
+        return InputError("command line",
+                          0,
+                          "--port " + std::to_string(port),
+                          "cannot listen on " + where +
+                            ": ports below 1024 need privileges",
+                          "choose a port from 1024 up, e.g. --port 8081.");
+      return InputError("command line",
+                        0,
+                        "--port " + std::to_string(port),
+                        "cannot listen on " + where +
+                          (error == EADDRINUSE ?
+                             ": another program uses the port" :
+                             " (" + std::string(std::strerror(error)) + ")"),
+                        "choose another port, e.g. --port " +
+                          std::to_string(port == 65535 ? 8081 : port + 1) +
+                          ".");
+    }
+  } // namespace
+
+
+
   /** The page (serve_page.cc): three.js draws the surface, the HIP and the
    * force; a drag on the organ moves the HIP in the view plane (with Alt,
    * in depth), other drags and the wheel turn, pan and zoom the view. */
@@ -1347,12 +1422,7 @@ namespace palpate
     if (s.bound > 0 && s.listening >= 0)
       ::listen(s.listening, SOMAXCONN);
     if (s.bound <= 0)
-      throw InputError("command line",
-                       0,
-                       "--port " + std::to_string(port),
-                       "cannot listen on " + host + ":" + std::to_string(port) +
-                         " (in use, or not allowed)",
-                       "choose another port, e.g. --port 8081.");
+      throw cannot_listen(host, port);
     // The names a request may address it by (Impl::refusal()): the host
     // it was given; on the loopback interface, or on every interface,
     // also the loopback's names; on every interface, this machine's name

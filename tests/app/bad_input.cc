@@ -56,9 +56,11 @@ namespace
            at      = message.find(path, at))
         message.replace(at, path.size(), shown);
     // And the machine's memory.
-    if (const auto at = message.find("this machine's ");
-        at != std::string::npos)
-      message.replace(at + 15, message.find(" GiB", at) - at - 15, "<memory>");
+    const std::string memory = "more than this machine's ";
+    if (const auto at = message.find(memory); at != std::string::npos)
+      message.replace(at + memory.size(),
+                      message.find(" GiB", at) - at - memory.size(),
+                      "<memory>");
     deallog << message << std::endl;
   }
 
@@ -524,6 +526,10 @@ main(int argc, char **argv)
         "/parameters/paper-mooney-rivlin.prm --set 'Material "
         "model/Mooney-Rivlin/C01=1e-5' --set 'Material "
         "model/Mooney-Rivlin/C10=1e-5'");
+
+  // serve --host names the host, not the port (issue 26).
+  run("serve --host 10.9.9.9 (not this machine's)",
+      "serve good.prm --host 10.9.9.9");
 
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;
