@@ -331,7 +331,12 @@ namespace palpate
         });
       }
     if (const std::string store = interaction.store_report(); !store.empty())
-      out << "  state store:   " << store << "\n";
+      {
+        out << "  state store:   " << store << "\n";
+        if (interaction.store_write_failed())
+          output_failures.push_back("the state store " + p.state_space.store +
+                                    " stopped taking states: " + store);
+      }
     if (p.effects.force_log)
       {
         const std::string file =

@@ -5,35 +5,21 @@
 #include <palpate/app/precompute.h>
 #include <palpate/app/scene_report.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 #include <palpate/state_space/state_store.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <thread>
 
 namespace palpate
 {
-  namespace
-  {
-    std::atomic<bool> interrupted{false};
-
-    extern "C" void
-    on_interrupt(int)
-    {
-      interrupted.store(true);
-    }
-  } // namespace
-
-
-
   int
   run_precompute(std::ostream &out, Scene scene, const double radius)
   {
@@ -63,13 +49,27 @@ namespace palpate
                      std::pow(radius / p.scheduler.cloud_radius, 3));
         p.scheduler.cloud_radius = radius;
       }
+    // One writer per store: the lock is taken before the interaction
+    // opens the store, and held until what the store kept has been counted
+    // and exported, so that no other process writes in between (the
+    // interaction's own store shares it). A second precompute, or an
+    // interaction on the same store, is refused naming this process.
+    const StoreLock lock(p.state_space.store);
+    // SIGINT, SIGTERM and SIGHUP (the terminal closed) stop it the same
+    // way: the states finished are appended, what the store keeps is
+    // counted and said, and the exit status is 128 + the signal's number.
+    const StopRequest stop;
+    const auto        stopping = [&] {
+      return stop.requested() || !lock.failure().empty();
+    };
     StoreFingerprint fingerprint;
-    bool             stopped = false;
+    unsigned int     before_run = 0; // records the store held before
     {
       Interaction interaction(scene);
       fingerprint              = StoreFingerprint::of(interaction.scene(),
                                          interaction.mesh(),
                                          interaction.nodes());
+      before_run               = interaction.stored_points();
       const auto        total  = interaction.initial_cloud_size();
       const auto        start  = Clock::now();
       const auto        before = interaction.cache().counts();
@@ -81,12 +81,9 @@ namespace palpate
           << "\n"
           << std::flush;
 
-      interrupted.store(false);
-      auto *const previous_int  = std::signal(SIGINT, on_interrupt);
-      auto *const previous_term = std::signal(SIGTERM, on_interrupt);
       interaction.attach();
       unsigned int shown = ~0u;
-      while (!interaction.initial_cloud_complete() && !interrupted.load())
+      while (!interaction.initial_cloud_complete() && !stopping())
         {
           std::this_thread::sleep_for(std::chrono::milliseconds(250));
           const auto   c    = interaction.cache().counts();
@@ -114,50 +111,93 @@ namespace palpate
         }
       // States held elsewhere (MPI servers) reach the store when it asks
       // for them, while the engine runs: wait until every finished state is
-      // stored (at most 60 s).
+      // stored (at most 60 s; the store appends every quarter second, so 2 s
+      // without progress means nothing more is coming: states dropped for
+      // the memory budget, a lost server).
+      auto progress = std::make_pair(interaction.stored_points(), Clock::now());
       for (const auto wait = Clock::now();
-           !interrupted.load() &&
-           std::chrono::duration<double>(Clock::now() - wait).count() < 60;)
+           !stopping() &&
+           std::chrono::duration<double>(Clock::now() - wait).count() < 60 &&
+           Clock::now() - progress.second < std::chrono::seconds(2);)
         {
-          const auto c = interaction.cache().counts();
-          if (interaction.stored_points() >= c.first + c.second)
+          const auto c      = interaction.cache().counts();
+          const auto stored = interaction.stored_points();
+          if (stored >= c.first + c.second)
             break;
+          if (stored > progress.first)
+            progress = std::make_pair(stored, Clock::now());
           std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
       interaction.detach(); // appends what was finished last
-      std::signal(SIGINT, previous_int);
-      std::signal(SIGTERM, previous_term);
       const auto   c = interaction.cache().counts();
       const double t =
         std::chrono::duration<double>(Clock::now() - start).count();
-      out << "\n  " << (interrupted.load() ? "interrupted" : "done")
+      out << "\n  "
+          << (stop.requested()       ? "stopped by " + stop.description() :
+              lock.failure().empty() ? std::string("done") :
+                                       std::string("stopped: the store "
+                                                   "could not be written,"))
           << " after " << Utilities::to_string(t, 3) << " s: " << c.first
           << " states and " << c.second << " failure points in the cache; "
           << interaction.store_report() << "\n";
-      stopped = interrupted.load();
     }
-    // The state space for ParaView, from the store (the interaction has
-    // closed it).
+    // What the store keeps, read back from the file (the interaction has
+    // closed it; the lock still keeps other writers out): the number a
+    // user can rely on, whatever stopped the run.
+    const StateStore store(p.state_space.store,
+                           fingerprint,
+                           StateStore::Access::read);
+    const auto       kept = store.contents();
+    out << "  store keeps:   " << kept.states << " states and " << kept.failures
+        << " failure points in " << p.state_space.store << " ("
+        << kept.states + kept.failures -
+             std::min(before_run, kept.states + kept.failures)
+        << " appended by this run"
+        << (kept.damaged + kept.incomplete > 0 ?
+              ", " + std::to_string(kept.damaged + kept.incomplete) +
+                " records damaged or cut short skipped" :
+              std::string())
+        << ")\n"
+        << std::flush;
+    // The state space for ParaView, from the store.
     const std::string vtk =
       std::filesystem::path(p.state_space.store).replace_extension().string() +
       "-space.vtk";
-    {
-      const StateStore store(p.state_space.store, fingerprint);
-      store.export_vtk(StateGrid(p.state_space.grid_spacing,
-                                 p.state_space.extent),
-                       vtk);
-    }
-    out << "  for ParaView:  " << vtk
-        << " (force, its magnitude, stiffness and status per grid point; "
-           "status -1 not computed, 0 an equilibrium, >= 2 a failure "
-           "point)\n";
-    if (stopped)
+    std::string export_failure;
+    try
+      {
+        store.export_vtk(StateGrid(p.state_space.grid_spacing,
+                                   p.state_space.extent),
+                         vtk);
+        out << "  for ParaView:  " << vtk
+            << " (force, its magnitude, stiffness and status per grid point; "
+               "status -1 not computed, 0 an equilibrium, >= 2 a failure "
+               "point)\n";
+      }
+    catch (const OutputError &e)
+      {
+        // Half a file would mislead ParaView: none at all.
+        std::error_code error;
+        std::filesystem::remove(vtk, error);
+        export_failure = e.what();
+      }
+    // A failed write is an output error (exit status 6), after everything
+    // else was said and written; the store's comes first, it is the cause.
+    if (const std::string failure = lock.failure(); !failure.empty())
+      throw OutputError(failure + (export_failure.empty() ?
+                                     std::string() :
+                                     "; the ParaView export was not "
+                                     "written either (" +
+                                       export_failure + ")"));
+    if (!export_failure.empty())
+      throw OutputError(export_failure);
+    if (stop.requested())
       out << "  run the same command again to go on: the states stored are "
              "not computed again.\n";
     else
       out << "  use it:        palpate " << scene.file()
           << " (with the same State space / Store) starts without waiting "
              "for these states.\n";
-    return stopped ? ExitStatus::interrupted : ExitStatus::success;
+    return stop.requested() ? stop.exit_status() : ExitStatus::success;
   }
 } // namespace palpate

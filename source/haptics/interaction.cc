@@ -87,13 +87,17 @@ namespace palpate
       std::lock_guard<std::mutex> lock(store_append_mutex);
       try
         {
-          stored += store->append(cache, grid);
+          store->append(cache, grid);
         }
       catch (const std::exception &e)
         {
           if (store_error.empty())
             store_error = e.what();
+          store_write_failed = true;
         }
+      // The store's own count: what it wrote and flushed, or after a
+      // failed write (the disk full), what it read back.
+      stored = store->appended();
     }
 
     /**
@@ -145,6 +149,9 @@ namespace palpate
     std::condition_variable   store_wake;
     std::atomic<unsigned int> stored{0};
     std::string               store_error;
+    /** A write to the store failed (a full disk): the run's outputs end
+     * with an output error (exit status 6). */
+    std::atomic<bool> store_write_failed{false};
 
     // Real-time state (touched by force() only).
     ForceFilter           filter;
@@ -545,6 +552,14 @@ namespace palpate
   {
     const Impl &s = *impl;
     return s.loaded.states + s.loaded.failures + s.stored.load();
+  }
+
+
+
+  bool
+  Interaction::store_write_failed() const
+  {
+    return impl->store_write_failed.load();
   }
 
 

@@ -9,15 +9,24 @@
 #include <palpate/state_space/state_grid.h>
 #include <palpate/state_space/state_store.h>
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -197,10 +206,530 @@ namespace palpate
 
 
 
+  // ------------------------------------------------------------------
+  // The writer's lock.
+  //
+  // Why a lock file of our own, with flock: HDF5 1.10 locks the file it
+  // opens, but a SWMR writer drops that lock as soon as it has marked the
+  // superblock "open for writing"; a second writer then finds the mark and
+  // is refused, and palpate used to clear the mark (it is also what a
+  // killed writer leaves) and write on, which is how two writers came to
+  // interleave their rows. The mark cannot tell a live writer from a dead
+  // one; a kernel lock can: flock belongs to the open file and goes with
+  // the process, however it ends. The lock is on `STORE.lock`, not on the
+  // store: the store does not exist before its first state, is created
+  // under another name and renamed (and once more when the first state
+  // fixes the record sizes), and HDF5 takes and drops flocks of its own on
+  // it, which would release ours (flock is per open file, and a process may
+  // have the store open twice). fcntl locks would not survive that either:
+  // they go when the process closes any descriptor of the file.
+  // ------------------------------------------------------------------
+
+  struct StoreLock::Held
+  {
+    std::string        store, lock_file;
+    int                fd  = -1;
+    pid_t              pid = 0;
+    mutable std::mutex mutex;
+    std::string        failure;
+
+    ~Held()
+    {
+      // Removed while still locked, so that nobody takes a lock on a file
+      // about to vanish unseen (acquire() checks that the file it locked is
+      // still the one at the path). A process forked from the holder shares
+      // its lock but leaves the file alone.
+      if (pid == getpid())
+        unlink(lock_file.c_str());
+      if (fd >= 0)
+        close(fd);
+    }
+  };
+
+
+
+  namespace
+  {
+    std::mutex &
+    lock_registry_mutex()
+    {
+      static std::mutex m;
+      return m;
+    }
+
+    /** The locks this process holds, by lock file: a second StateStore or
+     * StoreLock of the same store shares the lock instead of failing on
+     * it (flock would refuse a second descriptor of the same process). */
+    std::map<std::string, std::weak_ptr<StoreLock::Held>> &
+    lock_registry()
+    {
+      static std::map<std::string, std::weak_ptr<StoreLock::Held>> r;
+      return r;
+    }
+
+    /** This process's command line, for the lock file. */
+    std::string
+    command_line()
+    {
+      std::ifstream in("/proc/self/cmdline", std::ios::binary);
+      std::string   c((std::istreambuf_iterator<char>(in)),
+                    std::istreambuf_iterator<char>());
+      while (!c.empty() && c.back() == '\0')
+        c.pop_back();
+      std::replace(c.begin(), c.end(), '\0', ' ');
+      std::replace(c.begin(), c.end(), '\n', ' ');
+      if (c.size() > 300)
+        c = c.substr(0, 300) + "...";
+      return c.empty() ? "(unknown)" : c;
+    }
+
+    std::string
+    utc_now()
+    {
+      const std::time_t t = std::time(nullptr);
+      std::tm           tm{};
+      gmtime_r(&t, &tm);
+      char s[32];
+      std::strftime(s, sizeof(s), "%Y-%m-%d %H:%M:%S UTC", &tm);
+      return s;
+    }
+
+    /** The value of "KEY value" in the text of a lock file, or "". */
+    std::string
+    lock_entry(const std::string &text, const std::string &key)
+    {
+      std::istringstream in(text);
+      std::string        line;
+      while (std::getline(in, line))
+        if (line.compare(0, key.size() + 1, key + " ") == 0)
+          return line.substr(key.size() + 1);
+      return "";
+    }
+
+    /** "mode -r--r--r--, owner uid 0" of @p st. */
+    std::string
+    describe_mode(const struct stat &st)
+    {
+      std::string m = "-rwxrwxrwx";
+      for (unsigned int i = 0; i < 9; ++i)
+        if ((st.st_mode & (0400 >> i)) == 0)
+          m[1 + i] = '-';
+      return "mode " + m + ", owner uid " + std::to_string(st.st_uid) +
+             ", this process uid " + std::to_string(geteuid());
+    }
+
+    [[noreturn]] void
+    store_error(const std::string &store,
+                const std::string &problem,
+                const std::string &fix)
+    {
+      throw InputError(store, 0, "State space / Store", problem, fix);
+    }
+
+    std::shared_ptr<StoreLock::Held>
+    acquire_lock(const std::string &store)
+    {
+      // One lock per store file, whatever name it is given: the lock file
+      // sits beside the file symbolic links lead to.
+      std::error_code       error;
+      std::filesystem::path where = std::filesystem::absolute(store, error);
+      if (error)
+        where = store;
+      const auto canonical = std::filesystem::weakly_canonical(where, error);
+      if (!error)
+        where = canonical;
+      const std::string lock_file = where.string() + ".lock";
+
+      std::lock_guard<std::mutex> registry_lock(lock_registry_mutex());
+      auto                       &entry = lock_registry()[lock_file];
+      if (auto held = entry.lock(); held && held->pid == getpid())
+        return held;
+
+      // A few rounds: the holder may remove its lock file just as we lock
+      // it (see ~Held); then the file at the path is a new one.
+      for (unsigned int round = 0; round < 20; ++round)
+        {
+          const int fd =
+            open(lock_file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+          if (fd < 0)
+            {
+              const int         e = errno;
+              const std::string dir =
+                std::filesystem::path(lock_file).parent_path().string();
+              if (e == EACCES || e == EPERM || e == EROFS)
+                store_error(store,
+                            "palpate cannot make the lock file '" + lock_file +
+                              "' beside the store (" + std::strerror(e) +
+                              "): a writer takes it so that no other "
+                              "process writes the store at the same time",
+                            "make the directory '" + dir +
+                              "' writable for this user, or name a store in "
+                              "a directory you can write (State space / "
+                              "Store).");
+              store_error(store,
+                          "palpate cannot make the lock file '" + lock_file +
+                            "' beside the store: " + std::strerror(e),
+                          "name a store in a directory that exists and "
+                          "that you can write (State space / Store).");
+            }
+          if (flock(fd, LOCK_EX | LOCK_NB) != 0)
+            {
+              const int e = errno;
+              if (e != EWOULDBLOCK)
+                {
+                  close(fd);
+                  store_error(store,
+                              "the file system does not lock the file '" +
+                                lock_file + "' (" + std::strerror(e) +
+                                "), and without a lock two processes could "
+                                "write the store at once",
+                              "name a store on a local file system (State "
+                              "space / Store).");
+                }
+              // Somebody holds it: say who, from what it wrote there.
+              std::string text(4096, '\0');
+              const auto  n = pread(fd, text.data(), text.size(), 0);
+              close(fd);
+              text.resize(n > 0 ? n : 0);
+              const std::string pid     = lock_entry(text, "pid");
+              const std::string command = lock_entry(text, "command");
+              const std::string since   = lock_entry(text, "since");
+              const std::string who =
+                pid.empty() ?
+                  "another process (its lock file '" + lock_file +
+                    "' does not say which yet)" :
+                  "process " + pid +
+                    (command.empty() ? std::string() : " ('" + command + "')") +
+                    (since.empty() ? std::string() : ", since " + since) +
+                    ", by its lock file '" + lock_file + "'";
+              store_error(
+                store,
+                "another process is writing this store: " + who +
+                  ". Two writers would append to the same rows and damage "
+                  "each other's records, so this one does not start",
+                "wait until it ends, or stop it" +
+                  (pid.empty() ? std::string() : " (kill " + pid + ")") +
+                  ": palpate stops cleanly and keeps every state it "
+                  "stored; or give this run a store of its own (State "
+                  "space / Store = another file).");
+            }
+          struct stat locked, at_path;
+          if (fstat(fd, &locked) != 0 ||
+              stat(lock_file.c_str(), &at_path) != 0 ||
+              locked.st_ino != at_path.st_ino ||
+              locked.st_dev != at_path.st_dev)
+            {
+              close(fd);
+              continue;
+            }
+          // Ours. Say who we are, for a process that is refused (it is
+          // only information: the lock is the flock, not the text).
+          const std::string text =
+            "pid " + std::to_string(getpid()) + "\ncommand " + command_line() +
+            "\nstore " + where.string() + "\nsince " + utc_now() + "\n";
+          if (ftruncate(fd, 0) == 0)
+            {
+              const auto written = pwrite(fd, text.data(), text.size(), 0);
+              (void)written;
+            }
+          auto held       = std::make_shared<StoreLock::Held>();
+          held->store     = store;
+          held->lock_file = lock_file;
+          held->fd        = fd;
+          held->pid       = getpid();
+          entry           = held;
+          return held;
+        }
+      store_error(store,
+                  "palpate could not take the lock file '" + lock_file +
+                    "': it was removed and made again 20 times while "
+                    "locking it",
+                  "check what else makes and removes files there, then run "
+                  "again.");
+    }
+  } // namespace
+
+
+
+  namespace
+  {
+    /**
+     * The file access properties of every store file: the latest format
+     * (SWMR needs it), and HDF5's own file locking off. That lock cannot
+     * serve: a SWMR writer drops it once the file is open, while a reader
+     * holds its shared lock for as long as it has the file open, so that a
+     * writer opening the store while a reader reads it failed with "Resource
+     * temporarily unavailable". One writer per store is the StoreLock's
+     * job; readers need no lock (SWMR).
+     */
+    hid_t
+    file_access()
+    {
+      const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+      H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+      H5Pset_file_locking(fapl, false, true);
+      return fapl;
+    }
+
+    /** The system's error message if HDF5 failed in a system call (the
+     * sec2 driver's "error message = '...'"), else "". */
+    std::string
+    hdf5_system_error()
+    {
+      std::string found;
+      H5Ewalk2(
+        H5E_DEFAULT,
+        H5E_WALK_UPWARD,
+        [](unsigned int, const H5E_error2_t *e, void *data) -> herr_t {
+          auto &f = *static_cast<std::string *>(data);
+          if (e->desc != nullptr && f.empty())
+            {
+              const std::string m  = e->desc;
+              const auto        at = m.find("error message = '");
+              if (at != std::string::npos)
+                f = m.substr(at + 17, m.find('\'', at + 17) - at - 17);
+            }
+          return 0;
+        },
+        &found);
+      return found;
+    }
+
+    /**
+     * What HDF5 said last, from its error stack: the system's error message
+     * if a system call failed (for a failed write, "No space left on
+     * device"), else the message at the stack's bottom, where the cause is;
+     * "" if the stack is empty.
+     */
+    std::string
+    hdf5_error()
+    {
+      if (std::string system = hdf5_system_error(); !system.empty())
+        return system;
+      std::vector<std::string> messages;
+      H5Ewalk2(
+        H5E_DEFAULT,
+        H5E_WALK_UPWARD,
+        [](unsigned int, const H5E_error2_t *e, void *data) -> herr_t {
+          if (e->desc != nullptr)
+            static_cast<std::vector<std::string> *>(data)->push_back(e->desc);
+          return 0;
+        },
+        &messages);
+      return messages.empty() ? std::string() : messages.front();
+    }
+
+    /** A write to the store failed: why. */
+    struct WriteFailure
+    {
+      std::string reason;
+    };
+
+    /**
+     * Before HDF5 sees @p file: what keeps it from being a store this
+     * process can open for @p writing (or reading), said as such, so that
+     * a file that is fine but not writable is never called damaged.
+     * Returns whether the file exists (a new one is created).
+     */
+    bool
+    check_store_file(const std::string &file, const bool writing)
+    {
+      namespace fs = std::filesystem;
+      std::error_code       error;
+      const fs::path        path(file);
+      const fs::file_status status = fs::status(path, error);
+      if (status.type() == fs::file_type::none ||
+          (error && status.type() != fs::file_type::not_found))
+        store_error(file,
+                    "the file system refuses this path: " + error.message(),
+                    "name a store file in a directory you can write, e.g. "
+                    "'liver.h5'.");
+      if (status.type() == fs::file_type::not_found)
+        {
+          if (!writing)
+            store_error(file,
+                        "there is no store at this path",
+                        "name an existing store, or make one with palpate "
+                        "precompute SCENE.prm.");
+          const fs::path dir =
+            path.has_parent_path() ? path.parent_path() : fs::path(".");
+          const fs::file_status d = fs::status(dir, error);
+          if (d.type() == fs::file_type::not_found)
+            store_error(file,
+                        "its directory '" + dir.string() +
+                          "' does not exist, so the store cannot be made",
+                        "make the directory (mkdir -p '" + dir.string() +
+                          "') or name a store in one that exists.");
+          if (d.type() != fs::file_type::directory)
+            store_error(file,
+                        "'" + dir.string() + "' is not a directory",
+                        "name a store file in a directory, e.g. "
+                        "'liver.h5'.");
+          if (access(dir.c_str(), W_OK | X_OK) != 0)
+            {
+              const int e = errno;
+              store_error(file,
+                          e == EROFS ?
+                            "its directory '" + dir.string() +
+                              "' is on a read-only file system, so the "
+                              "store cannot be made" :
+                            "permission denied: palpate cannot make files "
+                            "in its directory '" +
+                              dir.string() + "' (" + std::strerror(e) + ")",
+                          "name a store in a directory this user can "
+                          "write, or make this one writable.");
+            }
+          return false;
+        }
+      if (status.type() == fs::file_type::directory)
+        store_error(file,
+                    "this is a directory, not a store file",
+                    "name a file, e.g. '" +
+                      (path / "liver.h5").lexically_normal().string() +
+                      "' (palpate makes it).");
+      if (status.type() != fs::file_type::regular)
+        {
+          const auto  t    = status.type();
+          const char *kind = t == fs::file_type::character ?
+                               "character device" :
+                             t == fs::file_type::block  ? "block device" :
+                             t == fs::file_type::fifo   ? "FIFO (named pipe)" :
+                             t == fs::file_type::socket ? "socket" :
+                                                          "special file";
+          store_error(file,
+                      std::string("this is a ") + kind +
+                        ", not a regular file; a store is a file that "
+                        "palpate reads and appends to",
+                      "name a store file, e.g. 'liver.h5' (palpate makes "
+                      "it if it does not exist).");
+        }
+      // Permissions as this process has them: open it as HDF5 will.
+      const int fd =
+        open(file.c_str(), (writing ? O_RDWR : O_RDONLY) | O_CLOEXEC);
+      if (fd < 0)
+        {
+          const int   e = errno;
+          struct stat st
+          {};
+          stat(file.c_str(), &st);
+          const bool readable = access(file.c_str(), R_OK) == 0;
+          if (e == EROFS)
+            store_error(file,
+                        "the store is on a read-only file system, and "
+                        "palpate appends to it the states it computes",
+                        "copy it to a writable place and name the copy in "
+                        "State space / Store (its states are loaded from "
+                        "there), or mount the file system writable.");
+          if (e == EACCES || e == EPERM)
+            store_error(
+              file,
+              std::string("permission denied: palpate can ") +
+                (writing && readable ? "read this store but not write it" :
+                                       "not read this store") +
+                " (" + describe_mode(st) + "). The store itself is not damaged",
+              (st.st_uid == geteuid() ?
+                 "give yourself permission: chmod u+" +
+                   std::string(writing ? "rw" : "r") + " '" + file + "'" :
+                 "ask its owner (uid " + std::to_string(st.st_uid) + ") for " +
+                   (writing ? "read and write" : "read") +
+                   " permission, or run as that user") +
+                "; to use its states without appending, copy it to a file "
+                "you can write and name the copy in State space / Store. "
+                "Do not delete it: its states are fine.");
+          store_error(file,
+                      std::string("palpate cannot open it: ") +
+                        std::strerror(e),
+                      "check the file and its permissions.");
+        }
+      // An HDF5 file begins with its signature, at byte 0 or after a user
+      // block of 512, 1024, 2048, ... bytes.
+      struct stat st
+      {};
+      fstat(fd, &st);
+      static const char signature[8] = {
+        '\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+      bool        hdf5 = false;
+      std::string head(64, '\0');
+      const auto  n = pread(fd, head.data(), head.size(), 0);
+      head.resize(n > 0 ? n : 0);
+      for (off_t at = 0; !hdf5 && at + 8 <= st.st_size;
+           at       = at == 0 ? 512 : 2 * at)
+        {
+                char bytes[8];
+                hdf5 = pread(fd, bytes, 8, at) == 8 &&
+                       std::memcmp(bytes, signature, 8) == 0;
+        }
+      close(fd);
+      if (st.st_size == 0)
+        store_error(file,
+                    "the file is empty, so it is not a state store (palpate "
+                    "never leaves an empty one: it makes a store under a "
+                    "temporary name and renames it when it is complete)",
+                    "name another store file, or remove this empty one: "
+                    "palpate then makes the store.");
+      if (!hdf5)
+        {
+          const bool text =
+            std::all_of(head.begin(), head.end(), [](const char c) {
+              return c == '\n' || c == '\t' || c == '\r' ||
+                     (static_cast<unsigned char>(c) >= 32 &&
+                      static_cast<unsigned char>(c) < 127);
+            });
+          std::string first = head.substr(0, head.find('\n'));
+          if (first.size() > 40)
+            first = first.substr(0, 40) + "...";
+          store_error(file,
+                      "this is not an HDF5 file, so not a state store: " +
+                        (text ? "it is text, beginning '" + first + "'" :
+                                std::string("it does not begin with HDF5's "
+                                            "signature")),
+                      "State space / Store names the HDF5 file palpate "
+                      "keeps the states in (e.g. 'liver.h5'; made if it "
+                      "does not exist); this file is something else: name "
+                      "another one.");
+        }
+      return true;
+    }
+  } // namespace
+
+
+
+  StoreLock::StoreLock(const std::string &store)
+  {
+    // What is wrong with the store itself is said before any lock: a
+    // directory, no permission, not a store.
+    check_store_file(store, true);
+    held = acquire_lock(store);
+  }
+
+
+
+  StoreLock::~StoreLock() = default;
+
+
+
+  const std::string &
+  StoreLock::lock_file() const
+  {
+    return held->lock_file;
+  }
+
+
+
+  std::string
+  StoreLock::failure() const
+  {
+    std::lock_guard<std::mutex> lock(held->mutex);
+    return held->failure;
+  }
+
+
+
   struct StateStore::Impl
   {
     std::string            file;
-    hid_t                  h5 = -1;
+    Access                 access = Access::write;
+    hid_t                  h5     = -1;
     hid_t                  datasets[8];
     hsize_t                n_solution = 0, n_multipliers = 0;
     hsize_t                rows = 0;
@@ -210,11 +739,32 @@ namespace palpate
     // Failure points that came before the first converged state, which
     // fixes the record sizes.
     std::vector<std::pair<unsigned int, State>> pending;
+    // The writer's lock (Access::write).
+    std::shared_ptr<StoreLock::Held> lock;
+    // The first row this object appended; a failed write stops appending,
+    // and `kept` is then what the file was read back to hold of ours.
+    hsize_t      first_row = 0;
+    bool         stopped   = false;
+    unsigned int kept      = 0;
+    // The descriptor reserve() takes room through.
+    int reserve_fd = -1;
+
+    Impl()
+    {
+      std::fill(std::begin(datasets), std::end(datasets), hid_t(-1));
+    }
+
+    // Also when the constructor throws (a refused store): no HDF5 handle
+    // stays open.
+    ~Impl()
+    {
+      close_file();
+    }
 
     [[noreturn]] void
     fail(const std::string &problem, const std::string &fix) const
     {
-      throw InputError(file, 0, "State space / Store", problem, fix);
+      store_error(file, problem, fix);
     }
 
     /** The columns of dataset @p d (1 for scalars). */
@@ -244,6 +794,29 @@ namespace palpate
                       H5T_NATIVE_DOUBLE;
     }
 
+    /** Close the file (errors ignored: after a failed write HDF5 may not
+     * manage to flush what it still holds; what lands is read back). */
+    void
+    close_file()
+    {
+      for (unsigned int d = 0; d < 8; ++d)
+        if (datasets[d] >= 0)
+          {
+            H5Dclose(datasets[d]);
+            datasets[d] = -1;
+          }
+      if (h5 >= 0)
+        H5Fclose(h5);
+      h5 = -1;
+      if (reserve_fd >= 0)
+        close(reserve_fd);
+      reserve_fd = -1;
+    }
+
+    /**
+     * Make the store with @p fingerprint and record sizes @p n_sol and
+     * @p n_mult. Throws WriteFailure if the file system refuses.
+     */
     void
     create(const StoreFingerprint &fingerprint,
            const hsize_t           n_sol,
@@ -251,17 +824,20 @@ namespace palpate
     {
       n_solution       = n_sol;
       n_multipliers    = n_mult;
-      const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-      H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+      const hid_t fapl = file_access();
       // Written to a temporary name and renamed when complete: a store
       // that exists has its fingerprint and datasets.
       const std::string tmp = file + ".creating";
       h5 = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
       H5Pclose(fapl);
       if (h5 < 0)
-        fail("the store cannot be created (" + std::string(strerror(errno)) +
-               ")",
-             "check that its directory exists and is writable.");
+        {
+          const int         e      = errno;
+          const std::string reason = hdf5_error();
+          throw WriteFailure{std::strerror(e) +
+                             (reason.empty() ? "" : "; HDF5: " + reason)};
+        }
+      bool ok = true;
       // The fingerprint: one string attribute per field, on the root.
       const hid_t space = H5Screate(H5S_SCALAR);
       for (const auto &[field, value] : fingerprint.fields)
@@ -270,8 +846,9 @@ namespace palpate
           H5Tset_size(str, value.size() + 1);
           const hid_t a =
             H5Acreate2(h5, field.c_str(), str, space, H5P_DEFAULT, H5P_DEFAULT);
-          H5Awrite(a, str, value.c_str());
-          H5Aclose(a);
+          ok = ok && a >= 0 && H5Awrite(a, str, value.c_str()) >= 0;
+          if (a >= 0)
+            H5Aclose(a);
           H5Tclose(str);
         }
       H5Sclose(space);
@@ -286,31 +863,80 @@ namespace palpate
           H5Pset_chunk(dcpl, 2, chunk);
           datasets[d] = H5Dcreate2(
             h5, dataset_names[d], type(d), s, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+          ok = ok && datasets[d] >= 0;
           H5Pclose(dcpl);
           H5Sclose(s);
         }
       for (unsigned int d = 0; d < 8; ++d)
-        H5Dclose(datasets[d]);
-      H5Fclose(h5);
-      std::filesystem::rename(tmp, file);
+        if (datasets[d] >= 0)
+          H5Dclose(datasets[d]);
+      std::fill(std::begin(datasets), std::end(datasets), hid_t(-1));
+      // Closing writes it: on a full disk, this is where it fails.
+      ok = H5Fclose(h5) >= 0 && ok;
+      h5 = -1;
+      std::error_code error;
+      if (ok)
+        std::filesystem::rename(tmp, file, error);
+      if (!ok || error)
+        {
+          const int         e      = errno;
+          const std::string reason = error ? error.message() : hdf5_error();
+          std::filesystem::remove(tmp, error);
+          throw WriteFailure{reason.empty() ? std::strerror(e) : reason};
+        }
       open();
+      first_row = 0;
     }
 
+    /** How many of a store's datasets the file @p f has; -1 if HDF5
+     * cannot even look (its root group is damaged). */
+    static int
+    store_datasets(const hid_t f)
+    {
+      int found = 0;
+      for (unsigned int d = 0; d < 8; ++d)
+        {
+          const htri_t e = H5Lexists(f, dataset_names[d], H5P_DEFAULT);
+          if (e < 0)
+            return -1;
+          found += e > 0;
+        }
+      return found;
+    }
+
+    [[noreturn]] void
+    not_a_store() const
+    {
+      fail("this is an HDF5 file, but not a palpate state store: it has "
+           "none of a store's datasets (point, status, force, ...)",
+           "name another store file (State space / Store); this one "
+           "belongs to something else.");
+    }
+
+    /** Open the existing store as access says; InputError if HDF5 cannot
+     * (the file was checked before: then it is damaged). */
     void
     open()
     {
-      const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-      H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
-      // A damaged file is damaged on every read: do not retry (SWMR
-      // retries metadata reads 100 times with growing pauses, minutes).
-      H5Pset_metadata_read_attempts(fapl, 1);
-      h5 = H5Fopen(file.c_str(), H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE, fapl);
-      if (h5 < 0)
+      const bool  writing = access == Access::write;
+      const hid_t fapl    = file_access();
+      // A damaged file is damaged on every read: a writer does not retry
+      // (SWMR retries metadata reads 100 times with growing pauses,
+      // minutes). A reader may catch a piece of metadata while the writer
+      // rewrites it, and has its checksum fail: it tries again, a few times.
+      H5Pset_metadata_read_attempts(fapl, writing ? 1 : 12);
+      const unsigned int flags = writing ? H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE :
+                                           H5F_ACC_RDONLY | H5F_ACC_SWMR_READ;
+      h5                       = H5Fopen(file.c_str(), flags, fapl);
+      std::string why          = h5 < 0 ? hdf5_error() : "";
+      std::string system       = h5 < 0 ? hdf5_system_error() : "";
+      if (h5 < 0 && writing && lock)
         {
           // A writer that was killed leaves the superblock marked "open for
-          // writing", and HDF5 refuses to open it again. The file itself
-          // is consistent (SWMR flushes in order): clear the mark, as
-          // HDF5's h5clear tool does, and open it again.
+          // writing", and HDF5 refuses to open it again. We hold the
+          // writer's lock, so no live writer has it open: the mark is a dead
+          // one's. The file itself is consistent (SWMR flushes in order):
+          // clear the mark, as HDF5's h5clear tool does, and open it again.
           hbool_t     clear = true;
           const hid_t fix   = H5Pcopy(fapl);
           if (H5Pset(fix, "clear_status_flags", &clear) >= 0)
@@ -318,29 +944,61 @@ namespace palpate
               const hid_t cleared = H5Fopen(file.c_str(), H5F_ACC_RDWR, fix);
               if (cleared >= 0)
                 {
+                  // The killed writer's last chunks may lie beyond the end
+                  // of allocation its superblock last recorded: HDF5 would
+                  // then allocate new space over them, and its writes fail
+                  // ("addr overflow"). Move the end of allocation to the
+                  // file's end, as `h5clear --increment` does.
+                  H5Fincrement_filesize(cleared, 0);
                   H5Fclose(cleared);
                   recovered = true;
-                  h5        = H5Fopen(file.c_str(),
-                               H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE,
-                               fapl);
+                  h5        = H5Fopen(file.c_str(), flags, fapl);
                 }
             }
           H5Pclose(fix);
         }
       H5Pclose(fapl);
+      // A system call that failed (HDF5 found the file checked above and
+      // could not read it) is not damage.
+      if (h5 < 0 && !system.empty())
+        fail("HDF5 cannot open the store: " + system +
+               ". The file itself may be fine",
+             "check what else has it open and its permissions, then run "
+             "again; do not delete it for this.");
       if (h5 < 0)
-        fail("HDF5 cannot open the store: it is damaged (truncated or "
-             "overwritten) or not a palpate store",
+        {
+          // HDF5 opens for SWMR only files of the latest format: a file of
+          // another program (older format) fails here, but is not damaged.
+          // Opened plainly, it shows what it is.
+          const hid_t plain = H5Pcreate(H5P_FILE_ACCESS);
+          H5Pset_file_locking(plain, false, true);
+          const hid_t probe = H5Fopen(file.c_str(), H5F_ACC_RDONLY, plain);
+          H5Pclose(plain);
+          if (probe >= 0)
+            {
+              const int found = store_datasets(probe);
+              H5Fclose(probe);
+              if (found == 0)
+                not_a_store();
+            }
+        }
+      if (h5 < 0)
+        fail("the store is damaged: it is an HDF5 file, but HDF5 cannot "
+             "read its structure (" +
+               (why.empty() ? std::string("no detail") : why) +
+               "); it was truncated or overwritten",
              "move it away or delete it: palpate then starts a new store "
              "(the states in it are lost).");
+      if (store_datasets(h5) == 0)
+        not_a_store();
       for (unsigned int d = 0; d < 8; ++d)
         {
           datasets[d] = H5Dopen2(h5, dataset_names[d], H5P_DEFAULT);
           if (datasets[d] < 0)
-            fail(std::string("the store has no dataset '") + dataset_names[d] +
-                   "': it is not a palpate store, or it is damaged",
+            fail(std::string("the store is damaged: its dataset '") +
+                   dataset_names[d] + "' is missing or unreadable",
                  "move it away or delete it: palpate then starts a new "
-                 "store.");
+                 "store (the states in it are lost).");
         }
       hsize_t     dims[2];
       const hid_t s = H5Dget_space(datasets[5]);
@@ -352,7 +1010,7 @@ namespace palpate
       H5Sclose(m);
       n_multipliers = dims[1];
       // The rows: the fewest any dataset has (a record cut short by a
-      // crash has some datasets extended, not all).
+      // crash, or being written, has some datasets extended, not all).
       rows = std::numeric_limits<hsize_t>::max();
       for (unsigned int d = 0; d < 8; ++d)
         {
@@ -361,12 +1019,19 @@ namespace palpate
           H5Sclose(sp);
           rows = std::min(rows, dims[0]);
         }
+      first_row = rows;
     }
 
     std::string
     attribute(const std::string &name) const
     {
-      if (H5Aexists(h5, name.c_str()) <= 0)
+      const htri_t exists = H5Aexists(h5, name.c_str());
+      if (exists < 0)
+        fail("the store is damaged: HDF5 cannot read its fingerprint (" +
+               hdf5_error() + ")",
+             "move it away or delete it: palpate then starts a new store "
+             "(the states in it are lost).");
+      if (exists == 0)
         return "(not recorded)";
       const hid_t a    = H5Aopen(h5, name.c_str(), H5P_DEFAULT);
       const hid_t t    = H5Aget_type(a);
@@ -396,30 +1061,78 @@ namespace palpate
       H5Sclose(file_space);
     }
 
-    void
+    /** Write row @p row of dataset @p d and flush it; false if HDF5 (the
+     * file system) refused. */
+    bool
     write_row(const hsize_t row, const unsigned int d, const void *data)
     {
       const hsize_t extent[2] = {row + 1, columns(d)};
-      H5Dset_extent(datasets[d], extent);
+      if (H5Dset_extent(datasets[d], extent) < 0)
+        return false;
       if (columns(d) > 0)
         {
           const hsize_t start[2] = {row, 0}, count[2] = {1, columns(d)};
           const hid_t   file_space = H5Dget_space(datasets[d]);
           H5Sselect_hyperslab(
             file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
-          const hid_t memory = H5Screate_simple(2, count, nullptr);
-          if (H5Dwrite(
-                datasets[d], type(d), memory, file_space, H5P_DEFAULT, data) <
-              0)
-            throw OutputError("writing the state store '" + file +
-                              "' failed (disk full?)");
+          const hid_t  memory  = H5Screate_simple(2, count, nullptr);
+          const herr_t written = H5Dwrite(
+            datasets[d], type(d), memory, file_space, H5P_DEFAULT, data);
           H5Sclose(memory);
           H5Sclose(file_space);
+          if (written < 0)
+            return false;
         }
-      H5Dflush(datasets[d]);
+      // The chunk cache holds the row until it is flushed: only the flush
+      // meets a full disk, so its result is what says the row is written.
+      return H5Dflush(datasets[d]) >= 0;
     }
 
-    bool
+    /**
+     * Make sure the file's blocks reach past HDF5's end of allocation by
+     * four records and 128 KiB: what one more record allocates (its rows,
+     * and the chunk index and metadata they add: pages of at most 1024
+     * addresses, 8 KiB, for each of the 8 datasets) with a margin. Returns ""
+     * on success, else why not. The blocks beyond the end of allocation stay as
+     * zeros at the end of the file (HDF5 allows a file longer than it uses) and
+     * are used by the next records.
+     */
+    std::string
+    reserve()
+    {
+      haddr_t eoa = 0;
+      if (H5Fget_eoa(h5, &eoa) < 0)
+        return "";
+      const off_t record =
+        (13 + n_solution + n_multipliers) * sizeof(double) + 16;
+      const off_t target = eoa + 4 * record + 128 * 1024;
+      // A descriptor of our own, kept while the file is open (close_file()
+      // closes it: create() renames a new file into place).
+      if (reserve_fd < 0)
+        reserve_fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC);
+      if (reserve_fd < 0)
+        return std::strerror(errno);
+      // The size each time: HDF5 may have cut the file back to its end of
+      // allocation when it flushed.
+      struct stat st
+      {};
+      int error = fstat(reserve_fd, &st) == 0 ? 0 : errno;
+      // posix_fallocate returns the error; glibc writes zeros where the
+      // file system cannot allocate.
+      if (error == 0 && st.st_size < eoa + 2 * record + 64 * 1024)
+        error = posix_fallocate(reserve_fd, 0, target);
+      return error == 0 ? "" : std::strerror(error);
+    }
+
+    /** The result of reading one record. */
+    enum class Read
+    {
+      intact,
+      damaged,
+      incomplete
+    };
+
+    Read
     read_record(const hsize_t row, Record &r) const
     {
       r.solution.resize(n_solution);
@@ -433,33 +1146,119 @@ namespace palpate
       read_row(row, 5, r.solution.data());
       read_row(row, 6, r.multipliers.data());
       read_row(row, 7, &checksum);
-      return checksum == r.checksum() && checksum != 0;
+      // The checksum is written last: none (HDF5's fill value, 0) means
+      // the writer never got there, it was killed or is writing it now.
+      if (checksum == 0)
+        return Read::incomplete;
+      return checksum == r.checksum() && r.point >= 0 ? Read::intact :
+                                                        Read::damaged;
     }
+
+    /**
+     * A write failed: stop appending. Close the file, open it again for
+     * reading, and count what it keeps of this object's records; record
+     * the failure with the lock and throw OutputError saying all that.
+     */
+    [[noreturn]] void
+    stop(std::string reason)
+    {
+      if (reason.empty())
+        reason = "the file system refused a write";
+      stopped = true;
+      close_file();
+      pending.clear();
+      unsigned int states = 0, failures = 0, damaged = 0, incomplete = 0;
+      kept = 0;
+      std::string unreadable;
+      access = Access::read;
+      try
+        {
+          open();
+          for (hsize_t row = 0; row < rows; ++row)
+            {
+              Record     r;
+              const Read read = read_record(row, r);
+              damaged += read == Read::damaged;
+              incomplete += read == Read::incomplete;
+              if (read == Read::intact)
+                {
+                  (r.status == 0 ? states : failures) += 1;
+                  kept += row >= first_row_before_stop;
+                }
+            }
+        }
+      catch (const InputError &e)
+        {
+          unreadable = e.problem();
+          close_file();
+        }
+      const std::string what =
+        unreadable.empty() ?
+          "it keeps " + std::to_string(states) + " states and " +
+            std::to_string(failures) + " failure points (read back), " +
+            std::to_string(kept) + " of them appended by this run" +
+            (damaged + incomplete > 0 ?
+               "; " + std::to_string(damaged + incomplete) +
+                 " records cut short or damaged are skipped" :
+               std::string()) :
+          "reading it back failed: " + unreadable;
+      const std::string message =
+        "writing the state store '" + file + "' failed (" + reason +
+        "); appending stopped: " + what +
+        ". Make room (or move the store to a disk with room) and run "
+        "again: the states kept are not computed again";
+      if (lock)
+        {
+          std::lock_guard<std::mutex> guard(lock->mutex);
+          if (lock->failure.empty())
+            lock->failure = message;
+        }
+      throw OutputError(message);
+    }
+
+    // The first row of this object's records when the write failed (open()
+    // in stop() moves first_row to the end).
+    hsize_t first_row_before_stop = 0;
   };
 
 
 
   StateStore::StateStore(const std::string      &file,
-                         const StoreFingerprint &fingerprint)
+                         const StoreFingerprint &fingerprint,
+                         const Access            access)
     : impl(std::make_unique<Impl>())
   {
     // HDF5 prints its error stack by default; palpate reports errors itself.
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    Impl &s = *impl;
-    s.file  = file;
-    // error_code: a path the file system refuses (a loop of links, a name
-    // too long) is the user's input, not an internal error.
-    std::error_code error;
-    const bool      exists = std::filesystem::exists(file, error);
-    if (error)
-      s.fail("the file system refuses this path: " + error.message(),
-             "name a store file in a directory you can write, e.g. "
-             "'liver.h5'.");
+    Impl &s            = *impl;
+    s.file             = file;
+    s.access           = access;
+    const bool writing = access == Access::write;
+    // What the file is, before HDF5 sees it: a file that is fine but not
+    // writable, a directory, a text file are not "damaged".
+    check_store_file(file, writing);
+    bool exists = true;
+    if (writing)
+      {
+        // The writer's lock, before anything is written; then look again
+        // (another writer may have made the store meanwhile).
+        s.lock = acquire_lock(file);
+        exists = check_store_file(file, writing);
+      }
     if (!exists)
       {
         // The sizes come with the first state: create lazily then. Until
         // then the fingerprint is kept.
-        s.create(fingerprint, 0, 0);
+        try
+          {
+            s.create(fingerprint, 0, 0);
+          }
+        catch (const WriteFailure &f)
+          {
+            s.fail("the store cannot be made: " + f.reason,
+                   "make room on its disk, or name a store where there is "
+                   "room and you can write (State space / Store).");
+          }
         return;
       }
     s.open();
@@ -477,17 +1276,7 @@ namespace palpate
 
 
 
-  StateStore::~StateStore()
-  {
-    Impl &s = *impl;
-    if (s.h5 >= 0)
-      {
-        for (unsigned int d = 0; d < 8; ++d)
-          if (s.datasets[d] >= 0)
-            H5Dclose(s.datasets[d]);
-        H5Fclose(s.h5);
-      }
-  }
+  StateStore::~StateStore() = default;
 
 
 
@@ -495,6 +1284,11 @@ namespace palpate
   StateStore::append(const unsigned int point, const State &state)
   {
     Impl &s = *impl;
+    if (s.stopped)
+      return;
+    if (s.access != Access::write)
+      throw std::logic_error("StateStore::append on a store opened for "
+                             "reading");
     if (s.n_solution == 0 && !state.converged)
       {
         s.pending.emplace_back(point, state);
@@ -516,6 +1310,7 @@ namespace palpate
         r.solution    = state.solution;
         r.multipliers = state.multipliers;
       }
+    s.first_row_before_stop = s.first_row;
     if (s.rows == 0 && s.n_solution == 0 && state.converged)
       {
         // The first state fixes the record sizes: make the datasets again
@@ -531,28 +1326,50 @@ namespace palpate
                                         "load effects",
                                         "palpate version"})
           keep.fields.emplace_back(field, s.attribute(field));
-        for (unsigned int d = 0; d < 8; ++d)
-          H5Dclose(s.datasets[d]);
-        H5Fclose(s.h5);
-        s.h5 = -1;
-        s.create(keep, state.solution.size(), state.multipliers.size());
+        s.close_file();
+        try
+          {
+            s.create(keep, state.solution.size(), state.multipliers.size());
+          }
+        catch (const WriteFailure &f)
+          {
+            s.first_row_before_stop = 0;
+            s.stop(f.reason);
+          }
+        s.first_row_before_stop = s.first_row;
       }
     r.solution.resize(s.n_solution, 0.0);
     r.multipliers.resize(s.n_multipliers, 0.0);
     const std::uint64_t checksum = r.checksum();
+    // Room first: a write that fails half-way leaves HDF5's superblock
+    // promising space the file never got (it is then "truncated" to HDF5,
+    // and no record in it can be read). So the space for this record, and
+    // more, is taken from the file system before HDF5 writes anything; if
+    // it cannot be had (the disk full, a file size limit), appending stops
+    // here and the file is as the last record left it.
+    if (const std::string refused = s.reserve(); !refused.empty())
+      s.stop(refused);
     // The checksum goes last: a record cut short has none and is skipped.
+    // Each row is flushed as it is written, and the whole file's buffers
+    // after the record, so that a killed writer loses at most the record
+    // being written and a reader never sees a checksum before its record.
     const hsize_t row = s.rows;
-    s.write_row(row, 0, &r.point);
-    s.write_row(row, 1, &r.status);
-    s.write_row(row, 2, r.force);
-    s.write_row(row, 3, r.stiffness);
-    s.write_row(row, 4, &r.wall_time);
-    s.write_row(row, 5, r.solution.data());
-    s.write_row(row, 6, r.multipliers.data());
-    s.write_row(row, 7, &checksum);
-    // The whole file's buffers, so that a killed writer loses at most the
-    // record being written.
-    H5Fflush(s.h5, H5F_SCOPE_LOCAL);
+    errno             = 0;
+    const bool written =
+      s.write_row(row, 0, &r.point) && s.write_row(row, 1, &r.status) &&
+      s.write_row(row, 2, r.force) && s.write_row(row, 3, r.stiffness) &&
+      s.write_row(row, 4, &r.wall_time) &&
+      s.write_row(row, 5, r.solution.data()) &&
+      s.write_row(row, 6, r.multipliers.data()) &&
+      s.write_row(row, 7, &checksum) && H5Fflush(s.h5, H5F_SCOPE_LOCAL) >= 0;
+    if (!written)
+      {
+        const int         e      = errno;
+        const std::string reason = hdf5_error();
+        s.stop(!reason.empty() ? reason :
+               e != 0          ? std::string(std::strerror(e)) :
+                                 std::string());
+      }
     ++s.rows;
     s.stored.insert(point);
     if (!s.pending.empty() && s.n_solution > 0)
@@ -566,20 +1383,43 @@ namespace palpate
 
 
 
+  unsigned int
+  StateStore::appended() const
+  {
+    const Impl &s = *impl;
+    return s.stopped ? s.kept : s.rows - std::min(s.rows, s.first_row);
+  }
+
+
+
+  bool
+  StateStore::stopped() const
+  {
+    return impl->stopped;
+  }
+
+
+
   std::vector<std::pair<unsigned int, State>>
-  StateStore::read_all(unsigned int &damaged) const
+  StateStore::read_all(unsigned int &damaged, unsigned int *incomplete) const
   {
     const Impl                                 &s = *impl;
     std::vector<std::pair<unsigned int, State>> states;
     damaged = 0;
+    if (incomplete != nullptr)
+      *incomplete = 0;
+    if (s.h5 < 0)
+      return states;
     for (hsize_t row = 0; row < s.rows; ++row)
       {
-        Record r;
-        if (!s.read_record(row, r) || r.point < 0)
-          {
-            ++damaged;
-            continue;
-          }
+        Record           r;
+        const Impl::Read read = s.read_record(row, r);
+        if (read == Impl::Read::damaged)
+          ++damaged;
+        if (read == Impl::Read::incomplete && incomplete != nullptr)
+          ++*incomplete;
+        if (read != Impl::Read::intact)
+          continue;
         State state;
         state.converged = r.status == 0;
         state.status    = r.status == 0 ? SolveStatus::converged :
@@ -610,7 +1450,7 @@ namespace palpate
   {
     Impl      &s = *impl;
     Loaded     loaded;
-    const auto all        = read_all(loaded.damaged);
+    const auto all        = read_all(loaded.damaged, &loaded.incomplete);
     const auto generation = cache.generation();
     for (const auto &[point, state] : all)
       {
@@ -640,11 +1480,25 @@ namespace palpate
 
 
 
+  StateStore::Loaded
+  StateStore::contents() const
+  {
+    Loaded     c;
+    const auto all = read_all(c.damaged, &c.incomplete);
+    for (const auto &[point, state] : all)
+      (state.converged ? c.states : c.failures) += 1;
+    return c;
+  }
+
+
+
   unsigned int
   StateStore::append(const StateCache &cache, const StateGrid &grid)
   {
     Impl        &s = *impl;
     unsigned int n = 0;
+    if (s.stopped)
+      return 0;
     for (unsigned int p = 0; p < grid.size(); ++p)
       {
         if (s.stored.count(p) > 0)
@@ -675,6 +1529,8 @@ namespace palpate
   {
     const Impl  &s = *impl;
     unsigned int n = 0;
+    if (s.stopped)
+      return 0;
     for (unsigned int p = 0; p < grid.size(); ++p)
       if (s.stored.count(p) == 0)
         {
@@ -750,8 +1606,10 @@ namespace palpate
             << (s != nullptr && s->has_stiffness ? s->stiffness[3 * r + 2] : 0.)
             << '\n';
     });
+    out.flush();
     if (!out)
-      throw OutputError("writing '" + filename + "' failed");
+      throw OutputError("writing '" + filename + "' failed (" +
+                        std::strerror(errno) + ")");
   }
 
 

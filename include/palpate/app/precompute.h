@@ -19,7 +19,13 @@ namespace palpate
    * interaction (threads, or the MPI servers under mpirun, rank 0 writing);
    * each finished state is appended within a quarter second, so an
    * interrupted run (Ctrl-C, kill) started again resumes where it stopped.
-   * Returns an ExitStatus.
+   *
+   * It holds the store's StoreLock for the whole run: another process that
+   * would write the store is refused. SIGINT, SIGTERM and SIGHUP stop it
+   * cleanly (exit status 128 + the signal's number); a write the file
+   * system refuses (the disk full) stops the appending (exit status 6).
+   * Either way it ends by reading the store back and saying exactly how
+   * many states and failure points it keeps. Returns an ExitStatus.
    */
   int
   run_precompute(std::ostream &out, Scene scene, const double radius);

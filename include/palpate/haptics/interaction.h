@@ -122,6 +122,11 @@ namespace palpate
     std::string
     store_report() const;
 
+    /** With a store: whether a write to it failed (a full disk; the store
+     * kept what store_report() says). */
+    bool
+    store_write_failed() const;
+
     /** With a store: the grid points it holds (loaded and appended). */
     unsigned int
     stored_points() const;

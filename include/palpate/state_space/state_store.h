@@ -37,6 +37,59 @@ namespace palpate
   };
 
   /**
+   * The right to write one state store: an exclusive lock (flock) on the
+   * file `STORE.lock` beside it, which says who holds it (process id,
+   * command line, since when). A second process that wants to write the
+   * store is refused with an InputError that names the holder and the fix;
+   * two writers would append to the same rows and damage each other's
+   * records. The lock is the kernel's: it goes with the process that holds
+   * it, so a writer that was killed (SIGKILL, a power cut) never blocks the
+   * next one, whatever its lock file still says.
+   *
+   * Within one process the lock is shared: every StoreLock and every
+   * StateStore opened for writing on the same file hold the same lock,
+   * which is released (and its lock file removed) when the last of them
+   * goes. `palpate precompute` holds one for its whole run, so that no
+   * other process writes between the interaction that fills the store and
+   * the count of what it kept.
+   */
+  class StoreLock
+  {
+  public:
+    /**
+     * Take the lock of the store @p store (the file need not exist yet).
+     * Throws InputError (entry State space / Store) if another process
+     * holds it, naming that process, or if the lock file cannot be made
+     * (the directory missing or not writable).
+     */
+    explicit StoreLock(const std::string &store);
+    ~StoreLock();
+
+    /** The lock file, `STORE.lock` beside the store (symbolic links
+     * resolved, so that two names of one store share one lock). */
+    const std::string &
+    lock_file() const;
+
+    /**
+     * Why appending to the store stopped in this process (a write failed:
+     * the disk full), with what the store kept; "" while nothing failed.
+     * Shared by every holder of the lock in this process.
+     */
+    std::string
+    failure() const;
+
+    /** The lock as this process holds it (its file descriptor, the
+     * failure); defined in state_store.cc. */
+    struct Held;
+
+  private:
+    std::shared_ptr<Held> held;
+    friend class StateStore;
+  };
+
+
+
+  /**
    * A persistent store of computed states in HDF5 (State space / Store,
    * palpate precompute): force, stiffness where available, displacement
    * field and multipliers of each state, failure points, and the scene's
@@ -48,23 +101,55 @@ namespace palpate
    * its values, written last, so a state cut short or changed on disk (a
    * flipped bit) is detected, skipped and counted, and the intact ones are
    * used. Nothing is ever rewritten in place.
+   *
+   * One writer: a store opened for writing holds its StoreLock, so a second
+   * process is refused instead of damaging records. Readers need no lock:
+   * they open the file in SWMR read mode and see only whole records (a
+   * record's checksum is written last; a record still being written, or
+   * cut short, has none and is skipped as incomplete, not as damaged).
+   *
+   * A write that fails (the disk full, a file size limit) stops the
+   * appending: the store closes the file, reads back what it keeps, and
+   * says exactly that; later appends do nothing.
    */
   class StateStore
   {
   public:
+    /** How a store is opened. */
+    enum class Access
+    {
+      /** Create it if it does not exist, load and append: takes the
+       * StoreLock. */
+      write,
+      /** Read what it holds while a writer may append (SWMR read): no
+       * lock; the file must exist. */
+      read
+    };
+
     /**
-     * Open @p file, or create it if it does not exist, for a scene with
-     * @p fingerprint. Throws InputError (entry State space / Store) if the
-     * file's fingerprint differs (naming the field and both values) or if
-     * HDF5 cannot open it.
+     * Open @p file, or create it if it does not exist (Access::write), for
+     * a scene with @p fingerprint. Throws InputError (entry State space /
+     * Store) naming the file, what is wrong and the fix: another process
+     * writes it (Access::write), the path is refused or is a directory or
+     * a device, permission is denied, it is not an HDF5 file or not a
+     * palpate store, it is damaged (HDF5 cannot read its structure), or its
+     * fingerprint differs (naming the field and both values).
      */
-    StateStore(const std::string &file, const StoreFingerprint &fingerprint);
+    StateStore(const std::string      &file,
+               const StoreFingerprint &fingerprint,
+               const Access            access = Access::write);
     ~StateStore();
 
-    /** What load() found. */
+    /** What load() or contents() found. */
     struct Loaded
     {
-      unsigned int states = 0, failures = 0, damaged = 0;
+      /** Intact states and failure points. */
+      unsigned int states = 0, failures = 0;
+      /** Records whose checksum does not match (changed on disk). */
+      unsigned int damaged = 0;
+      /** Records without a checksum: cut short by a writer that was
+       * killed, or (to a reader) still being written. */
+      unsigned int incomplete = 0;
     };
 
     /**
@@ -75,11 +160,17 @@ namespace palpate
     Loaded
     load(StateCache &cache, const StateGrid &grid);
 
+    /** Count what the store holds (intact states and failure points,
+     * damaged and incomplete records), reading every record. */
+    Loaded
+    contents() const;
+
     /**
      * Append the states and failure points @p cache holds that the store
      * does not, each flushed before the next. States held elsewhere (MPI
      * servers) are asked for and appended by a later call. Returns the
-     * number appended.
+     * number appended. If a write fails, throws OutputError saying what
+     * the store kept (see stopped()).
      */
     unsigned int
     append(const StateCache &cache, const StateGrid &grid);
@@ -87,19 +178,37 @@ namespace palpate
     /**
      * The number of points @p cache finished (states and failure points)
      * that the store does not hold yet and still can: a state the cache
-     * dropped for its budget is not counted (nothing gives it back).
+     * dropped for its budget is not counted (nothing gives it back), nor
+     * is anything once the store stopped().
      */
     unsigned int
     missing(const StateCache &cache, const StateGrid &grid) const;
 
-    /** Append one state (converged or not) at grid point @p point. */
+    /**
+     * Append one state (converged or not) at grid point @p point, flushed
+     * before it returns. If a write fails, the store stops: it reads back
+     * what the file keeps and throws OutputError saying so; after that,
+     * appending does nothing.
+     */
     void
     append(const unsigned int point, const State &state);
 
+    /**
+     * The records this object appended that the file holds: those written
+     * and flushed, or after a failed write, those read back intact.
+     */
+    unsigned int
+    appended() const;
+
+    /** Whether a write failed and appending stopped. */
+    bool
+    stopped() const;
+
     /** Read every intact state: (point, state); @p damaged counts those
-     * whose checksum does not match. */
+     * whose checksum does not match, @p incomplete (if given) those
+     * without a checksum (cut short, or being written). */
     std::vector<std::pair<unsigned int, State>>
-    read_all(unsigned int &damaged) const;
+    read_all(unsigned int &damaged, unsigned int *incomplete = nullptr) const;
 
     /**
      * Write the stored state space for ParaView as a legacy VTK
