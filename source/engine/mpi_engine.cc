@@ -301,6 +301,15 @@ namespace palpate
            << " states only it held are recomputed when needed";
     stats.lost_servers.push_back(what.str());
     replan = true;
+    // The survivors stop waiting for what they asked of it.
+    for (unsigned int r = 1; r < servers.size(); ++r)
+      if (!servers[r].lost)
+        {
+          Header h;
+          h.kind   = Kind::peer_lost;
+          h.holder = rank;
+          messenger.send(r, pack(h));
+        }
   }
 
 

@@ -141,9 +141,17 @@ namespace palpate
       return i == shared.store.end() ? std::shared_ptr<const State>() :
                                        i->second;
     };
+    // Servers the client said were lost (Kind::peer_lost); under
+    // shared.mutex.
+    std::set<int> lost_peers;
     // Ask the communicator to request point p from @p holder, unless it
     // is on its way already. Call with shared.mutex held.
     const auto request = [&](const unsigned int p, const int holder) {
+      if (lost_peers.count(holder))
+        {
+          shared.failed.insert(p); // it will not come
+          return;
+        }
       if (shared.requested.count(p))
         return;
       shared.failed.erase(p);
@@ -345,6 +353,25 @@ namespace palpate
                       }
                     else
                       shared.failed.insert(h.point);
+                    shared.wake_solver.notify_all();
+                    break;
+                  }
+                case Kind::peer_lost:
+                  {
+                    // Sources asked of the lost server never come: the
+                    // tasks waiting for them end as source_missing now,
+                    // and the client plans them from another source.
+                    std::lock_guard<std::mutex> lock(shared.mutex);
+                    lost_peers.insert(h.holder);
+                    for (auto it = shared.requested.begin();
+                         it != shared.requested.end();)
+                      if (it->second == h.holder)
+                        {
+                          shared.failed.insert(it->first);
+                          it = shared.requested.erase(it);
+                        }
+                      else
+                        ++it;
                     shared.wake_solver.notify_all();
                     break;
                   }

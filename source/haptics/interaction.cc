@@ -159,7 +159,11 @@ namespace palpate
     std::array<double, 9> stiffness = {}; // of the last force()
     const Interpolation   interpolation =
       interpolation_from_name(scene.parameters.state_space.interpolation);
-    MissingCause      previous_cause = MissingCause::none;
+    MissingCause previous_cause = MissingCause::none;
+    // Whether the last tick's missing data was held (a held stretch that
+    // turns into a fade, when a server's trouble ends before its states
+    // came, is a new event: the summary counts fades and holds apart).
+    bool              previous_held = false;
     Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
     Clock::time_point previous_call;
     bool first_call = true, was_complete = false, in_contact = false;
@@ -275,6 +279,7 @@ namespace palpate
         s.in_contact     = false;
         s.was_complete   = false;
         s.previous_cause = MissingCause::none;
+        s.previous_held  = false;
         s.hold.reset();
       }
     const auto now = Clock::now();
@@ -366,7 +371,7 @@ namespace palpate
         const unsigned int slot = cause == MissingCause::failure_region ? 0 :
                                   cause == MissingCause::outside        ? 1 :
                                                                           2;
-        if (cause != s.previous_cause)
+        if (cause != s.previous_cause || held != s.previous_held)
           {
             for (unsigned int d = 0; d < 3; ++d)
               s.event_position[d].store(finite ? position[d] : 0.0,
@@ -389,6 +394,9 @@ namespace palpate
           s.missing_nanoseconds.fetch_add(nanoseconds,
                                           std::memory_order_relaxed);
       }
+    s.previous_held = s.in_contact && cause != MissingCause::none &&
+                      (cause != MissingCause::not_computed || server_trouble) &&
+                      finite && s.hold.valid();
     s.previous_cause = s.in_contact ? cause : MissingCause::none;
     s.last_cause.store(static_cast<std::uint8_t>(cause),
                        std::memory_order_relaxed);

@@ -53,7 +53,11 @@ namespace palpate
       /** server -> client: alive, with the server's counters. */
       heartbeat,
       /** client -> server: end. */
-      shutdown
+      shutdown,
+      /** client -> server: the server `holder` was lost; whatever is asked
+       * of it will not come (a partitioned server's peers would otherwise
+       * wait 10 s for each source it held). */
+      peer_lost
     };
 
     /** Bits of Header::flags. */
