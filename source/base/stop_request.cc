@@ -52,7 +52,12 @@ namespace palpate
     // driver sees the flag at its next poll.
     action.sa_flags = SA_RESTART;
     for (unsigned int i = 0; i < 3; ++i)
-      sigaction(stop_signals[i], &action, &previous[i]);
+      {
+        sigaction(stop_signals[i], nullptr, &previous[i]);
+        // A signal the caller ignores (nohup ignores SIGHUP) stays ignored.
+        if (previous[i].sa_handler != SIG_IGN)
+          sigaction(stop_signals[i], &action, nullptr);
+      }
   }
 
 

@@ -109,6 +109,12 @@ namespace palpate
           << impl->position[k][1] << "," << impl->position[k][2] << ","
           << impl->force[k][0] << "," << impl->force[k][1] << ","
           << impl->force[k][2] << "\n";
+    // A full disk shows only here: a cut log is an output error.
+    out.close();
+    if (!out)
+      throw std::runtime_error("'" + filename +
+                               "' could not be written whole (is the disk "
+                               "full?)");
   }
 
 

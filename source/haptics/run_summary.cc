@@ -355,6 +355,11 @@ namespace palpate
     out << "key,value\n";
     for (const Field &f : fields(*this))
       out << f.key << "," << csv_value(f) << "\n";
+    out.close();
+    if (!out)
+      throw std::runtime_error("'" + filename +
+                               "' could not be written whole (is the disk "
+                               "full?)");
   }
 
 
@@ -371,5 +376,10 @@ namespace palpate
       out << "  " << json_string(f[i].key) << ": " << json_value(f[i])
           << (i + 1 < f.size() ? "," : "") << "\n";
     out << "}\n";
+    out.close();
+    if (!out)
+      throw std::runtime_error("'" + filename +
+                               "' could not be written whole (is the disk "
+                               "full?)");
   }
 } // namespace palpate

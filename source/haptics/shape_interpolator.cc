@@ -355,9 +355,18 @@ namespace palpate
     impl->thread.join();
     const std::string file = impl->directory + "/" + impl->stem + "-shape.pvd";
     std::ofstream     pvd(file);
-    if (pvd)
-      dealii::DataOutBase::write_pvd_record(pvd, impl->records);
-    pvd.flush();
+    // deal.II asserts on a stream that failed (a full disk): that is this
+    // output's failure, reported with the others, not an internal error.
+    try
+      {
+        if (pvd)
+          dealii::DataOutBase::write_pvd_record(pvd, impl->records);
+        pvd.close();
+      }
+    catch (const std::exception &)
+      {
+        pvd.setstate(std::ios::failbit);
+      }
     if (!pvd && impl->failure.empty())
       impl->failure = "cannot write the file '" + file + "'";
   }

@@ -1381,11 +1381,14 @@ namespace palpate
                     "and the loop preallocates its statistics for every tick",
                   "use 1000 Hz.");
     const auto &t = h.trajectory;
-    if ((t.type == "circle" || t.type == "smooth random") && !(t.radius > 0))
+    // At least 0.1 mm: below, a smooth random motion's speed scaling
+    // divides by (nearly) zero and its positions are NaN.
+    if ((t.type == "circle" || t.type == "smooth random") &&
+        !(t.radius >= 1e-4))
       throw error("Haptics/Trajectory/Radius",
                   "a " + t.type +
-                    " needs a positive radius (with 0 every "
-                    "position of the probe is undefined)",
+                    " needs a radius of at least 0.0001 m (0.1 mm; with 0 "
+                    "or less every position of the probe is undefined)",
                   "give the radius in metres, e.g. 0.01.");
     if ((t.type == "straight line" || t.type == "circle") &&
         Utilities::norm(t.direction) == 0)
