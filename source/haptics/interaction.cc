@@ -357,11 +357,11 @@ namespace palpate
     // timeout and the re-planning after it: held too, not faded.
     const bool server_trouble =
       cause == MissingCause::not_computed && s.engine->degraded();
+    bool held = false;
     if (s.in_contact && cause != MissingCause::none)
       {
-        const bool held =
-          (cause != MissingCause::not_computed || server_trouble) && finite &&
-          s.hold.valid();
+        held = (cause != MissingCause::not_computed || server_trouble) &&
+               finite && s.hold.valid();
         if (held)
           {
             target      = s.hold.force(position);
@@ -394,9 +394,7 @@ namespace palpate
           s.missing_nanoseconds.fetch_add(nanoseconds,
                                           std::memory_order_relaxed);
       }
-    s.previous_held = s.in_contact && cause != MissingCause::none &&
-                      (cause != MissingCause::not_computed || server_trouble) &&
-                      finite && s.hold.valid();
+    s.previous_held  = held;
     s.previous_cause = s.in_contact ? cause : MissingCause::none;
     s.last_cause.store(static_cast<std::uint8_t>(cause),
                        std::memory_order_relaxed);

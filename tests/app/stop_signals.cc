@@ -30,17 +30,21 @@
 namespace
 {
   /** Start palpate with @p args, its stdout in @p out_file (or /dev/full),
+   * or, if @p out_fd >= 0, into that descriptor (the write end of a pipe);
    * stderr in @p err_file. */
   pid_t
   start(const std::vector<std::string> &args,
         const std::string              &out_file,
-        const std::string              &err_file)
+        const std::string              &err_file,
+        const int                       out_fd = -1)
   {
     const pid_t pid = fork();
     if (pid == 0)
       {
         const int out =
-          open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+          out_fd >= 0 ?
+            out_fd :
+            open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         const int err =
           open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         dup2(out, 1);
@@ -202,22 +206,8 @@ main()
     int fds[2];
     if (pipe(fds) != 0)
       return 1;
-    const pid_t pid = fork();
-    if (pid == 0)
-      {
-        close(fds[0]);
-        dup2(fds[1], 1);
-        const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        dup2(e, 2);
-        std::vector<std::string> args = interaction;
-        std::vector<char *>      argv;
-        argv.push_back(const_cast<char *>(palpate_executable.c_str()));
-        for (const auto &a : args)
-          argv.push_back(const_cast<char *>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(argv[0], argv.data());
-        _exit(127);
-      }
+    fcntl(fds[0], F_SETFD, FD_CLOEXEC); // the child keeps only the write end
+    const pid_t pid = start(interaction, "", err, fds[1]);
     close(fds[1]);
     char c = 0;
     while (read(fds[0], &c, 1) == 1 && c != '\n')
