@@ -342,7 +342,10 @@ namespace
     // The partition.
     std::optional<Row> partition;
     double             cut_in_motion = -1, back_after_cut = -1;
-    const double       timeout = o.quick ? 1 : 5, motion = o.quick ? 3 : 16;
+    // Whether the force faded to zero after the cut at all (held through
+    // the loss, it does not: then there is nothing to come back).
+    bool         faded   = false;
+    const double timeout = o.quick ? 1 : 5, motion = o.quick ? 3 : 16;
     if (o.partition)
       {
         std::cout << "\none-way delay 1 ms, server 2 cut off ("
@@ -380,7 +383,7 @@ namespace
         // The motion's clock starts at the line "motion starts" (the force
         // log counts from there); when the force came back after the cut.
         cut_in_motion = t.run.cut_at - t.run.when_at;
-        bool faded    = false;
+        faded         = false;
         for (const auto &[time, f] : t.forces)
           if (time > cut_in_motion)
             {
@@ -462,8 +465,11 @@ namespace
                   << " missing_s=" << fixed(t.number("missing_data_seconds"), 2)
                   << " lost_servers=" << fixed(t.number("lost_servers"), 0)
                   << " server_timeout_s=" << fixed(timeout, 0)
+                  << " force_faded=" << (faded ? "yes" : "no")
                   << " force_back_after_cut_s="
-                  << (back_after_cut >= 0 ? fixed(back_after_cut, 2) : "never")
+                  << (!faded              ? std::string("0") :
+                      back_after_cut >= 0 ? fixed(back_after_cut, 2) :
+                                            std::string("never"))
                   << " non_finite=" << fixed(t.number("non_finite_forces"), 0)
                   << " status=" << t.status << " mpirun_ended="
                   << (t.run.mpirun_ended == "by itself"     ? "itself" :
