@@ -6,6 +6,8 @@
 #ifndef palpate_benchmarks_machine_h
 #define palpate_benchmarks_machine_h
 
+#include <palpate/base/environment.h>
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -22,7 +24,8 @@
 #include <utility>
 #include <vector>
 
-/** The processor model and the number of cores, e.g. "AMD EPYC, 2 cores". */
+/** The processor model, the number of cores and the BLAS kernels, e.g.
+ * "AMD EPYC, 2 cores, OpenBLAS, Zen kernels". */
 inline std::string
 machine()
 {
@@ -34,8 +37,9 @@ machine()
         model = line.substr(line.find(':') + 2);
         break;
       }
+  const std::string &blas = palpate::Environment::blas();
   return model + ", " + std::to_string(std::thread::hardware_concurrency()) +
-         " cores";
+         " cores" + (blas.empty() ? "" : ", " + blas);
 }
 
 /**

@@ -10,13 +10,71 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <string>
 
 namespace palpate
 {
   namespace
   {
-    bool thread_multiple = false;
-  }
+    bool        thread_multiple = false;
+    std::string blas_kernels;
+
+    /**
+     * OpenBLAS picks its kernels by the processor's model number when it is
+     * loaded. A processor newer than the library (Debian 12's OpenBLAS
+     * 0.3.21 on a Sapphire Rapids, this project's CI machine) is unknown to
+     * it and gets the generic Prescott (SSE3) kernels: every MUMPS
+     * factorisation of a liver then runs 2.7x slower (1,607 nodes: 113 ms
+     * instead of 42; doc/benchmarks/organ-speed.md), the dense kernels of
+     * the fronts being most of it. Where the library fell back so and the
+     * processor has AVX-512 (or AVX2 with FMA), switch to the SkylakeX (or
+     * Haswell) kernels, as OPENBLAS_CORETYPE would at start-up: the
+     * library's own dynamic dispatch is re-run with that variable set.
+     * This happens before anything calls the BLAS (no thread of palpate's
+     * exists yet). A user's own OPENBLAS_CORETYPE is always kept, and a
+     * BLAS other than OpenBLAS is left alone (the symbols are looked up
+     * at run time).
+     */
+    void
+    select_blas_kernels()
+    {
+      using Name = char *(*)();
+      using Call = void (*)();
+      const auto corename =
+        reinterpret_cast<Name>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
+      if (corename == nullptr)
+        return; // not OpenBLAS
+      blas_kernels = std::string("OpenBLAS, ") + corename() + " kernels";
+      if (std::getenv("OPENBLAS_CORETYPE") != nullptr)
+        {
+          blas_kernels += " (OPENBLAS_CORETYPE)";
+          return;
+        }
+      const auto quit =
+        reinterpret_cast<Call>(dlsym(RTLD_DEFAULT, "gotoblas_dynamic_quit"));
+      const auto init =
+        reinterpret_cast<Call>(dlsym(RTLD_DEFAULT, "gotoblas_dynamic_init"));
+      if (quit == nullptr || init == nullptr ||
+          std::string(corename()) != "Prescott")
+        return; // a build without dynamic dispatch, or a known processor
+      __builtin_cpu_init();
+      const char *better =
+        __builtin_cpu_supports("avx512f") &&
+            __builtin_cpu_supports("avx512dq") ?
+          "SkylakeX" :
+        __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ?
+          "Haswell" :
+          nullptr;
+      if (better == nullptr)
+        return; // a processor for which Prescott is right
+      setenv("OPENBLAS_CORETYPE", better, 1);
+      quit();
+      init();
+      blas_kernels = std::string("OpenBLAS, ") + corename() +
+                     " kernels (chosen by palpate: the library took this "
+                     "processor for a Prescott)";
+    }
+  } // namespace
 
 
 
@@ -35,6 +93,7 @@ namespace palpate
     // is not (it computes wrong results), which is why palpate installs
     // libopenblas0-pthread. Looked up at run time: another BLAS may be in
     // use, and then there is nothing to set.
+    select_blas_kernels();
     using SetThreads = void (*)(int);
     if (const auto set = reinterpret_cast<SetThreads>(
           dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
@@ -68,6 +127,14 @@ namespace palpate
   {
     std::atomic<bool> a_peer_was_lost{false};
   } // namespace
+
+
+
+  const std::string &
+  Environment::blas()
+  {
+    return blas_kernels;
+  }
 
 
 

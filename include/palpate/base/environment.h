@@ -4,6 +4,8 @@
 #ifndef palpate_base_environment_h
 #define palpate_base_environment_h
 
+#include <string>
+
 namespace palpate
 {
   /**
@@ -33,6 +35,16 @@ namespace palpate
     /** Whether MPI provides MPI_THREAD_MULTIPLE in this process. */
     static bool
     mpi_thread_multiple();
+
+    /**
+     * The BLAS in use and its kernels, e.g. "OpenBLAS, SkylakeX kernels";
+     * empty for a BLAS other than OpenBLAS. Where OpenBLAS took a newer
+     * processor than it knows for a Prescott (generic SSE3 kernels, 2.7x
+     * slower factorisations), the constructor switched it to the kernels
+     * the processor can run, and this says so.
+     */
+    static const std::string &
+    blas();
 
     /**
      * A rank of MPI_COMM_WORLD died (a lost solver server): MPI_Finalize
