@@ -42,6 +42,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <numeric>
 #include <sstream>
 #include <vector>
 
@@ -65,9 +66,16 @@ namespace
     unsigned int             lines     = 6; // states per line
     /** Only the first and the last lever, on a series of meshes: the
      * growth of the state time with the unknowns. */
-    bool        scaling = false;
-    bool        stroke  = true;
-    std::string csv;
+    bool scaling = false;
+    bool stroke  = true;
+    /** Print every Newton iteration of the last lever's states. */
+    bool trace = false;
+    /** Maximum Krylov iterations for every lever (0: the scene's). */
+    unsigned int krylov = 0;
+    /** The levers to run, by number (0: unchanged, the reference);
+     * empty: all. */
+    std::vector<unsigned int> levers;
+    std::string               csv;
   };
 
   /** A solver configuration: the scene's settings with some levers. */
@@ -132,7 +140,8 @@ namespace
           Parameters::AllParameters p,
           const Lever              &lever,
           const unsigned int        per_line,
-          const Measured           *reference)
+          const Measured           *reference,
+          const bool                trace = false)
   {
     lever.apply(p);
     StateSolver  solver(mesh, selection, p);
@@ -175,6 +184,23 @@ namespace
                 break; // the rest of this line has no neighbour
               }
             m.newton += s.newton_iterations;
+            if (trace)
+              {
+                std::cout << "    state " << m.ms.size() << " at ("
+                          << 1e3 * target[0] << ", " << 1e3 * target[1] << ", "
+                          << 1e3 * target[2] << ") mm: " << m.ms.back()
+                          << " ms, |f| " << Utilities::norm(s.force) << " N\n";
+                for (const auto &r : s.history)
+                  std::cout
+                    << "      inc " << r.increment << "  res "
+                    << r.residual_before << " -> " << r.residual_after
+                    << "  step " << r.step_length << "  "
+                    << (r.factorized ? "factorised" : "GMRES ")
+                    << (r.factorized ? "" : std::to_string(r.krylov_iterations))
+                    << "  asm " << 1e3 * r.assembly_time << " solve "
+                    << 1e3 * r.solve_time << " ls " << 1e3 * r.line_search_time
+                    << " ms\n";
+              }
             for (const auto &r : s.history)
               {
                 m.krylov += r.krylov_iterations;
@@ -384,6 +410,14 @@ main(int argc, char **argv)
         o.lines = std::stoul(argv[++i]);
       else if (a == "--no-stroke")
         o.stroke = false;
+      else if (a == "--trace")
+        o.trace = true;
+      else if (a == "--krylov" && i + 1 < argc)
+        o.krylov = std::stoul(argv[++i]);
+      else if (a == "--levers" && i + 1 < argc)
+        list(o.levers, [](const std::string &s) {
+          return static_cast<unsigned int>(std::stoul(s));
+        });
       else if (a == "--scaling")
         {
           o.scaling   = true;
@@ -399,7 +433,7 @@ main(int argc, char **argv)
           std::cerr
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
-               "[--no-stroke]\n";
+               "[--no-stroke] [--trace] [--krylov N] [--levers 0,4]\n";
           return 2;
         }
     }
@@ -462,18 +496,25 @@ main(int argc, char **argv)
   for (const double size : o.sizes)
     for (const std::string &material : o.materials)
       {
-        const Scene         scene = organ_scene(size, material);
-        const Mesh          mesh  = Mesh::create(scene);
-        const NodeSelection sel   = NodeSelection::create(scene, mesh);
+        Scene scene = organ_scene(size, material);
+        if (o.krylov > 0)
+          scene.parameters.nonlinear_solver.max_krylov_iterations = o.krylov;
+        const Mesh          mesh = Mesh::create(scene);
+        const NodeSelection sel  = NodeSelection::create(scene, mesh);
         std::cout << "liver " << mesh.n_vertices() << " nodes, "
                   << mesh.n_cells() << " tetrahedra, " << material << "\n";
-        std::cout << "  lever                 state [ms]  Newton  Krylov  "
-                     "factor.  asm [ms]  solve [ms]  ls [ms]  max force err  "
-                     "failed\n";
+        std::cout
+          << "  lever                 state [ms] mean [ms]  Newton  Krylov  "
+             "factor.  asm [ms]  solve [ms]  ls [ms]  max force err  "
+             "failed\n";
         std::vector<Measured> all;
         for (unsigned int l = 0; l < levers.size(); ++l)
           {
             if (o.scaling && l > 0 && l + 1 < levers.size())
+              continue;
+            if (!o.levers.empty() && l > 0 &&
+                std::find(o.levers.begin(), o.levers.end(), l) ==
+                  o.levers.end())
               continue;
             const Lever &lever = levers[l];
             all.push_back(measure(mesh,
@@ -481,7 +522,8 @@ main(int argc, char **argv)
                                   scene.parameters,
                                   lever,
                                   o.lines,
-                                  all.empty() ? nullptr : &all.front()));
+                                  all.empty() ? nullptr : &all.front(),
+                                  o.trace && l + 1 == levers.size()));
             const Measured &m = all.back();
             const double    err =
               m.force_error.empty() ?
@@ -489,8 +531,11 @@ main(int argc, char **argv)
                    *std::max_element(m.force_error.begin(), m.force_error.end());
             std::cout << "  " << std::left << std::setw(20) << m.lever
                       << std::right << std::setw(12) << std::setprecision(4)
-                      << median(m.ms) << std::setw(8) << std::setprecision(3)
-                      << m.newton << std::setw(8) << m.krylov << std::setw(9)
+                      << median(m.ms) << std::setw(10)
+                      << std::accumulate(m.ms.begin(), m.ms.end(), 0.0) /
+                           std::max<std::size_t>(1, m.ms.size())
+                      << std::setw(8) << std::setprecision(3) << m.newton
+                      << std::setw(8) << m.krylov << std::setw(9)
                       << m.factorizations << std::setw(10) << m.assembly_ms
                       << std::setw(12) << m.solve_ms << std::setw(9)
                       << m.line_search_ms << std::setw(15) << err
@@ -508,6 +553,9 @@ main(int argc, char **argv)
                     << " nodes=" << mesh.n_vertices()
                     << " material=" << material << " unknowns=" << m.unknowns
                     << " lever=" << m.lever << " state_ms=" << median(m.ms)
+                    << " mean_ms="
+                    << std::accumulate(m.ms.begin(), m.ms.end(), 0.0) /
+                         std::max<std::size_t>(1, m.ms.size())
                     << " newton=" << m.newton << " krylov=" << m.krylov
                     << " factorizations=" << m.factorizations
                     << " states=" << m.ms.size() << " failed=" << m.failed
