@@ -482,6 +482,15 @@ main(int argc, char **argv)
        p.nonlinear_solver.max_increment_length = 0.005;
      },
      true},
+    {"+single precision",
+     "single-precision factors as GMRES's preconditioner (MUMPS single)",
+     [](Parameters::AllParameters &p) {
+       p.nonlinear_solver.set_reuse(true);
+       p.linear_solver.solver                  = "MUMPS single";
+       p.linear_solver.ordering                = "METIS";
+       p.nonlinear_solver.max_increment_length = 0.005;
+     },
+     true},
   };
 
   std::ostringstream results;

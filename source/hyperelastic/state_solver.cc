@@ -323,7 +323,7 @@ namespace palpate
       {
         system->probe_load(x, state.active_displacement, j, rhs);
         bool solved = false;
-        if (factorized_current)
+        if (factorized_current && linear_solver->exact())
           solved = linear_solver->solve(rhs);
         else if (factorized)
           {
@@ -347,7 +347,19 @@ namespace palpate
             if (!linear_solver->factorize(matrix))
               return false;
             factorized = factorized_current = true;
-            solved                          = linear_solver->solve(rhs);
+            solved                          = linear_solver->exact() ?
+                                                linear_solver->solve(rhs) :
+                                                gmres(
+                         system->sparsity(),
+                         matrix,
+                         [this](std::vector<double> &v) {
+                           return linear_solver->solve(v);
+                         },
+                         rhs,
+                         1e-6,
+                         settings.max_krylov_iterations,
+                         krylov_v,
+                         krylov_z) > 0;
           }
         if (!solved)
           return false;
@@ -471,12 +483,38 @@ namespace palpate
           {
             factorized         = false;
             factorized_current = false;
-            if (!linear_solver->factorize(matrix) ||
-                !linear_solver->solve(step))
+            bool solved        = linear_solver->factorize(matrix);
+            if (solved && linear_solver->exact())
+              solved = linear_solver->solve(step);
+            else if (solved)
+              {
+                // Mixed precision: the fresh single-precision factors
+                // precondition GMRES on this very tangent, which then
+                // converges in one to three iterations to the same
+                // tolerance as the reused ones.
+                record.krylov_iterations = gmres(
+                  system->sparsity(),
+                  matrix,
+                  [this](std::vector<double> &v) {
+                    return linear_solver->solve(v);
+                  },
+                  step,
+                  eta,
+                  settings.max_krylov_iterations,
+                  krylov_v,
+                  krylov_z);
+                solved = record.krylov_iterations > 0;
+              }
+            if (!solved)
               {
                 outcome.status     = SolveStatus::linear_solver_failure;
                 outcome.iterations = iteration;
-                outcome.message    = linear_solver->message();
+                outcome.message =
+                  linear_solver->message().empty() ?
+                    "GMRES preconditioned by the single-precision "
+                    "factorisation of the tangent did not converge (use "
+                    "Linear solver / Solver = MUMPS)" :
+                    linear_solver->message();
                 return outcome;
               }
             factorized         = true;

@@ -882,12 +882,17 @@ namespace palpate
         prm.declare_entry(
           "Solver",
           "MUMPS",
-          Patterns::Selection("MUMPS|UMFPACK|KLU|Amesos MUMPS|Amesos KLU"),
+          Patterns::Selection(
+            "MUMPS|MUMPS single|UMFPACK|KLU|Amesos MUMPS|Amesos KLU"),
           "Sparse direct solver for the linearised systems. MUMPS is "
           "called through its C interface with the symmetric indefinite "
-          "LDL^T factorisation; UMFPACK and KLU through SuiteSparse; the "
-          "Amesos variants through Trilinos Amesos, for comparison. All "
-          "analyse the sparsity pattern once per solver.");
+          "LDL^T factorisation; 'MUMPS single' factorises in single "
+          "precision and serves as the preconditioner of GMRES in double "
+          "(mixed precision: the same Newton iterates and forces, cheaper "
+          "factorisations and solves on large meshes, "
+          "doc/benchmarks/organ-speed.md); UMFPACK and KLU through "
+          "SuiteSparse; the Amesos variants through Trilinos Amesos, for "
+          "comparison. All analyse the sparsity pattern once per solver.");
         prm.declare_entry(
           "Ordering",
           "by size",

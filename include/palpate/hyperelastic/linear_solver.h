@@ -64,6 +64,18 @@ namespace palpate
     virtual bool
     solve(std::vector<double> &rhs) = 0;
 
+    /**
+     * Whether solve() solves A x = b to round-off. False for a
+     * mixed-precision solver ("MUMPS single": single-precision factors),
+     * whose solve() is only an approximate inverse: the Newton method then
+     * uses it as GMRES's preconditioner, never as a solver.
+     */
+    virtual bool
+    exact() const
+    {
+      return true;
+    }
+
     /** The solver's name and settings, e.g. "MUMPS (LDL^T, METIS)". */
     virtual std::string
     name() const = 0;
@@ -84,8 +96,9 @@ namespace palpate
     }
 
     /**
-     * A solver by scene name: "MUMPS", "UMFPACK", "KLU", "Amesos MUMPS" or
-     * "Amesos KLU"; @p ordering is MUMPS's fill-reducing ordering.
+     * A solver by scene name: "MUMPS", "MUMPS single", "UMFPACK", "KLU",
+     * "Amesos MUMPS" or "Amesos KLU"; @p ordering is MUMPS's
+     * fill-reducing ordering.
      */
     static std::unique_ptr<LinearSolver>
     create(const std::string &name, const std::string &ordering);

@@ -284,7 +284,8 @@ namespace palpate
     /** `subsection Linear solver`: the sparse direct solver. */
     struct LinearSolver
     {
-      /** "MUMPS", "UMFPACK", "KLU", "Amesos MUMPS" or "Amesos KLU". */
+      /** "MUMPS", "MUMPS single", "UMFPACK", "KLU", "Amesos MUMPS" or
+       * "Amesos KLU". */
       std::string solver;
       /** MUMPS fill-reducing ordering: "by size" (AMF below
        * Parameters::LinearSolver::metis_from equations, METIS from there
