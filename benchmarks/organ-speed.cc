@@ -450,6 +450,7 @@ main(int argc, char **argv)
      "Newton step, AMF ordering, increments of 2.5 mm",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(false);
+       p.linear_solver.solver   = "MUMPS";
        p.linear_solver.ordering = "AMF";
      },
      false},
@@ -457,6 +458,7 @@ main(int argc, char **argv)
      "GMRES preconditioned by the kept factorisation",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(true);
+       p.linear_solver.solver   = "MUMPS";
        p.linear_solver.ordering = "AMF";
      },
      false},
@@ -464,6 +466,7 @@ main(int argc, char **argv)
      "METIS nested dissection",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(true);
+       p.linear_solver.solver   = "MUMPS";
        p.linear_solver.ordering = "METIS";
      },
      false},
@@ -471,6 +474,7 @@ main(int argc, char **argv)
      "the states behind on the line extrapolated",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(true);
+       p.linear_solver.solver   = "MUMPS";
        p.linear_solver.ordering = "METIS";
      },
      true},
@@ -478,6 +482,7 @@ main(int argc, char **argv)
      "a grid step (5 mm) in one increment",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(true);
+       p.linear_solver.solver                  = "MUMPS";
        p.linear_solver.ordering                = "METIS";
        p.nonlinear_solver.max_increment_length = 0.005;
      },

@@ -48,6 +48,14 @@ namespace palpate
           << " displacements, ";
     out << system.n_multipliers() << " multipliers)\n"
         << "  linear solver:  " << solver.linear_solver_name()
+        << (scene.parameters.linear_solver.solver == "by size" ?
+              std::string(system.n_equations() >=
+                              Parameters::LinearSolver::single_from ?
+                            " (Solver = by size: at least " :
+                            " (Solver = by size: fewer than ") +
+                Utilities::to_string(Parameters::LinearSolver::single_from) +
+                " equations)" :
+              std::string())
         << (scene.parameters.linear_solver.ordering == "by size" ?
               std::string(system.n_equations() >=
                               Parameters::LinearSolver::metis_from ?

@@ -203,9 +203,10 @@ namespace palpate
       // The ordering by the system's size unless the scene fixes it: the
       // fill of nested dissection grows more slowly with the mesh than
       // AMF's, which is cheaper to compute and as good on small meshes.
-      linear_solver = LinearSolver::create(p.linear_solver.solver,
-                                           p.linear_solver.ordering_for(
-                                             system->n_equations()));
+      ordering = p.linear_solver.ordering_for(system->n_equations());
+      linear_solver =
+        LinearSolver::create(p.linear_solver.solver_for(system->n_equations()),
+                             ordering);
       linear_solver->analyze(system->sparsity());
       setup_time = seconds_since(start);
     }
@@ -271,8 +272,25 @@ namespace palpate
              r <= 1e3 * settings.residual_tolerance * force_scale;
     }
 
+    /**
+     * A mixed-precision solver whose GMRES failed on a tangent (single
+     * precision too coarse for it): replace it by MUMPS in double for the
+     * rest of this solver's life. True if it did (the caller retries).
+     */
+    bool
+    fall_back_to_double()
+    {
+      if (linear_solver->exact())
+        return false;
+      linear_solver = LinearSolver::create("MUMPS", ordering);
+      linear_solver->analyze(system->sparsity());
+      factorized = factorized_current = false;
+      return true;
+    }
+
     std::unique_ptr<HyperelasticSystem>        system;
     std::unique_ptr<LinearSolver>              linear_solver;
+    std::string                                ordering;
     Parameters::NonlinearSolver                settings;
     double                                     setup_time = 0;
     std::function<void(const State &, double)> observer;
@@ -484,6 +502,8 @@ namespace palpate
             factorized         = false;
             factorized_current = false;
             bool solved        = linear_solver->factorize(matrix);
+            if (!solved && fall_back_to_double())
+              solved = linear_solver->factorize(matrix);
             if (solved && linear_solver->exact())
               solved = linear_solver->solve(step);
             else if (solved)
@@ -504,6 +524,14 @@ namespace palpate
                   krylov_v,
                   krylov_z);
                 solved = record.krylov_iterations > 0;
+                if (!solved && fall_back_to_double())
+                  {
+                    step = residual;
+                    for (double &v : step)
+                      v = -v;
+                    solved = linear_solver->factorize(matrix) &&
+                             linear_solver->solve(step);
+                  }
               }
             if (!solved)
               {

@@ -881,16 +881,19 @@ namespace palpate
       {
         prm.declare_entry(
           "Solver",
-          "MUMPS",
+          "by size",
           Patterns::Selection(
-            "MUMPS|MUMPS single|UMFPACK|KLU|Amesos MUMPS|Amesos KLU"),
+            "by size|MUMPS|MUMPS single|UMFPACK|KLU|Amesos MUMPS|Amesos KLU"),
           "Sparse direct solver for the linearised systems. MUMPS is "
           "called through its C interface with the symmetric indefinite "
           "LDL^T factorisation; 'MUMPS single' factorises in single "
           "precision and serves as the preconditioner of GMRES in double "
           "(mixed precision: the same Newton iterates and forces, cheaper "
-          "factorisations and solves on large meshes, "
-          "doc/benchmarks/organ-speed.md); UMFPACK and KLU through "
+          "factorisations and solves on large meshes; if GMRES fails with "
+          "it, the state solver changes to MUMPS for good); 'by size' "
+          "chooses MUMPS below 5,000 equations and MUMPS single from 5,000 "
+          "on (a state 8 % faster at 6,965 equations, 30 % at 16,980, "
+          "doc/benchmarks/organ-speed.md). UMFPACK and KLU through "
           "SuiteSparse; the Amesos variants through Trilinos Amesos, for "
           "comparison. All analyse the sparsity pattern once per solver.");
         prm.declare_entry(

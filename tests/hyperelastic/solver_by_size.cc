@@ -3,12 +3,16 @@
 
 // Solver settings that follow the mesh (issue 25): with the defaults
 // Nonlinear solver / Reuse factorization = by size and Linear solver /
-// Ordering = by size, a solver chooses by its number of equations: exact
-// Newton steps and AMF on the paper's StVK liver (1,473 equations), reuse
-// from 1,500 equations (Mooney-Rivlin on the same liver, 1,974), METIS
-// from 5,000 (a beam of 6,000 equations). A setting the scene fixes is
+// Solver and Ordering = by size, a solver chooses by its number of
+// equations: exact Newton steps, MUMPS in double and AMF on the paper's
+// StVK liver (1,473 equations), reuse from 1,500 equations (Mooney-Rivlin
+// on the same liver, 1,974), single-precision factors in GMRES and METIS
+// from 5,000 (a beam of 5,835 equations). A setting the scene fixes is
 // kept whatever the size. Each case also solves a state, so a wrong choice
-// that breaks the solver would show.
+// that breaks the solver would show. A tangent beyond single precision
+// (Young's modulus 1e43 Pa: entries above float's 3.4e38) makes the mixed
+// solver fall back to MUMPS in double, and the state is still computed,
+// with the force 1e38 times that at 1e5 Pa (StVK is linear in E) to 1e-9.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -17,7 +21,7 @@
 
 namespace
 {
-  void
+  palpate::State
   report(const std::string &name, const palpate::Scene &scene)
   {
     const Body           body(scene);
@@ -29,6 +33,7 @@ namespace
             << (solver.settings().reuse_factorization ? "on" : "off") << ", "
             << solver.linear_solver_name() << ", converged "
             << (s.converged ? "yes" : "no") << std::endl;
+    return s;
   }
 } // namespace
 
@@ -49,7 +54,29 @@ main(int argc, char **argv)
   auto          &m           = beam.parameters.mesh;
   m.beam_subdivisions_length = 24;
   m.beam_subdivisions_width = m.beam_subdivisions_height = 8;
-  report("beam 24 x 8 x 8", beam);
+  const palpate::State soft = report("beam 24 x 8 x 8", beam);
+
+  // Beyond single precision: the fall-back to double.
+  palpate::Scene stiff = beam;
+  stiff.parameters.material_model.set("St.Venant-Kirchhoff",
+                                      "Young's modulus",
+                                      1e43);
+  const palpate::State hard =
+    report("beam 24 x 8 x 8, E = 1e43 Pa (after the solve)", stiff);
+  palpate::Utilities::Point3 scaled = soft.force;
+  for (double &f : scaled)
+    f *= 1e38;
+  deallog << "  force = 1e38 x the force at 1e5 Pa: "
+          << (hard.converged &&
+                  palpate::Utilities::distance(hard.force, scaled) <=
+                    1e-9 * palpate::Utilities::norm(scaled) ?
+                "yes" :
+                "NO")
+          << std::endl;
+
+  // Fixed by the scene: kept.
+  beam.parameters.linear_solver.solver = "MUMPS";
+  report("beam 24 x 8 x 8, MUMPS fixed", beam);
 
   // Fixed by the scene: kept.
   beam.parameters.linear_solver.ordering = "AMF";
