@@ -8,6 +8,9 @@
 One line per lever configuration (the unchanged solver, and every lever on),
 log-log, with the least-squares exponent of state time ~ unknowns^p, and the
 issue's targets (30 ms at 1,500 nodes, 100 ms at 4,000 nodes) as marks.
+Several CSV files may be given before the PNG (e.g. a run of the unchanged
+solver with OPENBLAS_CORETYPE=Prescott, the BLAS kernels palpate used
+before it chose them: its lines are labelled so).
 Needs matplotlib (Debian: python3-matplotlib)."""
 import csv, math, sys
 
@@ -15,9 +18,16 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-if len(sys.argv) != 3:
+if len(sys.argv) < 3:
     sys.exit(__doc__)
-rows = list(csv.DictReader(open(sys.argv[1])))
+rows = []
+for name in sys.argv[1:-1]:
+    for r in csv.DictReader(open(name)):
+        if "prescott" in name.lower():
+            r["lever"] += " (generic Prescott BLAS kernels)"
+        rows.append(r)
+names = {"unchanged": "unchanged solver",
+         "+single precision": "every lever on"}
 fig, ax = plt.subplots(figsize=(6.5, 4.5))
 for lever in dict.fromkeys(r["lever"] for r in rows):
     s = sorted((r for r in rows if r["lever"] == lever), key=lambda r: int(r["unknowns"]))
@@ -27,7 +37,9 @@ for lever in dict.fromkeys(r["lever"] for r in rows):
     y = [math.log(v) for v in t]
     mx, my = sum(x) / len(x), sum(y) / len(y)
     p = sum((a - mx) * (b - my) for a, b in zip(x, y)) / sum((a - mx) ** 2 for a in x)
-    label = ("every lever on" if lever != "unchanged" else "unchanged solver")
+    label = names.get(lever, lever)
+    if lever.startswith("unchanged ("):
+        label = "unchanged solver, generic (Prescott) BLAS kernels"
     ax.loglog(n, t, "o-", label="%s: ~ unknowns^%.2f" % (label, p))
     for r, a, b in zip(s, n, t):
         ax.annotate("%s nodes" % r["nodes"], (a, b), fontsize=7,
@@ -40,4 +52,4 @@ ax.set_ylabel("median state from a neighbour, one core (ms)")
 ax.set_title("Liver + 1 cm sphere: cost of a state against the mesh")
 ax.legend(fontsize=8)
 fig.tight_layout()
-fig.savefig(sys.argv[2], dpi=110)
+fig.savefig(sys.argv[-1], dpi=110)

@@ -273,6 +273,55 @@ namespace palpate
     }
 
     /**
+     * GMRES on the tangent in matrix to @p tolerance, preconditioned by the
+     * linear solver's factors (of this tangent or an earlier one): @p rhs
+     * holds b on entry and x on success. The iterations; 0 if it failed,
+     * and then @p rhs is unchanged.
+     */
+    unsigned int
+    preconditioned_gmres(std::vector<double> &rhs, const double tolerance)
+    {
+      return gmres(
+        system->sparsity(),
+        matrix,
+        [this](std::vector<double> &v) { return linear_solver->solve(v); },
+        rhs,
+        tolerance,
+        settings.max_krylov_iterations,
+        krylov_v,
+        krylov_z);
+    }
+
+    /**
+     * Factorise the tangent in matrix and solve with it in place: a direct
+     * solve, or with mixed precision GMRES to @p tolerance preconditioned
+     * by the fresh factors (one to three iterations, counted in
+     * @p krylov_iterations); if the single-precision factors fail, MUMPS in
+     * double from then on. False if the linear solver fails.
+     */
+    bool
+    factorize_and_solve(std::vector<double> &rhs,
+                        const double         tolerance,
+                        unsigned int        &krylov_iterations)
+    {
+      factorized = factorized_current = false;
+      krylov_iterations               = 0;
+      bool solved                     = linear_solver->factorize(matrix);
+      if (solved && linear_solver->exact())
+        solved = linear_solver->solve(rhs);
+      else if (solved)
+        {
+          krylov_iterations = preconditioned_gmres(rhs, tolerance);
+          solved            = krylov_iterations > 0;
+        }
+      // rhs is still b after a failed factorisation or GMRES.
+      if (!solved && fall_back_to_double())
+        solved = linear_solver->factorize(matrix) && linear_solver->solve(rhs);
+      factorized = factorized_current = solved;
+      return solved;
+    }
+
+    /**
      * A mixed-precision solver whose GMRES failed on a tangent (single
      * precision too coarse for it): replace it by MUMPS in double for the
      * rest of this solver's life. True if it did (the caller retries).
@@ -344,40 +393,11 @@ namespace palpate
         if (factorized_current && linear_solver->exact())
           solved = linear_solver->solve(rhs);
         else if (factorized)
-          {
-            solved = gmres(
-                       system->sparsity(),
-                       matrix,
-                       [this](std::vector<double> &v) {
-                         return linear_solver->solve(v);
-                       },
-                       rhs,
-                       1e-6,
-                       settings.max_krylov_iterations,
-                       krylov_v,
-                       krylov_z) > 0;
-            if (!solved)
-              system->probe_load(x, state.active_displacement, j, rhs);
-          }
+          solved = preconditioned_gmres(rhs, 1e-6) > 0;
         if (!solved)
           {
-            factorized = factorized_current = false;
-            if (!linear_solver->factorize(matrix))
-              return false;
-            factorized = factorized_current = true;
-            solved                          = linear_solver->exact() ?
-                                                linear_solver->solve(rhs) :
-                                                gmres(
-                         system->sparsity(),
-                         matrix,
-                         [this](std::vector<double> &v) {
-                           return linear_solver->solve(v);
-                         },
-                         rhs,
-                         1e-6,
-                         settings.max_krylov_iterations,
-                         krylov_v,
-                         krylov_z) > 0;
+            unsigned int krylov_iterations;
+            solved = factorize_and_solve(rhs, 1e-6, krylov_iterations);
           }
         if (!solved)
           return false;
@@ -478,75 +498,18 @@ namespace palpate
         record.krylov_iterations = 0;
         if (settings.reuse_factorization && factorized)
           {
-            record.krylov_iterations = gmres(
-              system->sparsity(),
-              matrix,
-              [this](std::vector<double> &v) {
-                return linear_solver->solve(v);
-              },
-              step,
-              eta,
-              settings.max_krylov_iterations,
-              krylov_v,
-              krylov_z);
-            record.factorized = record.krylov_iterations == 0;
-            if (record.factorized)
-              {
-                step = residual;
-                for (double &s : step)
-                  s = -s;
-              }
+            record.krylov_iterations = preconditioned_gmres(step, eta);
+            record.factorized        = record.krylov_iterations == 0;
           }
-        if (record.factorized)
+        if (record.factorized &&
+            !factorize_and_solve(step, eta, record.krylov_iterations))
           {
-            factorized         = false;
-            factorized_current = false;
-            bool solved        = linear_solver->factorize(matrix);
-            if (!solved && fall_back_to_double())
-              solved = linear_solver->factorize(matrix);
-            if (solved && linear_solver->exact())
-              solved = linear_solver->solve(step);
-            else if (solved)
-              {
-                // Mixed precision: the fresh single-precision factors
-                // precondition GMRES on this very tangent, which then
-                // converges in one to three iterations to the same
-                // tolerance as the reused ones.
-                record.krylov_iterations = gmres(
-                  system->sparsity(),
-                  matrix,
-                  [this](std::vector<double> &v) {
-                    return linear_solver->solve(v);
-                  },
-                  step,
-                  eta,
-                  settings.max_krylov_iterations,
-                  krylov_v,
-                  krylov_z);
-                solved = record.krylov_iterations > 0;
-                if (!solved && fall_back_to_double())
-                  {
-                    step = residual;
-                    for (double &v : step)
-                      v = -v;
-                    solved = linear_solver->factorize(matrix) &&
-                             linear_solver->solve(step);
-                  }
-              }
-            if (!solved)
-              {
-                outcome.status     = SolveStatus::linear_solver_failure;
-                outcome.iterations = iteration;
-                outcome.message =
-                  linear_solver->message().empty() ?
-                    "GMRES preconditioned by the single-precision "
-                    "factorisation of the tangent did not converge (use "
-                    "Linear solver / Solver = MUMPS)" :
-                    linear_solver->message();
-                return outcome;
-              }
-            factorized         = true;
-            factorized_current = true;
+            outcome.status     = SolveStatus::linear_solver_failure;
+            outcome.iterations = iteration;
+            outcome.message    = linear_solver->message().empty() ?
+                                   "GMRES did not converge" :
+                                   linear_solver->message();
+            return outcome;
           }
         record.solve_time = seconds_since(start);
 
