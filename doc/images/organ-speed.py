@@ -50,6 +50,6 @@ ax.plot([4000 * 4.33], [100], "v", color="black", label="target 100 ms (4,000 no
 ax.set_xlabel("unknowns (Mooney-Rivlin P1-P1 with contact multipliers)")
 ax.set_ylabel("median state from a neighbour, one core (ms)")
 ax.set_title("Liver + 1 cm sphere: cost of a state against the mesh")
-ax.legend(fontsize=8)
+ax.legend(fontsize=7.5, loc="upper left")
 fig.tight_layout()
 fig.savefig(sys.argv[-1], dpi=110)

@@ -892,7 +892,8 @@ namespace palpate
           "factorisations and solves on large meshes; if GMRES fails with "
           "it, the state solver changes to MUMPS for good); 'by size' "
           "chooses MUMPS below 5,000 equations and MUMPS single from 5,000 "
-          "on (a state 8 % faster at 6,965 equations, 30 % at 16,980, "
+          "on (a state 9-13 % faster at 5,358-6,965 equations, 30-43 % at "
+          "16,980, "
           "doc/benchmarks/organ-speed.md). UMFPACK and KLU through "
           "SuiteSparse; the Amesos variants through Trilinos Amesos, for "
           "comparison. All analyse the sparsity pattern once per solver.");

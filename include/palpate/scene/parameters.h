@@ -300,8 +300,8 @@ namespace palpate
 
       /** With "by size": the number of equations from which single-precision
        * factors (MUMPS single, in GMRES) beat double ones (measured on the
-       * liver meshes: 8 % faster states at 6,965 equations, 30 % at
-       * 16,980, the same forces to 1e-9). */
+       * liver meshes: states 9-13 % faster at 5,358-6,965 equations,
+       * 30-43 % at 16,980, the same forces to 1e-9). */
       static constexpr unsigned int single_from = 5000;
 
       /** The solver used for a system of @p n_equations: solver, or with
