@@ -48,7 +48,10 @@ namespace palpate
       for (int r = 1; r < messenger.size(); ++r)
         if (r >= static_cast<int>(lost.size()) || !lost[r])
           messenger.send(r, pack(h));
-      messenger.flush(5);
+      // A lost server had its shutdown when it was lost (lose()); one
+      // that is dead, or still stopped, may never take it, and the client
+      // must not wait for it here.
+      messenger.flush(5, lost);
       servers_released = true;
     }
   } // namespace
@@ -301,6 +304,17 @@ namespace palpate
            << " states only it held are recomputed when needed";
     stats.lost_servers.push_back(what.str());
     replan = true;
+    // It is told to go at once: a server that was only stopped (SIGSTOP,
+    // a machine that froze) and comes back reads this first and exits,
+    // instead of waiting for a client that no longer talks to it, which
+    // kept mpirun from ever returning. The client never waits for this
+    // send to complete (send_shutdown skips lost ranks).
+    {
+      Header h;
+      h.kind = Kind::shutdown;
+      h.flags |= Flags::peers_lost;
+      messenger.send(rank, pack(h));
+    }
     // The survivors stop waiting for what they asked of it.
     for (unsigned int r = 1; r < servers.size(); ++r)
       if (!servers[r].lost)

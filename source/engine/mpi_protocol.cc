@@ -134,7 +134,7 @@ namespace palpate
     bool
     Messenger::send(const int rank, std::vector<char> message)
     {
-      pending.push_back({MPI_REQUEST_NULL, std::move(message)});
+      pending.push_back({MPI_REQUEST_NULL, rank, std::move(message)});
       Pending  &p   = pending.back();
       const int err = MPI_Isend(p.buffer.data(),
                                 static_cast<int>(p.buffer.size()),
@@ -196,14 +196,18 @@ namespace palpate
 
 
     bool
-    Messenger::flush(const double seconds)
+    Messenger::flush(const double seconds, const std::vector<bool> &skip)
     {
+      const auto waited_for = [&skip](const Pending &p) {
+        return p.rank < 0 || p.rank >= static_cast<int>(skip.size()) ||
+               !skip[p.rank];
+      };
       const auto end = std::chrono::steady_clock::now() +
                        std::chrono::duration<double>(seconds);
       while (true)
         {
           progress();
-          if (pending.empty())
+          if (std::none_of(pending.begin(), pending.end(), waited_for))
             return true;
           if (std::chrono::steady_clock::now() > end)
             return false;

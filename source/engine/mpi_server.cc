@@ -20,11 +20,13 @@
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
+#include <sys/types.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <csignal>
 #include <deque>
@@ -42,6 +44,25 @@ namespace palpate
     using Clock = std::chrono::steady_clock;
 
     using Utilities::seconds_since;
+
+    // Freeze this process for @p seconds as a stopped machine would (every
+    // thread, heartbeats included), for tests: a child that touches
+    // nothing of MPI's resumes it.
+    void
+    pause_for(const double seconds)
+    {
+      const pid_t me = getpid();
+      if (fork() == 0)
+        {
+          const timespec t{static_cast<time_t>(seconds),
+                           static_cast<long>((seconds - std::floor(seconds)) *
+                                             1e9)};
+          nanosleep(&t, nullptr);
+          kill(me, SIGCONT);
+          _exit(0);
+        }
+      std::raise(SIGSTOP);
+    }
 
     std::size_t
     bytes_of(const State &s)
@@ -313,6 +334,9 @@ namespace palpate
                     if (faults.die_after_tasks > 0 &&
                         tasks_received >= faults.die_after_tasks)
                       std::raise(SIGKILL); // a crashed machine, for tests
+                    if (faults.pause_after_tasks > 0 &&
+                        tasks_received == faults.pause_after_tasks)
+                      pause_for(faults.pause_seconds); // a frozen one
                     std::lock_guard<std::mutex> lock(shared.mutex);
                     shared.tasks.push_back(h);
                     shared.wake_solver.notify_all();

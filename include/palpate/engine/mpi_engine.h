@@ -95,6 +95,11 @@ namespace palpate
     /** After this many tasks received, the server kills its own process
      * (SIGKILL) as a crashed machine would; 0: never. */
     unsigned int die_after_tasks = 0;
+    /** After this many tasks received, the server stops its own process
+     * (SIGSTOP) as a frozen machine would, and a child process resumes it
+     * (SIGCONT) @p pause_seconds later; 0: never. */
+    unsigned int pause_after_tasks = 0;
+    double       pause_seconds     = 0;
   };
 
   /**

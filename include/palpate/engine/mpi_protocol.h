@@ -156,9 +156,11 @@ namespace palpate
       progress();
 
       /** Wait until every send completed, at most @p seconds; false if
-       * some did not (a peer that died). */
+       * some did not (a peer that died). Sends to a rank r with
+       * @p skip[r] set are not waited for (a peer known to be lost, which
+       * may never take them). */
       bool
-      flush(const double seconds);
+      flush(const double seconds, const std::vector<bool> &skip = {});
 
       /** This rank and the number of ranks. */
       int
@@ -179,6 +181,7 @@ namespace palpate
       struct Pending
       {
         MPI_Request       request;
+        int               rank;
         std::vector<char> buffer;
       };
       MPI_Comm            communicator;
