@@ -187,6 +187,7 @@ every_linear_solver()
 {
   return {{"MUMPS", "METIS"},
           {"MUMPS", "AMD"},
+          {"MUMPS single", "METIS"},
           {"UMFPACK", "METIS"},
           {"KLU", "METIS"},
           {"Amesos MUMPS", "METIS"},

@@ -46,36 +46,34 @@ namespace palpate
     else
       out << system.n_equations() - system.n_multipliers()
           << " displacements, ";
+    // What a 'by size' entry chose for this system, and why.
+    const unsigned int n        = system.n_equations();
+    const auto         why_size = [n](const bool         by_size,
+                              const std::string &entry,
+                              const unsigned int threshold) {
+      if (!by_size)
+        return std::string();
+      return " (" + entry +
+             " = by size: " + (n >= threshold ? "at least " : "fewer than ") +
+             Utilities::to_string(threshold) + " equations)";
+    };
+    const auto &linear = scene.parameters.linear_solver;
     out << system.n_multipliers() << " multipliers)\n"
         << "  linear solver:  " << solver.linear_solver_name()
-        << (scene.parameters.linear_solver.solver == "by size" ?
-              std::string(system.n_equations() >=
-                              Parameters::LinearSolver::single_from ?
-                            " (Solver = by size: at least " :
-                            " (Solver = by size: fewer than ") +
-                Utilities::to_string(Parameters::LinearSolver::single_from) +
-                " equations)" :
-              std::string())
-        << (scene.parameters.linear_solver.ordering == "by size" ?
-              std::string(system.n_equations() >=
-                              Parameters::LinearSolver::metis_from ?
-                            " (Ordering = by size: at least " :
-                            " (Ordering = by size: fewer than ") +
-                Utilities::to_string(Parameters::LinearSolver::metis_from) +
-                " equations)" :
-              std::string())
+        << why_size(linear.solver == "by size",
+                    "Solver",
+                    Parameters::LinearSolver::single_from)
+        << why_size(linear.ordering == "by size",
+                    "Ordering",
+                    Parameters::LinearSolver::metis_from)
         << "\n"
         << "  Newton steps:   "
         << (solver.settings().reuse_factorization ?
               "GMRES preconditioned by a kept factorisation" :
               "a factorisation each")
-        << (scene.parameters.nonlinear_solver.reuse_by_size ?
-              std::string(solver.settings().reuse_factorization ?
-                            " (Reuse factorization = by size: at least " :
-                            " (Reuse factorization = by size: fewer than ") +
-                Utilities::to_string(Parameters::NonlinearSolver::reuse_from) +
-                " equations)" :
-              std::string())
+        << why_size(scene.parameters.nonlinear_solver.reuse_by_size,
+                    "Reuse factorization",
+                    Parameters::NonlinearSolver::reuse_from)
         << "\n"
         << "  active node:    from rest to (" << Utilities::to_string(target, 4)
         << ") m\n";

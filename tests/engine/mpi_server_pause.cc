@@ -30,13 +30,10 @@ main(int argc, char **argv)
   using Clock = std::chrono::steady_clock;
   palpate::Environment env(argc, argv);
 
-  palpate::Scene scene       = shipped_scene("beam.prm");
-  auto          &p           = scene.parameters;
-  p.state_space.grid_spacing = 0.002;
-  p.state_space.extent       = 0.006;
-  p.scheduler.cloud_radius   = 0.0045;
-  p.engine.type              = "mpi";
-  p.engine.server_timeout    = 1;
+  palpate::Scene scene    = small_beam_scene();
+  auto          &p        = scene.parameters;
+  p.engine.type           = "mpi";
+  p.engine.server_timeout = 1;
   p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e6);
   const Body body(scene);
   if (palpate::mpi_rank() > 0)
