@@ -85,6 +85,17 @@ namespace palpate
       Utilities::Point3 step;
       for (unsigned int k = 0; k < 3; ++k)
         step[k] = look_ahead * velocity[k];
+      // At least one grid spacing along the motion: at slow speeds the
+      // look-ahead time covers a fraction of a cell, and the next cell's
+      // corners would count as needed only once the HIP is in that cell,
+      // while a state on a real organ takes seconds (3,976-node liver at
+      // 2 mm/s: the HIP entered a cell whose corners were still
+      // unscheduled, 3.9 s without force; doc/benchmarks/organ-speed.md).
+      // Only the order changes: the cloud itself stays the look-ahead's.
+      const double speed_step = Utilities::norm(step);
+      if (speed_step > 0 && speed_step < h)
+        for (unsigned int k = 0; k < 3; ++k)
+          step[k] *= h / speed_step;
       const double       length = Utilities::norm(step);
       const unsigned int samples =
         std::min(1000u, 1u + static_cast<unsigned int>(4 * length / h));
