@@ -444,10 +444,11 @@ main(int argc, char **argv)
       o.materials = {"mr"};
     }
 
+  // Each lever changes one setting; configuration l applies levers 0..l.
   const std::vector<Lever> levers = {
     {"unchanged",
      "the shipped solver as a 501-node scene sets it: refactorise every "
-     "Newton step, AMF ordering, increments of 2.5 mm",
+     "Newton step, MUMPS in double, AMF ordering, increments of 2.5 mm",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(false);
        p.linear_solver.solver   = "MUMPS";
@@ -456,46 +457,39 @@ main(int argc, char **argv)
      false},
     {"+reuse",
      "GMRES preconditioned by the kept factorisation",
-     [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.set_reuse(true);
-       p.linear_solver.solver   = "MUMPS";
-       p.linear_solver.ordering = "AMF";
-     },
+     [](Parameters::AllParameters &p) { p.nonlinear_solver.set_reuse(true); },
      false},
     {"+metis",
      "METIS nested dissection",
-     [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.set_reuse(true);
-       p.linear_solver.solver   = "MUMPS";
-       p.linear_solver.ordering = "METIS";
-     },
+     [](Parameters::AllParameters &p) { p.linear_solver.ordering = "METIS"; },
      false},
     {"+extrapolation",
      "the states behind on the line extrapolated",
-     [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.set_reuse(true);
-       p.linear_solver.solver   = "MUMPS";
-       p.linear_solver.ordering = "METIS";
-     },
+     [](Parameters::AllParameters &) {},
      true},
     {"+one increment",
      "a grid step (5 mm) in one increment",
      [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.set_reuse(true);
-       p.linear_solver.solver                  = "MUMPS";
-       p.linear_solver.ordering                = "METIS";
        p.nonlinear_solver.max_increment_length = 0.005;
      },
-     true},
+     false},
     {"+single precision",
      "single-precision factors as GMRES's preconditioner (MUMPS single)",
      [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.set_reuse(true);
-       p.linear_solver.solver                  = "MUMPS single";
-       p.linear_solver.ordering                = "METIS";
-       p.nonlinear_solver.max_increment_length = 0.005;
+       p.linear_solver.solver = "MUMPS single";
      },
-     true},
+     false},
+  };
+  // Configuration l: every lever up to l.
+  const auto configuration = [&levers](const unsigned int l) {
+    Lever c = levers[l];
+    c.apply = [&levers, l](Parameters::AllParameters &p) {
+      for (unsigned int i = 0; i <= l; ++i)
+        levers[i].apply(p);
+    };
+    for (unsigned int i = 0; i <= l; ++i)
+      c.extrapolate = c.extrapolate || levers[i].extrapolate;
+    return c;
   };
 
   std::ostringstream results;
@@ -530,7 +524,7 @@ main(int argc, char **argv)
                 std::find(o.levers.begin(), o.levers.end(), l) ==
                   o.levers.end())
               continue;
-            const Lever &lever = levers[l];
+            const Lever lever = configuration(l);
             all.push_back(measure(mesh,
                                   sel,
                                   scene.parameters,
