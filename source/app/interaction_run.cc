@@ -273,6 +273,33 @@ namespace palpate
           output_failures.push_back(file + ": " + e.what());
         }
     };
+    for (const auto &format : p.output.summary_formats)
+      {
+        const std::string file =
+          p.output.directory + "/" + stem + "-summary." + format;
+        write(file, [&] {
+          if (format == "csv")
+            summary.write_csv(file);
+          else
+            summary.write_json(file);
+        });
+      }
+    if (const std::string store = interaction.store_report(); !store.empty())
+      {
+        out << "  state store:   " << store << "\n";
+        if (interaction.store_write_failed())
+          output_failures.push_back("the state store " + p.state_space.store +
+                                    " stopped taking states: " + store);
+      }
+    if (p.effects.force_log)
+      {
+        const std::string file =
+          p.output.directory + "/" + stem + "-forces.csv";
+        write(file, [&] { device.write_force_log(file); });
+      }
+    // The states as VTU come last: they take longest (seconds on a real
+    // organ), and a second Ctrl-C while they are written, which ends the
+    // process at once, must find the force log and summaries on disk.
     if (p.effects.vtu_export)
       {
         // The states the haptic loop used, for ParaView, and an index.
@@ -318,30 +345,6 @@ namespace palpate
                                  std::string())
               << "\n";
         });
-      }
-    for (const auto &format : p.output.summary_formats)
-      {
-        const std::string file =
-          p.output.directory + "/" + stem + "-summary." + format;
-        write(file, [&] {
-          if (format == "csv")
-            summary.write_csv(file);
-          else
-            summary.write_json(file);
-        });
-      }
-    if (const std::string store = interaction.store_report(); !store.empty())
-      {
-        out << "  state store:   " << store << "\n";
-        if (interaction.store_write_failed())
-          output_failures.push_back("the state store " + p.state_space.store +
-                                    " stopped taking states: " + store);
-      }
-    if (p.effects.force_log)
-      {
-        const std::string file =
-          p.output.directory + "/" + stem + "-forces.csv";
-        write(file, [&] { device.write_force_log(file); });
       }
     if (shape)
       out << "  wrote " << p.output.directory << "/" << stem << "-shape.pvd ("

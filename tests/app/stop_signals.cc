@@ -198,6 +198,43 @@ main()
               << std::endl;
     }
 
+  // A second Ctrl-C while the used states are written as VTU (the slowest
+  // output) ends the process at once, as documented; the force log and the
+  // summaries are on disk by then, since they are written before the VTU.
+  {
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() != ".txt")
+        std::filesystem::remove(f.path());
+    std::filesystem::remove(out);
+    auto with_vtu = interaction;
+    with_vtu.push_back("--set");
+    with_vtu.push_back("Effects/VTU export=true");
+    const pid_t pid     = start(with_vtu, out, err);
+    const bool  started = wait_for(out, "; motion starts");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    kill(pid, SIGINT);
+    // The VTU index is the first file the export creates.
+    bool exporting = false;
+    for (unsigned int i = 0; i < 60000 && !exporting; ++i)
+      {
+        exporting = std::filesystem::exists(dir + "/paper-stvk-states.csv");
+        if (!exporting)
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
+      }
+    kill(pid, SIGINT);
+    const int status = wait_status(pid);
+    deallog << "second SIGINT during the VTU export: motion started "
+            << ok(started) << ", export began " << ok(exporting)
+            << ", ended (status 130 or killed by SIGINT) "
+            << ok(status == 130 || status == 1000 + SIGINT)
+            << ", force log written "
+            << ok(force_log(dir + "/paper-stvk-forces.csv").second > 1000)
+            << ", summaries written "
+            << ok(std::filesystem::exists(dir + "/paper-stvk-summary.csv") &&
+                  std::filesystem::exists(dir + "/paper-stvk-summary.json"))
+            << std::endl;
+  }
+
   // Standard output closed (a reader that went away, `| head -1`): the
   // write fails instead of SIGPIPE killing the program; the run stops,
   // writes its files and exits with status 6.
