@@ -265,9 +265,16 @@ namespace palpate
                             "-0.01 for 1 cm down.");
         }
       out << "\n";
-      return run_static_solve(out, scene, mesh, nodes, *target) ?
-               ExitStatus::success :
-               ExitStatus::solve_failed;
+      const int status = run_static_solve(out, scene, mesh, nodes, *target);
+      if (status > 128)
+        {
+          out.flush();
+          std::cerr << "\npalpate: the solve was stopped by a signal; what it "
+                       "reached was printed and its output files were "
+                       "written. Exit status "
+                    << status << ".\n";
+        }
+      return status;
     }
 
     /** The error for a command-line argument palpate does not know. */

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/app/application.h>
 #include <palpate/app/static_solve.h>
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -22,7 +24,7 @@
 
 namespace palpate
 {
-  bool
+  int
   run_static_solve(std::ostream            &out,
                    const Scene             &scene,
                    const Mesh              &mesh,
@@ -76,7 +78,8 @@ namespace palpate
                     Parameters::NonlinearSolver::reuse_from)
         << "\n"
         << "  active node:    from rest to (" << Utilities::to_string(target, 4)
-        << ") m\n";
+        << ") m\n"
+        << std::flush; // the solve can take minutes: say what it does first
 
     // Shape output: the path from rest, a frame per converged increment.
     const std::string stem =
@@ -86,25 +89,40 @@ namespace palpate
     std::vector<std::pair<double, std::string>> frames;
     std::unique_ptr<ShapeFrames>                writer;
     const State                                 rest = solver.rest_state();
+    const auto frame = [&](const State &s, const double t) {
+      char name[64];
+      std::snprintf(name,
+                    sizeof(name),
+                    "-shape-%05u.vtu",
+                    static_cast<unsigned int>(frames.size()));
+      const std::string file = stem + name;
+      writer->write(s.solution, s.force, p.output.directory + "/" + file);
+      frames.emplace_back(t, file);
+    };
     if (p.effects.shape_output)
       {
         std::filesystem::create_directories(p.output.directory);
-        writer           = std::make_unique<ShapeFrames>(mesh, nodes, system);
-        const auto frame = [&](const State &s, const double t) {
-          char name[64];
-          std::snprintf(name,
-                        sizeof(name),
-                        "-shape-%05u.vtu",
-                        static_cast<unsigned int>(frames.size()));
-          const std::string file = stem + name;
-          writer->write(s.solution, s.force, p.output.directory + "/" + file);
-          frames.emplace_back(t, file);
-        };
+        writer = std::make_unique<ShapeFrames>(mesh, nodes, system);
         frame(rest, 0);
-        solver.set_increment_observer(frame);
       }
+    // The last equilibrium on the path, for a report if a stop signal
+    // (Ctrl-C) ends the solve early: its increments can take minutes on a
+    // real organ, and what they reached is worth printing.
+    double            reached = 0;
+    Utilities::Point3 reached_at{{0, 0, 0}}, reached_force{{0, 0, 0}};
+    solver.set_increment_observer([&](const State &s, const double t) {
+      reached       = t;
+      reached_at    = s.active_displacement;
+      reached_force = s.force;
+      if (writer)
+        frame(s, t);
+    });
+    const StopRequest stop;
+    solver.set_stop_check([&stop] { return stop.requested(); });
     const State state = solver.solve(rest, target);
     solver.set_increment_observer(nullptr);
+    solver.set_stop_check(nullptr);
+    const bool stopped = state.status == SolveStatus::stopped;
 
     out
       << "  Newton history (force residual relative to the force scale, after\n"
@@ -142,6 +160,19 @@ namespace palpate
                   " N): the device would clip it. Is the modulus in Pa, the "
                   "push in metres, the mesh's Scale factor right?\n" :
                 std::string());
+    else if (stopped)
+      out << "  STOPPED:        by " << stop.description() << " after "
+          << state.newton_iterations
+          << " Newton iterations, before the state converged (not a failure "
+             "point)\n"
+          << "  reached:        "
+          << (reached > 0 ?
+                Utilities::to_string(100 * reached, 3) +
+                  " % of the path, the active node at (" +
+                  Utilities::to_string(reached_at, 4) + ") m, force there (" +
+                  Utilities::to_string(reached_force, 5) + ") N" :
+                std::string("no increment converged"))
+          << "\n";
     else
       out << "  FAILURE POINT:  " << to_string(state.status) << ": "
           << state.message << "\n  (no force is reported for a failure point)\n"
@@ -212,6 +243,8 @@ namespace palpate
             << state.newton_iterations << "\n";
         out << "  wrote " << file << "\n";
       }
-    return state.converged;
+    if (stopped)
+      return 128 + stop.signal_number();
+    return state.converged ? ExitStatus::success : ExitStatus::solve_failed;
   }
 } // namespace palpate

@@ -29,6 +29,8 @@ namespace palpate
           return "not finite";
         case SolveStatus::linear_solver_failure:
           return "linear solver failure";
+        case SolveStatus::stopped:
+          return "stopped";
       }
     return "unknown";
   }
@@ -343,6 +345,7 @@ namespace palpate
     Parameters::NonlinearSolver                settings;
     double                                     setup_time = 0;
     std::function<void(const State &, double)> observer;
+    std::function<bool()>                      stop_check;
 
     // Work vectors, reused from solve to solve.
     std::vector<double> residual, trial_residual, best_residual, matrix, step,
@@ -453,6 +456,13 @@ namespace palpate
               "the residual or its force scale is not finite (force scale " +
               Utilities::to_string(scale, 3) +
               " N: are the material constants within their physical range?)";
+            return outcome;
+          }
+        if (stop_check && stop_check())
+          {
+            outcome.status     = SolveStatus::stopped;
+            outcome.iterations = iteration;
+            outcome.message    = "a stop was asked for";
             return outcome;
           }
         if (iteration == settings.max_newton_iterations)
@@ -892,7 +902,8 @@ namespace palpate
         const bool    may_cut_back = depth < s.max_cutbacks;
         Impl::Outcome o = impl->newton(x, point(t1), state, may_cut_back);
         state.newton_iterations += o.iterations;
-        if (o.status != SolveStatus::converged && predicted)
+        if (o.status != SolveStatus::converged &&
+            o.status != SolveStatus::stopped && predicted)
           {
             // The extrapolation can overshoot into an unstable region:
             // start again from the last equilibrium.
@@ -921,7 +932,9 @@ namespace palpate
             return true;
           }
         x = saved;
-        if (depth < s.max_cutbacks && o.status != SolveStatus::inverted_element)
+        if (depth < s.max_cutbacks &&
+            o.status != SolveStatus::inverted_element &&
+            o.status != SolveStatus::stopped)
           {
             const double middle = 0.5 * (t0 + t1);
             return increment(t0, middle, depth + 1) &&
@@ -974,6 +987,14 @@ namespace palpate
     std::function<void(const State &, double)> observer)
   {
     impl->observer = std::move(observer);
+  }
+
+
+
+  void
+  StateSolver::set_stop_check(std::function<bool()> stop_check)
+  {
+    impl->stop_check = std::move(stop_check);
   }
 
 

@@ -235,6 +235,49 @@ main()
             << std::endl;
   }
 
+  // `palpate solve` stopped in the middle of a long path (1000 increments):
+  // within a Newton iteration it prints the history and how far it got,
+  // writes the shape output and the force log, and exits 128 + 2.
+  {
+    std::filesystem::remove(out);
+    const pid_t pid     = start({"solve",
+                                 scene,
+                                 "--to",
+                                 "0,0,-0.02",
+                                 "--set",
+                                 "Nonlinear solver/Number of increments=1000",
+                                 "--set",
+                                 "Effects/Force log=true",
+                                 "--set",
+                                 "Effects/Shape output=true",
+                                 "--set",
+                                 "Output/Directory=" + dir},
+                            out,
+                            err);
+    const bool  started = wait_for(out, "active node:    from rest");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    kill(pid, SIGINT);
+    const int         status  = wait_status(pid);
+    const std::string text    = read_file(out);
+    const std::string reached = line_with(text, "reached:");
+    const std::string pvd     = read_file(dir + "/paper-stvk-shape.pvd");
+    const std::string log     = read_file(dir + "/paper-stvk-forces.csv");
+    deallog << "solve, SIGINT: started " << ok(started) << ", exit status "
+            << status << " " << ok(status == 130) << ", STOPPED line "
+            << ok(line_with(text, "STOPPED:").find("by SIGINT") !=
+                  std::string::npos)
+            << ", part of the path reached "
+            << ok(reached.find("% of the path") != std::string::npos &&
+                  reached.find(" 100 %") == std::string::npos)
+            << ", history printed "
+            << ok(text.find("Newton history") != std::string::npos)
+            << ", PVD closed with frames "
+            << ok(pvd.find("</VTKFile>") != std::string::npos &&
+                  count(pvd, "<DataSet") > 1)
+            << ", force log row (not converged) "
+            << ok(log.find(",0,") != std::string::npos) << std::endl;
+  }
+
   // Standard output closed (a reader that went away, `| head -1`): the
   // write fails instead of SIGPIPE killing the program; the run stops,
   // writes its files and exits with status 6.

@@ -20,9 +20,15 @@ namespace palpate
    * increment, the force on the probe, and where the time went. Writes the
    * state as VTU and the force as CSV when the scene's effects ask for it.
    *
-   * Returns whether the state converged.
+   * A stop signal (SIGINT, SIGTERM, SIGHUP) ends the solve within one
+   * Newton iteration: the history, the last equilibrium reached and the
+   * files asked for are written all the same.
+   *
+   * Returns the exit status: ExitStatus::success if the state converged,
+   * ExitStatus::solve_failed at a failure point, 128 + the signal's number
+   * after a stop.
    */
-  bool
+  int
   run_static_solve(std::ostream            &out,
                    const Scene             &scene,
                    const Mesh              &mesh,

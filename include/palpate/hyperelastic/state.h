@@ -24,7 +24,11 @@ namespace palpate
     /** A residual or update became NaN or infinite. */
     not_finite,
     /** The sparse direct solver failed (singular tangent). */
-    linear_solver_failure
+    linear_solver_failure,
+    /** A stop was asked for (StateSolver::set_stop_check()) before the
+     * state converged: says nothing about the body, so never a failure
+     * point to keep. */
+    stopped
   };
 
   /** A short name for @p status, e.g. "max iterations". */

@@ -88,6 +88,16 @@ namespace palpate
     void
     set_increment_observer(std::function<void(const State &, double)> observer);
 
+    /**
+     * Ask @p stop_check before every Newton iteration whether to give up:
+     * if it returns true, solve() returns at once with the last
+     * equilibrium reached on the way and SolveStatus::stopped (no retry,
+     * no cut-back). For `palpate solve` under Ctrl-C, whose increments can
+     * take minutes on a real organ. Null: never (the default).
+     */
+    void
+    set_stop_check(std::function<bool()> stop_check);
+
     const HyperelasticSystem &
     system() const;
 
