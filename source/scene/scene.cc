@@ -1017,6 +1017,22 @@ namespace palpate
     /** Engine / Memory budget (MiB): 1 TiB; beyond, its byte count
      * overflows. */
     constexpr double max_memory_budget = 1 << 20;
+    /** Nonlinear solver / Residual and Increment tolerance: below, round-off
+     * (1e-16 times the condition) keeps Newton from ever converging. */
+    constexpr double min_tolerance = 1e-15;
+    /** Nonlinear solver / Residual tolerance: the force's error is about
+     * this times the force scale; above, it means nothing. */
+    constexpr double max_residual_tolerance = 0.1;
+    /** Nonlinear solver / Increment tolerance: the active node within this
+     * times the body's diameter of its target. */
+    constexpr double max_increment_tolerance = 1e-3;
+    /** Nonlinear solver / Maximum increment length (m), unless 0: a path
+     * of more than 1000 increments is refused, and 1000 of these are
+     * 10 cm, the paper's largest displacement. */
+    constexpr double min_increment_length = 1e-4;
+    /** Material model / Density (kg/m^3): five times the densest element's
+     * (osmium, 22,590); tissue is about 1,000-1,100. */
+    constexpr double max_density = 1e5;
   } // namespace Limits
 
 
@@ -1236,6 +1252,43 @@ namespace palpate
       throw error("Nonlinear solver/Increment tolerance",
                   "the tolerance must be positive",
                   "use e.g. 1e-8.");
+    if (n.residual_tolerance < min_tolerance ||
+        n.residual_tolerance > max_residual_tolerance)
+      throw error("Nonlinear solver/Residual tolerance",
+                  "between " + Utilities::to_string(min_tolerance, 3) +
+                    " and " + Utilities::to_string(max_residual_tolerance, 3) +
+                    ": the force is accurate to about this times the force "
+                    "scale, so above that it means nothing, and below it "
+                    "round-off keeps Newton from ever converging (every "
+                    "state a failure point)",
+                  "use 1e-8 (the default) or what `palpate study` "
+                  "recommends, e.g. 1e-4.");
+    if (n.increment_tolerance < min_tolerance ||
+        n.increment_tolerance > max_increment_tolerance)
+      throw error("Nonlinear solver/Increment tolerance",
+                  "between " + Utilities::to_string(min_tolerance, 3) +
+                    " and " + Utilities::to_string(max_increment_tolerance, 3) +
+                    ": the active node is on its target to this times the "
+                    "body's diameter, so above that the probe is not where "
+                    "the force is computed, and below it round-off keeps "
+                    "Newton from ever converging",
+                  "use 1e-8 (the default).");
+    if (n.max_increment_length > 0 &&
+        n.max_increment_length < min_increment_length)
+      throw error("Nonlinear solver/Maximum increment length",
+                  "0 (no limit) or at least " +
+                    Utilities::to_string(min_increment_length, 3) +
+                    " m (0.1 mm): a path needing more than 1000 increments "
+                    "is refused as a failure point, and 1000 increments of "
+                    "0.1 mm are 10 cm, the paper's largest displacement",
+                  "use 0.01 (the default) or the grid spacing.");
+    if (p.material_model.density > max_density)
+      throw error("Material model/Density",
+                  "at most " + Utilities::to_string(max_density, 3) +
+                    " kg/m^3, five times the densest element's (osmium, "
+                    "22,590): the density is in kg/m^3, and tissue's is "
+                    "about 1,000-1,100",
+                  "use 1060 (liver) or your tissue's density in kg/m^3.");
 
     // State space and cloud.
     if (p.state_space.grid_spacing <= 0)

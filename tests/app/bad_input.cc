@@ -395,7 +395,7 @@ main(int argc, char **argv)
         "iterations.prm",
         beam + "subsection Nonlinear solver\n"
                "  set Maximum Newton iterations = 1000000000\n"
-               "  set Residual tolerance = 1e-300\nend\n");
+               "  set Residual tolerance = 1e-12\nend\n");
   scene("Maximum line search steps = 1000000000",
         "line-search.prm",
         beam + "subsection Nonlinear solver\n"
@@ -404,6 +404,28 @@ main(int argc, char **argv)
         "cutbacks.prm",
         beam + "subsection Nonlinear solver\n"
                "  set Maximum cutbacks = 1000000000\nend\n");
+  // Tolerances that make every state wrong or every state a failure point,
+  // increments too short to reach anything, a density in g/cm^3 x 1e6.
+  scene("Residual tolerance = 1",
+        "tolerance-loose.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Residual tolerance = 1\nend\n");
+  scene("Residual tolerance = 1e-300",
+        "tolerance-tight.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Residual tolerance = 1e-300\nend\n");
+  scene("Increment tolerance = 0.5",
+        "increment-tolerance.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Increment tolerance = 0.5\nend\n");
+  scene("Maximum increment length = 1e-9",
+        "increment-length.prm",
+        beam + "subsection Nonlinear solver\n"
+               "  set Maximum increment length = 1e-9\nend\n");
+  scene("Density = 1e9",
+        "density.prm",
+        beam + "subsection Material model\n"
+               "  set Density = 1e9\nend\n");
   // Paths the file system refuses: a link to itself.
   std::filesystem::remove("loop");
   std::filesystem::create_symlink("loop", "loop");
