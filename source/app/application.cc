@@ -17,6 +17,8 @@
 #include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -534,7 +536,30 @@ namespace palpate
               port = static_cast<int>(
                 number_argument("--port", args[++i], 1, 65535, "8080"));
             else if (args[i] == "--host" && i + 1 < args.size())
-              host = args[++i];
+              {
+                host = args[++i];
+                // An address or a host name: letters, digits, '.', '-',
+                // and ':' '[' ']' for IPv6. An empty one would listen on
+                // every interface without saying so.
+                const bool valid =
+                  !host.empty() && host.size() <= 253 &&
+                  std::all_of(host.begin(), host.end(), [](const char c) {
+                    return std::isalnum(static_cast<unsigned char>(c)) ||
+                           c == '.' || c == '-' || c == ':' || c == '[' ||
+                           c == ']';
+                  });
+                if (!valid)
+                  throw InputError(
+                    "command line",
+                    0,
+                    "--host '" + host.substr(0, 80) + "'",
+                    host.empty() ? "the address to listen on is empty" :
+                                   "not an address or a host name (letters, "
+                                   "digits, '.', '-'; IPv6 in brackets)",
+                    "give 127.0.0.1 (this machine only, the default), "
+                    "0.0.0.0 (every interface) or one of this machine's "
+                    "addresses.");
+              }
             else
               throw unexpected(args[i]);
           const Scene scene = read_and_report(args[1], settings, out);

@@ -942,6 +942,20 @@ namespace palpate
     std::string
     refusal(const httplib::Request &request, std::string &kind) const
     {
+      // A control character in a header (a NUL, a bare CR or LF) is not
+      // HTTP (RFC 9110, 5.5): whoever sends it is probing for a parser
+      // that reads it differently.
+      for (const auto &[name, value] : request.headers)
+        for (const std::string *text : {&name, &value})
+          for (const char c : *text)
+            if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') ||
+                c == 0x7f)
+              {
+                kind = "malformed";
+                return "the header '" + printable(name, 40) +
+                       "' holds a control character (NUL, CR or LF), which "
+                       "HTTP does not allow";
+              }
       const std::string host      = request.get_header_value("Host");
       const auto        authority = parse_authority(host);
       if (request.headers.count("Host") != 1 || !authority ||
@@ -1121,7 +1135,7 @@ namespace palpate
         if (reason.empty())
           return httplib::Server::HandlerResponse::Unhandled;
         s.refuse(req, kind, reason);
-        res.status = 403;
+        res.status = kind == "malformed" ? 400 : 403;
         res.set_header("Connection", "close");
         res.set_content("refused: " + reason + "\n", "text/plain");
         return httplib::Server::HandlerResponse::Handled;
@@ -1569,7 +1583,9 @@ namespace palpate
     o << "  refused:           " << total << " requests";
     if (total > 0)
       {
-        o << " (403; by what was wrong:";
+        o << (refusal.count("malformed") > 0 ? " (403, malformed 400;" :
+                                               " (403;")
+          << " by what was wrong:";
         for (const auto &[kind, count] : refusal)
           o << " " << kind << " " << count
             << (&kind == &refusal.rbegin()->first ? ")" : ",");

@@ -624,6 +624,10 @@ namespace palpate
           m.file_name = std::filesystem::absolute(options.finer_mesh).string();
           finer_name  = std::filesystem::path(options.finer_mesh).stem();
           finer       = f;
+          // Read it and select its nodes now: a file that is not a mesh
+          // of this organ is an input error before the reference solves,
+          // not after them.
+          const Body check(f);
         }
       else if (m.source == "file")
         {

@@ -358,7 +358,12 @@ namespace palpate
     const bool server_trouble =
       cause == MissingCause::not_computed && s.engine->degraded();
     bool held = false;
-    if (s.in_contact && cause != MissingCause::none)
+    // Missing data is an event while in contact; a failure region or the
+    // state space's edge also before it (the HIP got there before any cell
+    // was complete: zero force, with nothing to hold, is reported too).
+    const bool event = cause != MissingCause::none &&
+                       (s.in_contact || cause != MissingCause::not_computed);
+    if (event)
       {
         held = (cause != MissingCause::not_computed || server_trouble) &&
                finite && s.hold.valid();
@@ -377,7 +382,8 @@ namespace palpate
               s.event_position[d].store(finite ? position[d] : 0.0,
                                         std::memory_order_relaxed);
             s.event_cause.store(static_cast<std::uint8_t>(cause) |
-                                  (held ? 0x10 : 0),
+                                  (held ? 0x10 : 0) |
+                                  (s.hold.valid() ? 0 : 0x20),
                                 std::memory_order_relaxed);
             s.event_stiffness.store(s.hold.held_stiffness(),
                                     std::memory_order_relaxed);
@@ -395,7 +401,7 @@ namespace palpate
                                           std::memory_order_relaxed);
       }
     s.previous_held  = held;
-    s.previous_cause = s.in_contact ? cause : MissingCause::none;
+    s.previous_cause = event ? cause : MissingCause::none;
     s.last_cause.store(static_cast<std::uint8_t>(cause),
                        std::memory_order_relaxed);
     s.was_complete = complete;
@@ -613,6 +619,7 @@ namespace palpate
     const std::uint8_t code  = s.event_cause.load(std::memory_order_relaxed);
     const auto         cause = static_cast<MissingCause>(code & 0x0f);
     const bool         held  = code & 0x10;
+    const bool         nothing_held = code & 0x20; // no complete cell before it
     const std::string  why =
       cause == MissingCause::failure_region ?
          "the HIP is in a failure region (no equilibrium was found for a "
@@ -632,7 +639,9 @@ namespace palpate
                " N/mm deeper" :
       cause == MissingCause::not_computed ?
              "the force fades to zero until they are computed" :
-             "the force fades to zero";
+      nothing_held ? "the force is zero: no cell was complete before it, so "
+                     "there is no force to hold" :
+                     "the force fades to zero";
     log << "palpate: missing data at t = " << Utilities::to_string(t, 4)
         << " s, HIP at (" << Utilities::to_string(p, 3) << ") m: " << why
         << "; " << what << (n > 1 ? " (" + std::to_string(n) + " events)" : "")

@@ -234,6 +234,42 @@ namespace palpate
             "trajectory replay (Haptics / Trajectory / File name)",
             "the times do not increase",
             "sort the lines by time; each time must be later than the last.");
+        // A hand on a device stays within reach and moves at most a few
+        // m/s: positions far away or jumps faster than that are a unit
+        // mistake (millimetres, milliseconds), and 1e308 would overflow.
+        constexpr double max_reach = 1;  // m from the first position
+        constexpr double max_speed = 10; // m/s between two lines
+        if (!points.empty())
+          {
+            const Utilities::Point3 x{{v[1], v[2], v[3]}};
+            const double from_first = Utilities::distance(x, points.front());
+            if (!(from_first <= max_reach))
+              throw InputError(
+                filename,
+                number,
+                "trajectory replay (Haptics / Trajectory / File name)",
+                "the position is " +
+                  (std::isfinite(from_first) ?
+                     Utilities::to_string(from_first, 3) + " m" :
+                     std::string("over 1e308 m")) +
+                  " from the first one; a hand on a device moves within "
+                  "about half a metre, and at most " +
+                  Utilities::to_string(max_reach, 3) + " m is accepted",
+                "give the positions in metres (not millimetres).");
+            const double speed =
+              Utilities::distance(x, points.back()) / (v[0] - times.back());
+            if (!(speed <= max_speed))
+              throw InputError(
+                filename,
+                number,
+                "trajectory replay (Haptics / Trajectory / File name)",
+                "from the line before, the probe would move at " +
+                  Utilities::to_string(speed, 3) +
+                  " m/s; a hand moves at most a few m/s, and at most " +
+                  Utilities::to_string(max_speed, 3) + " m/s is accepted",
+                "give the times in seconds and the positions in metres "
+                "(not milliseconds or millimetres).");
+          }
         times.push_back(v[0]);
         points.push_back({{v[1], v[2], v[3]}});
       }

@@ -12,10 +12,14 @@
 #include <boost/property_tree/ptree.hpp>
 #include <boost/property_tree/xml_parser.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -653,15 +657,32 @@ namespace palpate
       }
     std::ifstream in(filename, std::ios::binary);
     if (!in)
-      throw InputError(filename,
-                       0,
-                       "(the scene file itself)",
-                       "the file cannot be opened: " +
-                         std::string(fs::exists(filename, ec) ?
-                                       "it is not readable" :
-                                       "it does not exist"),
-                       "check the path; shipped scenes are in parameters/, "
-                       "e.g. 'palpate parameters/default.prm'.");
+      {
+        // Why, as the file system says it: a missing file is not a loop of
+        // links, a name too long or a missing permission.
+        const int  fd   = ::open(filename.c_str(), O_RDONLY);
+        const int  why  = fd < 0 ? errno : 0;
+        const bool none = why == ENOENT || why == ENOTDIR;
+        if (fd >= 0)
+          ::close(fd);
+        throw InputError(
+          filename.substr(0, 300),
+          0,
+          "(the scene file itself)",
+          "the file cannot be opened: " +
+            std::string(none          ? "it does not exist" :
+                        why == EACCES ? "it is not readable (permissions)" :
+                        why == ELOOP  ? "it is a loop of symbolic links" :
+                        why == ENAMETOOLONG ?
+                                       "the path is longer than the system "
+                                       "allows" :
+                        why != 0 ? std::strerror(why) :
+                                   "it is not readable"),
+          none ? "check the path; shipped scenes are in parameters/, e.g. "
+                 "'palpate parameters/default.prm'." :
+                 "name the scene's .prm file itself (check the links on "
+                 "the way and the permissions).");
+      }
     // A scene is a few kB of text: refuse to read gigabytes by mistake.
     constexpr std::size_t max_bytes = std::size_t(4) << 20;
     std::string           content(max_bytes + 1, '\0');

@@ -19,6 +19,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <climits>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -535,8 +536,23 @@ namespace palpate
     check_store_file(const std::string &file, const bool writing)
     {
       namespace fs = std::filesystem;
-      std::error_code       error;
-      const fs::path        path(file);
+      std::error_code error;
+      const fs::path  path(file);
+      // A writer makes STORE.lock and STORE.creating beside it: their
+      // names, 9 characters longer, must fit the file system's limit too
+      // (NAME_MAX, 255 on Linux), or the failure looks like a full disk.
+      if (const std::size_t n = path.filename().string().size();
+          writing && n + std::strlen(".creating") > NAME_MAX)
+        store_error(file,
+                    "its file name has " + std::to_string(n) +
+                      " characters; palpate makes '" +
+                      path.filename().string().substr(0, 20) +
+                      "....creating' and '....lock' beside it, and a file "
+                      "name may have at most " + std::to_string(NAME_MAX) +
+                      " characters",
+                    "use a name of at most " +
+                      std::to_string(NAME_MAX - std::strlen(".creating")) +
+                      " characters, e.g. 'liver.h5'.");
       const fs::file_status status = fs::status(path, error);
       if (status.type() == fs::file_type::none ||
           (error && status.type() != fs::file_type::not_found))

@@ -200,6 +200,18 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = ms.csv\n  end\nend\n");
+  write_file("far.csv", "t, x, y, z\n0, 0, 0, 0\n1, 0, 0, 1e308\n");
+  scene("a replay position at 1e308 m",
+        "replay-far.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = far.csv\n  end\nend\n");
+  write_file("mm.csv", "t, x, y, z\n0, 0, 0, 0\n0.001, 0, 0, -0.5\n");
+  scene("a replay jump of 0.5 m in 1 ms (500 m/s)",
+        "replay-fast.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = mm.csv\n  end\nend\n");
   scene("Engine / Workers = 1000 (once: accepted, 1,400 deadline misses)",
         "workers.prm",
         beam + "subsection Engine\n  set Workers = 1000\nend\n");
@@ -552,6 +564,17 @@ main(int argc, char **argv)
   // serve --host names the host, not the port (issue 26).
   run("serve --host 10.9.9.9 (not this machine's)",
       "serve good.prm --host 10.9.9.9");
+  run("serve --host '' (empty)", "serve good.prm --host ''");
+  run("serve --host with a space", "serve good.prm --host 'a b'");
+
+  // The scene itself a loop of links: not "does not exist".
+  std::filesystem::remove("scene-loop.prm");
+  std::filesystem::create_symlink("scene-loop.prm", "scene-loop.prm");
+  run("a scene that is a loop of links", "scene-loop.prm");
+  // A store whose name leaves no room for its lock file: not a full disk.
+  run("a state store named with 250 characters",
+      "precompute good.prm --set 'State space/Store=" + std::string(247, 's') +
+        ".h5'");
 
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;

@@ -463,6 +463,30 @@ main(int argc, char **argv)
                                "http://evil.example)") != std::string::npos)
           << std::endl;
 
+  // A header holding a NUL (or another control character) is not HTTP: 400
+  // with the reason, for a read and for a change with everything else right.
+  {
+    const std::string nul(1, '\0');
+    const auto        read = round_trip(
+      port,
+      request("GET", "/frame", host(port) + "X-Probe: a" + nul + "b\r\n"));
+    const auto change =
+      round_trip(port,
+                 request("POST",
+                         "/material",
+                         host(port) + same_origin + command_type + with_token +
+                           "X-Probe: a" + nul + "b\r\n",
+                         "Young's modulus=1e13"));
+    const auto malformed = [](const Answer &a) {
+      return a.status == 400 &&
+             a.body.find("holds a control character") != std::string::npos;
+    };
+    deallog << "a header holding a NUL: a read refused (400) "
+            << ok(malformed(read)) << ", a change refused (400) "
+            << ok(malformed(change)) << ", the modulus still the scene's "
+            << ok(youngs_modulus(server) == 1e5) << std::endl;
+  }
+
   // The page's own requests: same origin, the token, its content type,
   // as the browser sends them. Each change is printed before its answer
   // comes.
@@ -542,8 +566,8 @@ main(int argc, char **argv)
           << ", the refusals: "
           << ok(s.find("  refused:           " +
                        std::to_string(sent_origin + sent_host + read_refusals +
-                                      sent_token + sent_type + 1) +
-                       " requests (403;") != std::string::npos)
+                                      sent_token + sent_type + 1 + 2) +
+                       " requests (403, malformed 400;") != std::string::npos)
           << std::endl;
 
   // Slow clients. 20 send a request line, then a header line every 3 s;

@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include "../tests.h"
@@ -66,14 +67,17 @@ main(int argc, char **argv)
 
   double       smallest = 1e9, at_30 = 0, at_110 = 0;
   bool         finite = true, failure_region = false, outside = false;
-  bool         faded = false;
-  unsigned int steps = 0;
+  bool         faded           = false;
+  double       first_failure_z = 0; // the first depth in a failure region
+  unsigned int steps           = 0;
   for (int i = 1; i <= 220; ++i)
     {
       const double z = -0.0005 * i;
       const Point3 f = computed_and_settled_force(interaction, {{0, 0, z}});
       const auto   c = interaction.missing_cause();
       finite         = finite && all_finite(f);
+      if (c == palpate::MissingCause::failure_region && !failure_region)
+        first_failure_z = z;
       failure_region =
         failure_region || c == palpate::MissingCause::failure_region;
       outside = outside || c == palpate::MissingCause::outside;
@@ -168,4 +172,33 @@ main(int argc, char **argv)
           << (std::abs(edge.work) < 5e-2 * edge.scale ? "yes" : "NO")
           << std::endl;
   interaction.detach();
+
+  // Attached again (nothing held), the HIP straight to where the push met
+  // the failure region, before any complete cell: the force is zero, and
+  // that is reported as missing data with its cause, not passed over.
+  {
+    std::ostringstream events;
+    interaction.poll_events(events); // what the runs above reported
+    const auto before = interaction.summary().missing_events;
+    interaction.attach();
+    const Point3 f =
+      ::settled_force(interaction, {{0, 0, first_failure_z}}, 1000);
+    events.str("");
+    interaction.poll_events(events);
+    deallog
+      << "attached again, straight into the failure region: cause "
+      << (interaction.missing_cause() == palpate::MissingCause::failure_region ?
+            "failure region" :
+            "OTHER")
+      << ", force zero " << (palpate::Utilities::norm(f) == 0 ? "yes" : "NO")
+      << ", a missing-data event counted "
+      << (interaction.summary().missing_events == before + 1 ? "yes" : "NO")
+      << ", and reported with its cause "
+      << (events.str().find("failure region") != std::string::npos &&
+              events.str().find("no force to hold") != std::string::npos ?
+            "yes" :
+            "NO")
+      << std::endl;
+    interaction.detach();
+  }
 }
