@@ -21,6 +21,7 @@
 #include <ifaddrs.h>
 #include <netdb.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -452,9 +453,15 @@ namespace palpate
     class ConnectionThreads : public httplib::TaskQueue
     {
     public:
-      ConnectionThreads(const std::size_t keep, const std::size_t most)
+      /** @p evict, when every thread is taken, closes the connection
+       * that has waited longest for a request (GuardedServer), so that a
+       * new one (the page's) gets a thread; false if there was none. */
+      ConnectionThreads(const std::size_t     keep,
+                        const std::size_t     most,
+                        std::function<bool()> evict)
         : keep(keep)
         , most(most)
+        , evict(std::move(evict))
       {}
 
       ~ConnectionThreads() override
@@ -481,6 +488,13 @@ namespace palpate
             {
               // No more threads to be had: it waits for one.
             }
+        else if (evict)
+          // Every thread taken, most by clients still sending a request:
+          // the slowest are closed, one for each connection that waits
+          // for a thread, and their threads take them.
+          for (std::size_t k = waiting; k < jobs.size(); ++k)
+            if (!evict())
+              break;
         wake.notify_one();
       }
 
@@ -553,6 +567,7 @@ namespace palpate
       }
 
       const std::size_t                      keep, most;
+      const std::function<bool()>            evict;
       std::mutex                             mutex;
       std::condition_variable                wake;
       std::deque<std::function<void()>>      jobs;
@@ -560,6 +575,260 @@ namespace palpate
       std::vector<std::thread::id>           finished;
       std::size_t                            waiting  = 0;
       bool                                   stopping = false;
+    };
+  } // namespace
+
+
+
+  namespace
+  {
+    /**
+     * cpp-httplib's server with a deadline on every request: a client must
+     * send a request whole within @p request_limit seconds of connecting
+     * or of its last answer, or its connection is closed. cpp-httplib's
+     * own read timeout is per read, so a client that sent a header line
+     * every second (slowloris) held a thread for ever, and 300 of them took
+     * every thread. The page's requests come whole at once.
+     *
+     * It serves each connection itself (the same keep-alive loop as
+     * cpp-httplib's, around its process_request()) on a Stream whose reads
+     * end at the deadline; and it knows its connections, so that with
+     * every thread taken the one that has waited longest for its request
+     * can be closed to make room (evict_slowest()).
+     */
+    class GuardedServer : public httplib::Server
+    {
+    public:
+      explicit GuardedServer(const double request_limit)
+        : request_limit(std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double>(request_limit)))
+      {}
+
+      /** Close the connection that has waited longest (at least 0.1 s)
+       * for its request; false if there is none. */
+      bool
+      evict_slowest()
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        Connection                 *slowest = nullptr;
+        const auto                  now     = Clock::now();
+        for (auto &[socket, c] : connections)
+          if (c.waiting && !c.closed &&
+              now - c.waiting_since > std::chrono::milliseconds(100) &&
+              (slowest == nullptr || c.waiting_since < slowest->waiting_since))
+            slowest = &c;
+        if (slowest == nullptr)
+          return false;
+        // The thread serving it sees the end of the stream and returns.
+        ::shutdown(slowest->socket, SHUT_RDWR);
+        slowest->closed = true;
+        ++n_closed;
+        return true;
+      }
+
+      /** Connections closed because a request did not come whole in
+       * time, or to make room. */
+      unsigned int
+      closed_slow() const
+      {
+        return n_closed.load();
+      }
+
+    private:
+      struct Connection
+      {
+        socket_t          socket = -1;
+        Clock::time_point waiting_since;
+        bool              waiting = true, closed = false;
+      };
+
+      /** A socket whose reads end at a deadline (the request's). */
+      class DeadlineStream : public httplib::Stream
+      {
+      public:
+        DeadlineStream(const socket_t sock, const Clock::duration write_limit)
+          : sock(sock)
+          , write_limit(write_limit)
+        {}
+
+        Clock::time_point deadline;
+        bool              late = false;
+
+        bool
+        is_readable() const override
+        {
+          return wait(POLLIN, deadline);
+        }
+
+        bool
+        is_writable() const override
+        {
+          return wait(POLLOUT, Clock::now() + write_limit);
+        }
+
+        ssize_t
+        read(char *ptr, size_t size) override
+        {
+          if (!wait(POLLIN, deadline))
+            {
+              late = true;
+              return -1;
+            }
+          ssize_t n;
+          do
+            n = ::recv(sock, ptr, size, 0);
+          while (n < 0 && errno == EINTR);
+          return n;
+        }
+
+        ssize_t
+        write(const char *ptr, size_t size) override
+        {
+          if (!is_writable())
+            return -1;
+          ssize_t n;
+          do
+            n = ::send(sock, ptr, size, MSG_NOSIGNAL);
+          while (n < 0 && errno == EINTR);
+          return n;
+        }
+
+        void
+        get_remote_ip_and_port(std::string &ip, int &port) const override
+        {
+          address(::getpeername, ip, port);
+        }
+
+        void
+        get_local_ip_and_port(std::string &ip, int &port) const override
+        {
+          address(::getsockname, ip, port);
+        }
+
+        socket_t
+        socket() const override
+        {
+          return sock;
+        }
+
+      private:
+        const socket_t        sock;
+        const Clock::duration write_limit;
+
+        bool
+        wait(const short events, const Clock::time_point until) const
+        {
+          for (;;)
+            {
+              const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(
+                  until - Clock::now())
+                  .count();
+              if (left <= 0)
+                return false;
+              pollfd    p{sock, events, 0};
+              const int r = ::poll(&p, 1, static_cast<int>(left));
+              if (r > 0)
+                return true;
+              if (r == 0 || errno != EINTR)
+                return false;
+            }
+        }
+
+        void
+        address(int (*get)(int, sockaddr *, socklen_t *),
+                std::string &ip,
+                int         &port) const
+        {
+          sockaddr_storage a{};
+          socklen_t        length           = sizeof a;
+          char             host[NI_MAXHOST] = {}, service[NI_MAXSERV] = {};
+          if (get(sock, reinterpret_cast<sockaddr *>(&a), &length) == 0 &&
+              ::getnameinfo(reinterpret_cast<sockaddr *>(&a),
+                            length,
+                            host,
+                            sizeof host,
+                            service,
+                            sizeof service,
+                            NI_NUMERICHOST | NI_NUMERICSERV) == 0)
+            {
+              ip   = host;
+              port = std::atoi(service);
+            }
+        }
+      };
+
+      bool
+      process_and_close_socket(socket_t sock) override
+      {
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          connections[sock] = {sock, Clock::now(), true, false};
+        }
+        const auto seconds = [](const time_t s, const time_t us) {
+          return std::chrono::duration_cast<Clock::duration>(
+            std::chrono::seconds(s) + std::chrono::microseconds(us));
+        };
+        DeadlineStream stream(sock,
+                              seconds(write_timeout_sec_, write_timeout_usec_));
+        const auto read_limit = seconds(read_timeout_sec_, read_timeout_usec_);
+        const auto keep_alive = seconds(keep_alive_timeout_sec_, 0);
+        bool       result     = false;
+        for (std::size_t left = keep_alive_max_count_; left > 0; --left)
+          {
+            // Kept alive: the next request's first byte within the
+            // keep-alive time (checking now and then that the server
+            // still runs); then the whole request within request_limit.
+            const auto start = Clock::now();
+            bool       ready = false;
+            while (!ready && is_running() && Clock::now() - start < keep_alive)
+              {
+                pollfd p{sock, POLLIN, 0};
+                ready = ::poll(&p, 1, 100) > 0;
+              }
+            if (!ready)
+              break;
+            stream.deadline =
+              std::min(start + request_limit, Clock::now() + read_limit);
+            bool closed = false;
+            result      = process_request(stream,
+                                     left == 1 || !is_running(),
+                                     closed,
+                                     [this, sock](httplib::Request &) {
+                                       set_waiting(sock, false);
+                                     });
+            if (stream.late)
+              {
+                std::lock_guard<std::mutex> lock(mutex);
+                if (!connections[sock].closed)
+                  ++n_closed;
+              }
+            if (!result || closed || stream.late)
+              break;
+            set_waiting(sock, true);
+          }
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          connections.erase(sock);
+        }
+        ::shutdown(sock, SHUT_RDWR);
+        ::close(sock);
+        return result;
+      }
+
+      void
+      set_waiting(const socket_t sock, const bool waiting)
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        auto                       &c = connections[sock];
+        c.waiting                     = waiting;
+        c.waiting_since               = Clock::now();
+      }
+
+      const Clock::duration          request_limit;
+      std::mutex                     mutex;
+      std::map<socket_t, Connection> connections;
+      std::atomic<unsigned int>      n_closed{0};
     };
   } // namespace
 
@@ -1110,8 +1379,11 @@ namespace palpate
       return refused;
     }
 
-    httplib::Server server;
-    std::thread     http, device;
+    /** A request must come whole within this many seconds of connecting
+     * or of the last answer (keep-alive waits 1 s for its first byte). */
+    static constexpr double request_limit = 3;
+    GuardedServer           server{request_limit};
+    std::thread             http, device;
   };
 
 
@@ -1401,10 +1673,18 @@ namespace palpate
     // every 3 s held every thread); one that sends nothing for 1 s
     // before a request, or pauses 2 s within one (the page's requests
     // come whole; cpp-httplib's default would wait 5 s), or does not take
-    // an answer for 5 s, is closed. A kept-alive connection serves up to
+    // an answer for 5 s, is closed; so is one whose request has not come
+    // whole 3 s after it connected or got its last answer (GuardedServer:
+    // a header line every second held a thread for ever), and with every
+    // thread taken, the one that has waited longest for its request is
+    // closed to make room. A kept-alive connection serves up to
     // 100 requests (the page asks 30 times a second; the default, 5, made
     // it connect again six times a second).
-    server.new_task_queue = [] { return new ConnectionThreads(8, 256); };
+    server.new_task_queue = [&s] {
+      return new ConnectionThreads(8, 256, [&s] {
+        return s.server.evict_slowest();
+      });
+    };
     server.set_keep_alive_timeout(1);
     server.set_keep_alive_max_count(100);
     server.set_read_timeout(2, 0);
