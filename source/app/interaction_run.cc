@@ -24,50 +24,43 @@
 
 namespace palpate
 {
-  namespace
+  void
+  check_output_directory(const Scene &scene)
   {
-    /**
-     * That Output / Directory exists or can be created, and takes files:
-     * an InputError naming the entry if not.
-     */
-    void
-    check_output_directory(const Scene &scene)
-    {
-      const std::string &directory = scene.parameters.output.directory;
-      std::string        problem;
-      try
+    const std::string &directory = scene.parameters.output.directory;
+    std::string        problem;
+    try
+      {
+        std::filesystem::create_directories(directory);
+        const std::string probe = directory + "/.palpate-write-test";
         {
-          std::filesystem::create_directories(directory);
-          const std::string probe = directory + "/.palpate-write-test";
-          {
-            std::ofstream test(probe);
-            test << "test\n";
-            test.flush();
-            if (!test)
-              problem = "files cannot be written in it";
-          }
-          std::filesystem::remove(probe);
+          std::ofstream test(probe);
+          test << "test\n";
+          test.flush();
+          if (!test)
+            problem = "files cannot be written in it";
         }
-      catch (const std::filesystem::filesystem_error &e)
-        {
-          // error_code: the path may be one the file system refuses
-          // altogether (a loop of links).
-          std::error_code error;
-          problem = std::string("it cannot be created: ") + e.code().message() +
-                    (std::filesystem::exists(directory, error) &&
-                         !std::filesystem::is_directory(directory, error) ?
-                       " (a file of that name is in the way)" :
-                       "");
-        }
-      if (!problem.empty())
-        throw scene.error("Output/Directory",
-                          "the scene writes files (shape output, force log "
-                          "or summaries) into '" +
-                            directory + "', but " + problem,
-                          "name a directory you can write, e.g. 'output', or "
-                          "turn those outputs off.");
-    }
-  } // namespace
+        std::filesystem::remove(probe);
+      }
+    catch (const std::filesystem::filesystem_error &e)
+      {
+        // error_code: the path may be one the file system refuses
+        // altogether (a loop of links).
+        std::error_code error;
+        problem = std::string("it cannot be created: ") + e.code().message() +
+                  (std::filesystem::exists(directory, error) &&
+                       !std::filesystem::is_directory(directory, error) ?
+                     " (a file of that name is in the way)" :
+                     "");
+      }
+    if (!problem.empty())
+      throw scene.error("Output/Directory",
+                        "the scene writes files (shape output, force log "
+                        "or summaries) into '" +
+                          directory + "', but " + problem,
+                        "name a directory you can write, e.g. 'output', or "
+                        "turn those outputs off.");
+  }
 
 
 

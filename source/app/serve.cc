@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/app/application.h>
+#include <palpate/app/interaction_run.h>
 #include <palpate/app/serve.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/base/stop_request.h>
@@ -35,6 +36,7 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <map>
@@ -848,6 +850,14 @@ namespace palpate
       for (auto &a : {&target, &hip, &force})
         for (auto &x : *a)
           x.store(0);
+      force_log = scene.parameters.effects.force_log;
+      if (force_log)
+        {
+          std::size_t n = 1;
+          while (n < 4 * rate)
+            n *= 2;
+          log_ring.resize(n);
+        }
       // The surface: its vertices (rest positions), triangles, and the
       // DoFs of each vertex's displacement.
       const Mesh              &mesh = interaction.mesh();
@@ -1022,6 +1032,22 @@ namespace palpate
               hip[k].store(x[k]);
               force[k].store(f[k]);
             }
+          if (force_log)
+            {
+              const std::size_t h = log_head.load(std::memory_order_relaxed);
+              if (h - log_tail.load(std::memory_order_acquire) <
+                  log_ring.size())
+                {
+                  log_ring[h & (log_ring.size() - 1)] = {
+                    std::chrono::duration<double>(Clock::now() - log_start)
+                      .count(),
+                    x,
+                    f};
+                  log_head.store(h + 1, std::memory_order_release);
+                }
+              else
+                log_dropped.fetch_add(1, std::memory_order_relaxed);
+            }
           cause.store(static_cast<std::uint8_t>(interaction.missing_cause()));
         }
     }
@@ -1126,6 +1152,19 @@ namespace palpate
     // The device's HIP and velocity (device_mutex).
     Utilities::Point3 device_position{{0, 0, 0}}, device_velocity{{0, 0, 0}};
     std::atomic<std::uint8_t> cause{0};
+
+    /** Effects / Force log: a ring the device thread fills (never waiting
+     * or allocating) and write_force_log() empties. */
+    struct LogRow
+    {
+      double            t;
+      Utilities::Point3 x, f;
+    };
+    bool                       force_log = false;
+    std::vector<LogRow>        log_ring; // a power of two long
+    std::atomic<std::size_t>   log_head{0}, log_tail{0};
+    std::atomic<std::uint64_t> log_dropped{0};
+    Clock::time_point          log_start = Clock::now();
     // The engine's counters at the last load sample (frame()).
     struct
     {
@@ -1884,6 +1923,33 @@ namespace palpate
 
 
 
+  std::size_t
+  LiveServer::write_force_log(std::ostream &csv)
+  {
+    Impl             &s    = *impl;
+    const std::size_t head = s.log_head.load(std::memory_order_acquire);
+    std::size_t       tail = s.log_tail.load(std::memory_order_relaxed);
+    const std::size_t n    = head - tail;
+    for (; tail != head; ++tail)
+      {
+        const auto &r = s.log_ring[tail & (s.log_ring.size() - 1)];
+        csv << r.t << "," << r.x[0] << "," << r.x[1] << "," << r.x[2] << ","
+            << r.f[0] << "," << r.f[1] << "," << r.f[2] << "\n";
+      }
+    s.log_tail.store(tail, std::memory_order_release);
+    return n;
+  }
+
+
+
+  std::uint64_t
+  LiveServer::force_log_dropped() const
+  {
+    return impl->log_dropped.load();
+  }
+
+
+
   void
   LiveServer::last(Utilities::Point3 &hip, Utilities::Point3 &force) const
   {
@@ -1902,6 +1968,13 @@ namespace palpate
             const std::string &host,
             const int          port)
   {
+    const auto       &p = scene.parameters;
+    const std::string stem =
+      scene.file().empty() ?
+        "default" :
+        std::filesystem::path(scene.file()).stem().string();
+    if (p.effects.force_log || !p.output.summary_formats.empty())
+      check_output_directory(scene);
     LiveServer server(scene, host, port, 0.05, &out);
     // Listening on every interface: the address to open is this machine's
     // (LiveServer::address()); the others it answers to are listed, since
@@ -1923,27 +1996,80 @@ namespace palpate
            "material constant, shift-click another active node. Ctrl-C "
            "ends.\n"
         << std::flush;
+    if (p.effects.shape_output)
+      out << "Effects / Shape output: not written by palpate serve (the "
+             "browser shows the shape; an interaction run, palpate "
+          << (scene.file().empty() ? "SCENE.prm" : scene.file())
+          << ", records its frames for ParaView).\n";
+    // The force log is written as the view runs, a few times a second
+    // (the device thread only fills a ring): a run that ends however it
+    // ends keeps it.
+    const std::string log_file =
+      p.output.directory + "/" + stem + "-serve-forces.csv";
+    std::ofstream            log;
+    std::size_t              log_rows = 0;
+    std::vector<std::string> failures;
+    if (p.effects.force_log)
+      {
+        log.open(log_file);
+        log << "t_s,x_m,y_m,z_m,fx_N,fy_N,fz_N\n" << std::setprecision(9);
+        out << "Force log: " << log_file
+            << " (t in s since the view started)\n";
+      }
+    out << std::flush;
     // The view runs until a stop signal (Ctrl-C, SIGTERM, SIGHUP: its
     // normal end, status 0) or until nobody can read what it prints.
+    std::string stopped_by;
+    int         stop_signal = 0;
     {
       const StopRequest stop;
       while (!stop.requested() && out)
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        {
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          if (log.is_open() && log)
+            log_rows += server.write_force_log(log);
+        }
+      stopped_by  = stop.requested() ?
+                      "by " + stop.description() + " (the live view's end)" :
+                      "because standard output could not be written";
+      stop_signal = stop.signal_number();
     }
     server.stop();
+    if (log.is_open())
+      {
+        log_rows += server.write_force_log(log);
+        log.close();
+      }
     out << "Live view ended.\n";
-    RunSummary summary = server.interaction().summary();
-    summary.trajectory = "the browser's mouse (palpate serve)";
+    RunSummary summary  = server.interaction().summary();
+    summary.trajectory  = "the browser's mouse (palpate serve)";
+    summary.stopped_by  = stopped_by;
+    summary.stop_signal = stop_signal;
     summary.print(out);
     server.print_summary(out);
+    if (const std::string store = server.interaction().store_report();
+        !store.empty())
+      {
+        out << "  state store:       " << store << "\n";
+        if (server.interaction().store_write_failed())
+          failures.push_back("the state store " + p.state_space.store +
+                             " stopped taking states: " + store);
+      }
+    if (p.effects.force_log)
+      {
+        if (log)
+          out << "  wrote " << log_file << " (" << log_rows << " rows"
+              << (server.force_log_dropped() > 0 ?
+                    ", " + std::to_string(server.force_log_dropped()) +
+                      " ticks not logged: the writer fell behind" :
+                    std::string())
+              << ")\n";
+        else
+          failures.push_back(log_file + ": could not be written whole (is "
+                                        "the disk full?)");
+      }
 
     // The machine-readable summaries, as after an interaction.
-    const auto       &p = scene.parameters;
-    const std::string stem =
-      scene.file().empty() ?
-        "default" :
-        std::filesystem::path(scene.file()).stem().string();
-    std::vector<std::string> failures;
     for (const auto &format : p.output.summary_formats)
       {
         const std::string file =
@@ -1969,7 +2095,7 @@ namespace palpate
           what += "\n  " + f;
         throw OutputError("the live view ended (its summary is above), but " +
                           std::to_string(failures.size()) +
-                          " summary file(s) could not be written:" + what);
+                          " output(s) could not be written:" + what);
       }
     return ExitStatus::success;
   }

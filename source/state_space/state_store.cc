@@ -17,9 +17,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdint>
-#include <climits>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -548,8 +548,8 @@ namespace palpate
                       " characters; palpate makes '" +
                       path.filename().string().substr(0, 20) +
                       "....creating' and '....lock' beside it, and a file "
-                      "name may have at most " + std::to_string(NAME_MAX) +
-                      " characters",
+                      "name may have at most " +
+                      std::to_string(NAME_MAX) + " characters",
                     "use a name of at most " +
                       std::to_string(NAME_MAX - std::strlen(".creating")) +
                       " characters, e.g. 'liver.h5'.");

@@ -278,6 +278,51 @@ main()
             << ok(log.find(",0,") != std::string::npos) << std::endl;
   }
 
+  // `palpate serve`: SIGINT is its normal end (status 0). The summary
+  // names the stop and the state store; the force log, written as the
+  // view runs, has a row per tick; Shape output is said to be not written.
+  {
+    std::filesystem::remove(out);
+    const std::string port      = std::to_string(20000 + getpid() % 20000);
+    const pid_t       pid       = start({"serve",
+                                         scene,
+                                         "--port",
+                                         port,
+                                         "--set",
+                                         "Effects/Force log=true",
+                                         "--set",
+                                         "Effects/Shape output=true",
+                                         "--set",
+                                         "Output/Summary formats=json",
+                                         "--set",
+                                         "State space/Store=" + dir + "/serve.h5",
+                                         "--set",
+                                         "Output/Directory=" + dir},
+                            out,
+                            err);
+    const bool        listening = wait_for(out, "Live view: open");
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+    kill(pid, SIGINT);
+    const int         status = wait_status(pid);
+    const std::string text   = read_file(out);
+    const auto [last, rows]  = force_log(dir + "/paper-stvk-serve-forces.csv");
+    deallog << "serve, SIGINT: listening " << ok(listening) << ", exit status "
+            << status << " " << ok(status == 0) << ", STOPPED line "
+            << ok(line_with(text, "STOPPED:").find("by SIGINT") !=
+                  std::string::npos)
+            << ", state store line "
+            << ok(line_with(text, "state store:").find("serve.h5") !=
+                  std::string::npos)
+            << ", shape output said not written "
+            << ok(text.find("Shape output: not written by palpate serve") !=
+                  std::string::npos)
+            << ", force log: a row per tick for the 2 s "
+            << ok(rows > 1000 && last > 1) << ", JSON names the stop "
+            << ok(read_file(dir + "/paper-stvk-serve-summary.json")
+                    .find("\"stopped_by\": \"by SIGINT") != std::string::npos)
+            << std::endl;
+  }
+
   // Standard output closed (a reader that went away, `| head -1`): the
   // write fails instead of SIGPIPE killing the program; the run stops,
   // writes its files and exits with status 6.

@@ -21,6 +21,14 @@ namespace palpate
    */
   RunSummary
   run_interaction(std::ostream &out, const Scene &scene);
+
+  /**
+   * That the scene's Output / Directory exists or can be created, and
+   * takes files: an InputError naming the entry if not. Before a run that
+   * writes files, so that no work is lost to it at the end.
+   */
+  void
+  check_output_directory(const Scene &scene);
 } // namespace palpate
 
 #endif

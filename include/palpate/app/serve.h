@@ -6,6 +6,8 @@
 
 #include <palpate/base/utilities.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -145,6 +147,21 @@ namespace palpate
     /** Stop serving and the device thread; detach. */
     void
     stop();
+
+    /**
+     * With Effects / Force log: write the rows the device thread logged
+     * since the last call to @p csv (t in s since the view started, the
+     * HIP in m, the force in N, as an interaction's force log), and return
+     * how many. The device thread puts its rows in a ring of 4 s of ticks
+     * and never waits: call this from one thread, a few times a second;
+     * rows that found the ring full are counted (force_log_dropped()).
+     */
+    std::size_t
+    write_force_log(std::ostream &csv);
+
+    /** Force-log rows lost because write_force_log() fell behind. */
+    std::uint64_t
+    force_log_dropped() const;
 
   private:
     struct Impl;
