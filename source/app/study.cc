@@ -627,7 +627,22 @@ namespace palpate
           // Read it and select its nodes now: a file that is not a mesh
           // of this organ is an input error before the reference solves,
           // not after them.
-          const Body check(f);
+          try
+            {
+              const Body check(f);
+            }
+          catch (const InputError &e)
+            {
+              // The file's own problem, but named as what it is here.
+              throw InputError(e.file(),
+                               e.line(),
+                               "--finer-mesh (" + e.entry() + ")",
+                               e.problem(),
+                               "give a finer mesh of the same organ, in the "
+                               "scene's file unit (its Scale factor applies): "
+                               "the study solves the scene on it to measure "
+                               "the mesh's error.");
+            }
         }
       else if (m.source == "file")
         {

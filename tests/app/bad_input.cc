@@ -567,6 +567,12 @@ main(int argc, char **argv)
   run("serve --host '' (empty)", "serve good.prm --host ''");
   run("serve --host with a space", "serve good.prm --host 'a b'");
 
+  // study --finer-mesh with a file that is not a mesh: refused before the
+  // reference solves, not after them.
+  write_file("not-a-mesh.msh", "hello\n");
+  run("study --finer-mesh with a file that is not a mesh",
+      "study good.prm --quick --finer-mesh not-a-mesh.msh");
+
   // The scene itself a loop of links: not "does not exist".
   std::filesystem::remove("scene-loop.prm");
   std::filesystem::create_symlink("scene-loop.prm", "scene-loop.prm");
