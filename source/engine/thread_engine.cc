@@ -62,6 +62,11 @@ namespace palpate
       solvers.swap(built);
     }
 
+    /** A stop check for a solve toward @p target: true once the HIP has
+     * moved away from it (StateSolver::set_stop_check()). */
+    std::function<bool()>
+    left_behind(const unsigned int target) const;
+
     /** The scheduler's view of a point (call with the mutex held). */
     PointKnowledge
     knowledge(const unsigned int p) const
@@ -229,6 +234,30 @@ namespace palpate
 
 
 
+  std::function<bool()>
+  ThreadEngine::Impl::left_behind(const unsigned int target) const
+  {
+    // Left behind: farther from the HIP's predicted path than the cloud
+    // reaches, and than when it started, each by two grid spacings (a
+    // bridge's target lies outside the cloud but gets nearer; a hand that
+    // wavers back and forth must not cancel what it comes back to).
+    const Utilities::Point3 x = grid.position(target);
+    Utilities::Point3       position, velocity;
+    hip.read(position, velocity);
+    const double margin = 2 * grid.spacing();
+    const double limit =
+      std::max(parameters.scheduler.cloud_radius,
+               scheduler.distance_to_path(x, position, velocity)) +
+      margin;
+    return [this, x, limit] {
+      Utilities::Point3 position, velocity;
+      hip.read(position, velocity);
+      return scheduler.distance_to_path(x, position, velocity) > limit;
+    };
+  }
+
+
+
   void
   ThreadEngine::Impl::worker_loop(const unsigned int worker)
   {
@@ -258,6 +287,12 @@ namespace palpate
           start      = now();
           running_since += start;
         }
+
+        // A running state the HIP has moved away from is given up (on a
+        // real organ a state takes seconds, in which a hand moves
+        // centimetres): the worker is free for the states the HIP now
+        // needs. Asked at every Newton iteration.
+        solver.set_stop_check(left_behind(task.target));
 
         // solve() reports numerical failures as failure points; anything
         // else that goes wrong (out of memory, a library error) must not
@@ -290,7 +325,9 @@ namespace palpate
                                       behind.get(),
                                       behind2.get());
                 solved = true;
-                if (result.converged)
+                if (result.status == SolveStatus::stopped)
+                  solved = false; // cancelled: nothing learnt, nothing kept
+                else if (result.converged)
                   {
                     result.history.clear();
                     result.history.shrink_to_fit();
@@ -330,6 +367,11 @@ namespace palpate
           running_since -= start;
           ++finished;
           replan = true;
+          if (result.status == SolveStatus::stopped)
+            {
+              ++stats.cancelled;
+              stats.busy_time += duration;
+            }
           if (solved)
             {
               if (generation != cache.generation())

@@ -211,6 +211,7 @@ namespace palpate
               count("states_computed", s.states_computed),
               count("states_failed", s.states_failed),
               count("tasks_dropped", s.tasks_dropped),
+              count("tasks_cancelled", s.tasks_cancelled),
               count("results_discarded", s.results_discarded),
               count("solver_errors", s.solver_errors),
               real("median_state_ms", s.median_state_ms),
@@ -275,7 +276,8 @@ namespace palpate
       << " ms per state, workers busy " << 100 * worker_busy_fraction
       << " % of the time\n"
       << "  scheduling:        " << tasks_dropped
-      << " queued tasks dropped (left the cloud), " << results_discarded
+      << " queued tasks dropped (left the cloud), " << tasks_cancelled
+      << " running states cancelled (the HIP moved away), " << results_discarded
       << " results discarded (parameters changed)\n"
       << "  cache:             " << corner_hits << " of " << corner_reads
       << " corner reads found a state\n"

@@ -22,7 +22,7 @@ namespace palpate
 
     // The engine.
     unsigned int states_computed = 0, states_failed = 0, tasks_dropped = 0,
-                 results_discarded = 0;
+                 tasks_cancelled = 0, results_discarded = 0;
     /** Solves that threw instead of converging or failing (each is also a
      * failure point), and the last message. */
     unsigned int solver_errors = 0;
