@@ -157,13 +157,24 @@ namespace palpate
     bool         moving         = p.haptics.trajectory.start == "immediately";
     unsigned int cloud_states   = 0;
     bool         cloud_complete = false;
+    // Start = after rest neighbourhood: the motion waits only for the 27
+    // grid points around rest, the rest of the cloud comes during it.
+    const bool neighbourhood =
+      p.haptics.trajectory.start == "after rest neighbourhood";
+    const auto ready = [&] {
+      return neighbourhood ? interaction.rest_neighbourhood_missing() == 0 :
+                             interaction.initial_cloud_complete();
+    };
     if (moving)
       loop.start_motion();
     else
       out << "  initial cloud: " << interaction.initial_cloud_size()
           << " grid points around the rest position; the motion starts when "
-             "they are computed (at most "
-          << wait_limit
+          << (neighbourhood ?
+                "the 27 around it are computed (Start = after rest "
+                "neighbourhood; the others during the motion)" :
+                "they are computed")
+          << " (at most " << wait_limit
           << " s: Haptics / Trajectory / Initial cloud time "
              "limit)\n"
           << std::flush;
@@ -195,8 +206,7 @@ namespace palpate
             loop.join();
             break;
           }
-        if (!moving && t > next_progress &&
-            !interaction.initial_cloud_complete())
+        if (!moving && t > next_progress && !ready())
           {
             const auto counts = interaction.cache().counts();
             out << "  initial cloud: " << counts.first << " of "
@@ -206,7 +216,7 @@ namespace palpate
                 << std::flush;
             next_progress += 10;
           }
-        if (!moving && (interaction.initial_cloud_complete() || t > wait_limit))
+        if (!moving && (ready() || t > wait_limit))
           {
             const auto counts = interaction.cache().counts();
             cloud_states      = counts.first;
@@ -214,6 +224,10 @@ namespace palpate
             out << "  initial cloud: " << counts.first << " states computed, "
                 << counts.second << " failure points, in "
                 << std::setprecision(3) << t << " s"
+                << (neighbourhood && t <= wait_limit ?
+                      " (the 27 grid points around rest are there; the "
+                      "rest of the cloud is computed during the motion)" :
+                      std::string())
                 << (t > wait_limit ?
                       " (not complete after Initial cloud time limit = " +
                         Utilities::to_string(wait_limit, 4) +

@@ -471,6 +471,26 @@ namespace palpate
 
 
   unsigned int
+  Interaction::rest_neighbourhood_missing() const
+  {
+    const Impl     &s      = *impl;
+    const GridIndex rest   = s.grid.nearest({{0, 0, 0}});
+    unsigned int    absent = 0;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k)
+          {
+            const GridIndex g{{rest[0] + i, rest[1] + j, rest[2] + k}};
+            if (s.grid.contains(g) &&
+                s.cache.status(s.grid.linear(g)) == PointStatus::missing)
+              ++absent;
+          }
+    return absent;
+  }
+
+
+
+  unsigned int
   Interaction::initial_cloud_size() const noexcept
   {
     return impl->cloud_size;

@@ -1142,17 +1142,24 @@ namespace palpate
                           "scene file's directory.");
         prm.declare_entry("Start",
                           "after initial cloud",
-                          Patterns::Selection(
-                            "after initial cloud|immediately"),
+                          Patterns::Selection("after initial cloud|after rest "
+                                              "neighbourhood|immediately"),
                           "When the motion starts: once the initial cloud "
                           "around the rest position is computed (the "
-                          "paper's protocol), or at once.");
+                          "paper's protocol); once the 27 grid points "
+                          "around it are (every cell that touches the rest "
+                          "position: the hand can move a grid spacing in any "
+                          "direction on complete data, and the rest of the "
+                          "cloud is computed during the motion; on a big "
+                          "organ, where a state takes seconds, a twentieth "
+                          "of the wait); or at once.");
         prm.declare_entry(
           "Initial cloud time limit",
           "120",
           Patterns::Double(0, 3600),
-          "With Start = after initial cloud: the longest the motion waits "
-          "for the initial cloud (s); then it starts anyway, and the run "
+          "With Start = after initial cloud (or after rest neighbourhood): "
+          "the longest the motion waits for the initial cloud (or the rest "
+          "neighbourhood) (s); then it starts anyway, and the run "
           "says so. Every state of the cloud (Scheduler / Cloud radius) "
           "around the rest position, at the scene's cost per state, divided "
           "by the workers: a large organ or cloud needs more than the "

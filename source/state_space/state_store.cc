@@ -1135,7 +1135,8 @@ namespace palpate
       int error = fstat(reserve_fd, &st) == 0 ? 0 : errno;
       // posix_fallocate returns the error; glibc writes zeros where the
       // file system cannot allocate.
-      if (error == 0 && st.st_size < eoa + 2 * record + 64 * 1024)
+      if (error == 0 &&
+          static_cast<std::uint64_t>(st.st_size) < eoa + 2 * record + 64 * 1024)
         error = posix_fallocate(reserve_fd, 0, target);
       return error == 0 ? "" : std::strerror(error);
     }

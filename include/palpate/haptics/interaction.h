@@ -136,6 +136,13 @@ namespace palpate
     bool
     initial_cloud_complete() const;
 
+    /** How many of the 27 grid points around the rest position (the
+     * corners of every cell that touches it) are neither computed nor
+     * failure points yet (Haptics / Trajectory / Start = after rest
+     * neighbourhood waits for 0). */
+    unsigned int
+    rest_neighbourhood_missing() const;
+
     /** The number of grid points in the cloud around the rest position:
      * the states computed before the motion starts. */
     unsigned int

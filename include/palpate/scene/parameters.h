@@ -394,7 +394,8 @@ namespace palpate
       double       radius;
       unsigned int seed;
       std::string  file_name;
-      /** "after initial cloud" or "immediately". */
+      /** "after initial cloud", "after rest neighbourhood" or
+       * "immediately". */
       std::string start;
       /** The longest wait for the initial cloud before the motion starts
        * anyway (s). */
