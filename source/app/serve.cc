@@ -155,24 +155,6 @@ namespace palpate
       return s.str();
     }
 
-    /** @p text as a JSON string (quotes, backslashes and control
-     * characters escaped). */
-    std::string
-    json_string(const std::string &text)
-    {
-      std::ostringstream s;
-      s << '"';
-      for (const char c : text)
-        if (c == '"' || c == '\\')
-          s << '\\' << c;
-        else if (static_cast<unsigned char>(c) < 0x20)
-          s << ' ';
-        else
-          s << c;
-      s << '"';
-      return s.str();
-    }
-
     std::string
     json_number(const double x)
     {
@@ -912,8 +894,9 @@ namespace palpate
         << ",\"spacing\":" << grid.spacing()
         << ",\"extent\":" << grid.spacing() * grid.half_width()
         << ",\"diameter\":" << mesh.diameter()
-        << ",\"scene\":" << json_string(interaction.scene().file());
-      m << ",\"engine\":" << json_string(interaction.summary().engine);
+        << ",\"scene\":" << Utilities::json_string(interaction.scene().file());
+      m << ",\"engine\":"
+        << Utilities::json_string(interaction.summary().engine);
       mesh_json = m.str();
       describe_active();
       displacement.assign(3 * surface.size(), 0.0);
@@ -1354,7 +1337,7 @@ namespace palpate
       std::lock_guard<std::mutex> lock(mutex);
       const auto &material = interaction.scene().parameters.material_model;
       std::ostringstream m;
-      m << "{\"model\":" << json_string(material.model_name)
+      m << "{\"model\":" << Utilities::json_string(material.model_name)
         << ",\"constants\":{";
       const auto found = material.models.find(material.model_name);
       if (found != material.models.end())
@@ -1362,8 +1345,8 @@ namespace palpate
           bool first = true;
           for (const auto &[entry, value] : found->second)
             {
-              m << (first ? "" : ",") << json_string(entry) << ":"
-                << json_string(value);
+              m << (first ? "" : ",") << Utilities::json_string(entry) << ":"
+                << Utilities::json_string(value);
               first = false;
             }
         }

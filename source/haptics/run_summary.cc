@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/base/utilities.h>
 #include <palpate/haptics/run_summary.h>
 
 #include <algorithm>
@@ -81,87 +82,6 @@ namespace palpate
       return std::string(buffer, result.ptr);
     }
 
-    /**
-     * @p text as a JSON string (RFC 8259, section 7): quotes, backslashes
-     * and every control character below 0x20 escaped (the short forms
-     * where JSON has them, \u00XX otherwise). JSON text must be UTF-8
-     * (section 8.1), and a scene path may hold any bytes: a byte that does
-     * not belong to a valid UTF-8 sequence becomes U+FFFD.
-     */
-    std::string
-    json_string(const std::string &text)
-    {
-      std::string out = "\"";
-      for (std::size_t i = 0; i < text.size(); ++i)
-        {
-          const auto c = static_cast<unsigned char>(text[i]);
-          switch (c)
-            {
-              case '"':
-                out += "\\\"";
-                continue;
-              case '\\':
-                out += "\\\\";
-                continue;
-              case '\b':
-                out += "\\b";
-                continue;
-              case '\f':
-                out += "\\f";
-                continue;
-              case '\n':
-                out += "\\n";
-                continue;
-              case '\r':
-                out += "\\r";
-                continue;
-              case '\t':
-                out += "\\t";
-                continue;
-              default:
-                break;
-            }
-          if (c < 0x20)
-            {
-              static const char hex[] = "0123456789abcdef";
-              out += "\\u00";
-              out += hex[c >> 4];
-              out += hex[c & 0xf];
-              continue;
-            }
-          if (c < 0x80)
-            {
-              out += static_cast<char>(c);
-              continue;
-            }
-          // A multi-byte UTF-8 sequence: a lead byte 110xxxxx, 1110xxxx or
-          // 11110xxx and that many continuation bytes 10xxxxxx, not an
-          // overlong form, a surrogate or beyond U+10FFFF.
-          const unsigned int length = c >= 0xc2 && c <= 0xdf ? 2 :
-                                      c >= 0xe0 && c <= 0xef ? 3 :
-                                      c >= 0xf0 && c <= 0xf4 ? 4 :
-                                                               0;
-          bool               valid  = length > 0 && i + length <= text.size();
-          for (unsigned int k = 1; valid && k < length; ++k)
-            valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
-          if (valid && length > 2)
-            {
-              const auto second = static_cast<unsigned char>(text[i + 1]);
-              valid             = !(c == 0xe0 && second < 0xa0) && // overlong
-                      !(c == 0xed && second > 0x9f) &&             // surrogate
-                      !(c == 0xf0 && second < 0x90) &&             // overlong
-                      !(c == 0xf4 && second > 0x8f);               // > U+10FFFF
-            }
-          if (valid)
-            {
-              out.append(text, i, length);
-              i += length - 1;
-            }
-          else
-            out += "\\ufffd";
-        }
-      return out + "\"";
-    }
 
     /** A JSON value: numbers bare, NaN and infinities null (JSON has no
      * such numbers), text escaped. */
@@ -171,7 +91,7 @@ namespace palpate
       switch (f.kind)
         {
           case Field::Kind::text:
-            return json_string(f.text);
+            return Utilities::json_string(f.text);
           case Field::Kind::real:
             return std::isfinite(f.real) ? shortest(f.real) : "null";
           default:
@@ -375,8 +295,8 @@ namespace palpate
     const auto f = fields(*this);
     out << "{\n";
     for (std::size_t i = 0; i < f.size(); ++i)
-      out << "  " << json_string(f[i].key) << ": " << json_value(f[i])
-          << (i + 1 < f.size() ? "," : "") << "\n";
+      out << "  " << Utilities::json_string(f[i].key) << ": "
+          << json_value(f[i]) << (i + 1 < f.size() ? "," : "") << "\n";
     out << "}\n";
     out.close();
     if (!out)

@@ -90,6 +90,15 @@ namespace palpate
      */
     Point3
     parse_point(const std::string &text);
+
+    /**
+     * @p text as a JSON string, quotes included (RFC 8259, section 7):
+     * quotes, backslashes and every control character escaped, bytes that
+     * are not valid UTF-8 as U+FFFD. The one JSON escaper of the run
+     * summaries and the live view.
+     */
+    std::string
+    json_string(const std::string &text);
   } // namespace Utilities
 } // namespace palpate
 
