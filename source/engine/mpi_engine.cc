@@ -172,6 +172,11 @@ namespace palpate
     void
     fetch_wanted_states();
 
+    /** Send Kind::cancel for the running or queued tasks the HIP has moved
+     * away from (cancel_limit). */
+    void
+    cancel_left_behind();
+
     Parameters::AllParameters parameters;
     const StateGrid          &grid;
     StateCache               &cache;
@@ -189,6 +194,10 @@ namespace palpate
     // r), and which server computes it (its rank, or 0).
     std::vector<std::uint64_t> holders;
     std::vector<int>           in_progress;
+    // For each dispatched task: the distance from the HIP's predicted path
+    // beyond which it is cancelled (left_behind()), and whether the cancel
+    // was sent.
+    std::map<unsigned int, std::pair<double, bool>> cancel_limit;
     // States the client asked for (lazy transfer to the shape output):
     // when, and from whom.
     std::map<unsigned int, std::pair<Clock::time_point, int>> requested;
@@ -286,6 +295,7 @@ namespace palpate
           {
             what << " " << t;
             in_progress[t] = 0;
+            cancel_limit.erase(t);
             --busy;
             ++finished;
           }
@@ -377,6 +387,14 @@ namespace palpate
                 stats.transfer_seconds.push_back(h.fetch_seconds);
                 holders[h.source] |= bit(from);
               }
+            cancel_limit.erase(h.point);
+            if (static_cast<SolveStatus>(h.status) == SolveStatus::stopped)
+              {
+                // Cancelled (the HIP moved away): nothing learnt.
+                ++stats.cancelled;
+                stats.busy_time += h.duration;
+                break;
+              }
             const bool converged = h.flags & Flags::converged;
             if (h.generation != cache.generation())
               ++stats.discarded;
@@ -441,6 +459,27 @@ namespace palpate
         default:
           break;
       }
+  }
+
+
+
+  void
+  MpiEngine::Impl::cancel_left_behind()
+  {
+    Utilities::Point3 position, velocity;
+    hip.read(position, velocity);
+    for (auto &[point, limit] : cancel_limit)
+      if (!limit.second && in_progress[point] != 0 &&
+          scheduler.distance_to_path(grid.position(point), position, velocity) >
+            limit.first)
+        {
+          Header h;
+          h.kind  = Kind::cancel;
+          h.point = point;
+          // Not sent (the server is being lost): its result never comes
+          // either, and lose() plans the point again.
+          limit.second = messenger.send(in_progress[point], pack(h));
+        }
   }
 
 
@@ -567,6 +606,14 @@ namespace palpate
           s.task_start = Clock::now();
         s.tasks.push_back(task.target);
         in_progress[task.target] = rank;
+        // Cancelled once farther from the predicted path than the cloud
+        // reaches, and than now, each by two grid spacings (as the thread
+        // engine's workers do).
+        cancel_limit[task.target] = {
+          std::max(parameters.scheduler.cloud_radius,
+                   scheduler.distance_to_path(x, position, velocity)) +
+            2 * grid.spacing(),
+          false};
         ++busy;
         free.erase(chosen);
       }
@@ -665,6 +712,7 @@ namespace palpate
 
           if (attached && (replan || t >= next_tick))
             {
+              cancel_left_behind();
               plan_and_dispatch();
               if (t >= next_tick)
                 next_tick = std::max(next_tick + period, t);

@@ -97,6 +97,13 @@ namespace palpate
       std::deque<std::pair<unsigned int, int>> to_request;
       std::set<unsigned int>                   failed, transferred;
 
+      // Points whose tasks the client cancelled (Kind::cancel): the
+      // running solve stops at its next Newton iteration, a queued one
+      // ends at once; both report SolveStatus::stopped.
+      std::set<unsigned int> cancelled;
+      // The point being solved now (~0u: none).
+      unsigned int solving = ~0u;
+
       // Messages the solver thread wants sent (the communicator sends).
       std::deque<std::pair<Header, std::shared_ptr<const State>>> outbox;
     };
@@ -202,6 +209,14 @@ namespace palpate
           result.holder     = task.holder;
           result.generation = task.generation;
 
+          // Cancelled while it waited here: it ends at once.
+          if (shared.cancelled.erase(task.point) > 0)
+            {
+              result.status = static_cast<std::int32_t>(SolveStatus::stopped);
+              shared.outbox.emplace_back(result, nullptr);
+              continue;
+            }
+
           // The source: the rest state, one held here, or one fetched
           // from its holder through the communicator.
           std::shared_ptr<const State> source = held(task.source);
@@ -246,12 +261,17 @@ namespace palpate
             }
 
           // Solve, with the lock released: the communicator answers
-          // requests meanwhile.
+          // requests meanwhile, and may cancel it.
+          shared.solving = task.point;
           lock.unlock();
           const Utilities::Point3 target{
             {task.position[0], task.position[1], task.position[2]}};
           const auto start = Clock::now();
           State      state;
+          solver->set_stop_check([&shared, point = task.point] {
+            std::lock_guard<std::mutex> guard(shared.mutex);
+            return shared.cancelled.count(point) > 0;
+          });
           try
             {
               state =
@@ -267,6 +287,8 @@ namespace palpate
           result.status            = static_cast<std::int32_t>(state.status);
           result.newton_iterations = state.newton_iterations;
           lock.lock();
+          shared.solving = ~0u;
+          shared.cancelled.erase(task.point);
 
           if (state.converged)
             {
@@ -397,6 +419,20 @@ namespace palpate
                       else
                         ++it;
                     shared.wake_solver.notify_all();
+                    break;
+                  }
+                case Kind::cancel:
+                  {
+                    // Only a task this server has (queued or running): a
+                    // cancel that crossed the result on the way is moot.
+                    std::lock_guard<std::mutex> lock(shared.mutex);
+                    const bool queued = std::any_of(shared.tasks.begin(),
+                                                    shared.tasks.end(),
+                                                    [&](const Header &t) {
+                                                      return t.point == h.point;
+                                                    });
+                    if (queued || shared.solving == h.point)
+                      shared.cancelled.insert(h.point);
                     break;
                   }
                 case Kind::shutdown:

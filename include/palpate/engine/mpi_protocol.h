@@ -57,7 +57,10 @@ namespace palpate
       /** client -> server: the server `holder` was lost; whatever is asked
        * of it will not come (a partitioned server's peers would otherwise
        * wait 10 s for each source it held). */
-      peer_lost
+      peer_lost,
+      /** client -> server: give up the task for point (the HIP moved away
+       * from it); its result comes with SolveStatus::stopped. */
+      cancel
     };
 
     /** Bits of Header::flags. */

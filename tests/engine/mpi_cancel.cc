@@ -1,0 +1,113 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// A running state the HIP has moved away from is given up, with the MPI
+// engine (issue 25; the threaded engine: engine/cancel_left_behind): the
+// client sends the server a cancel, the server's solve stops at its next
+// Newton iteration (a queued task ends when its turn comes) and reports it
+// stopped. The client and two solver servers on the paper's liver, each
+// state made slow (40 increments, about a second):
+// - the HIP moves 4 mm while states run (less than two grid spacings
+//   beyond the cloud): nothing is cancelled;
+// - the HIP jumps 9 cm away: the states running near rest are cancelled
+//   within a Newton iteration (the workers free in well under the time a
+//   state takes); a cancelled state is neither a state nor a failure point
+//   (the cache holds only converged states, no failure point), and it is
+//   counted as cancelled, not failed.
+
+#include <palpate/engine/hip_channel.h>
+#include <palpate/engine/mpi_engine.h>
+#include <palpate/mesh/mesh.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
+
+#include <chrono>
+#include <thread>
+
+#include "../tests.h"
+
+namespace
+{
+  using Clock = std::chrono::steady_clock;
+
+  /** Wait at most @p seconds for @p done(); the seconds it took, or -1. */
+  template <typename Predicate>
+  double
+  wait_for(const Predicate &done, const double seconds)
+  {
+    const auto start = Clock::now();
+    while (!done())
+      {
+        const double t =
+          std::chrono::duration<double>(Clock::now() - start).count();
+        if (t > seconds)
+          return -1;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+
+  palpate::Scene scene            = shipped_scene("paper-stvk.prm");
+  auto          &p                = scene.parameters;
+  p.nonlinear_solver.n_increments = 40;
+  p.engine.type                   = "mpi";
+  p.engine.task_timeout           = 600;
+  const Body body(scene);
+  if (palpate::mpi_rank() > 0)
+    return palpate::run_solver_server(scene, body.mesh, body.nodes);
+
+  initlog();
+  palpate::StateGrid  grid(p.state_space.grid_spacing, p.state_space.extent);
+  palpate::StateCache cache(grid, 1 << 28);
+  palpate::HipChannel hip;
+  palpate::MpiEngine  engine(p, grid, cache, hip);
+
+  engine.start();
+  // Both servers on the cloud around rest.
+  const bool busy = wait_for([&] { return engine.load().busy >= 2; }, 60) >= 0;
+  hip.write({{0.004, 0, 0}}, {{0, 0, 0}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  const auto near = engine.statistics();
+  deallog << "both servers busy: " << ok(busy)
+          << "; the HIP moves 4 mm: nothing cancelled "
+          << ok(near.cancelled == 0) << ", states still computed "
+          << ok(near.computed > 0) << std::endl;
+
+  // The time one state takes here (the median of those computed).
+  std::vector<double> durations;
+  for (const auto &t : near.tasks)
+    if (t.converged)
+      durations.push_back(t.duration);
+  std::sort(durations.begin(), durations.end());
+  const double state_time =
+    durations.empty() ? 0 : durations[durations.size() / 2];
+
+  // Away: the running states are left behind.
+  wait_for([&] { return engine.load().busy >= 2; }, 60);
+  const unsigned int before = engine.statistics().cancelled;
+  hip.write({{0, 0, -0.09}}, {{0, 0, 0}});
+  const double freed =
+    wait_for([&] { return engine.statistics().cancelled >= before + 1; }, 60);
+  engine.stop();
+  const auto stats = engine.statistics();
+  deallog << "the HIP jumps 9 cm away: running states cancelled "
+          << ok(stats.cancelled >= 1) << ", within a fifth of a state's time "
+          << ok(freed >= 0 && freed < 0.2 * state_time) << std::endl;
+  deallog << "no failure point published " << ok(cache.counts().second == 0)
+          << ", none counted " << ok(stats.failed == 0)
+          << ", every cached state converged ";
+  bool converged = true;
+  for (unsigned int q = 0; q < grid.size(); ++q)
+    if (const auto s = cache.state(q))
+      converged = converged && s->converged;
+  deallog << ok(converged) << std::endl;
+  std::cout << "state time " << state_time << " s, freed after " << freed
+            << " s, cancelled " << stats.cancelled << std::endl;
+}
