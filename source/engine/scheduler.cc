@@ -50,37 +50,15 @@ namespace palpate
 
 
 
-  std::vector<Task>
-  Scheduler::plan(const Utilities::Point3                           &hip,
-                  const Utilities::Point3                           &velocity,
-                  const std::function<PointKnowledge(unsigned int)> &knowledge,
-                  const unsigned int                                 max_tasks,
-                  const bool allow_bridge) const
+  std::vector<std::pair<unsigned int, double>>
+  Scheduler::path_corners(const Utilities::Point3 &hip,
+                          const Utilities::Point3 &velocity) const
   {
-    std::vector<Task> candidates;
-    if (max_tasks == 0)
-      return candidates;
-
-    // The grid box around the path, widened by the radius (clamped in
-    // floating point before the conversion: the host controls the HIP).
-    const double h = grid.spacing(), n = grid.half_width();
-    GridIndex    low, high;
-    for (unsigned int k = 0; k < 3; ++k)
-      {
-        const double a = hip[k], b = hip[k] + look_ahead * velocity[k];
-        if (!std::isfinite(a) || !std::isfinite(b))
-          return candidates;
-        low[k] = static_cast<int>(
-          std::clamp(std::floor((std::min(a, b) - radius) / h), -n, n));
-        high[k] = static_cast<int>(
-          std::clamp(std::ceil((std::max(a, b) + radius) / h), -n, n));
-      }
-
     // The cells the HIP is in and will pass through along its predicted
-    // path (located as the interpolation locates it): their corners come
-    // before everything else, in the order the HIP will need them (the arc
-    // length to the first point of the path in their cell).
+    // path (located as the interpolation locates it), and the arc length
+    // to the first point of the path in their cell.
     std::vector<std::pair<unsigned int, double>> needed; // (point, arc)
+    const double                                 h = grid.spacing();
     {
       Utilities::Point3 step;
       for (unsigned int k = 0; k < 3; ++k)
@@ -125,6 +103,42 @@ namespace palpate
                                }),
                    needed.end());
     }
+    return needed;
+  }
+
+
+
+  std::vector<Task>
+  Scheduler::plan(const Utilities::Point3                           &hip,
+                  const Utilities::Point3                           &velocity,
+                  const std::function<PointKnowledge(unsigned int)> &knowledge,
+                  const unsigned int                                 max_tasks,
+                  const bool allow_bridge) const
+  {
+    std::vector<Task> candidates;
+    if (max_tasks == 0)
+      return candidates;
+
+    // The grid box around the path, widened by the radius (clamped in
+    // floating point before the conversion: the host controls the HIP).
+    const double h = grid.spacing(), n = grid.half_width();
+    GridIndex    low, high;
+    for (unsigned int k = 0; k < 3; ++k)
+      {
+        const double a = hip[k], b = hip[k] + look_ahead * velocity[k];
+        if (!std::isfinite(a) || !std::isfinite(b))
+          return candidates;
+        low[k] = static_cast<int>(
+          std::clamp(std::floor((std::min(a, b) - radius) / h), -n, n));
+        high[k] = static_cast<int>(
+          std::clamp(std::ceil((std::max(a, b) + radius) / h), -n, n));
+      }
+
+    // The cells the HIP is in and will pass through along its predicted
+    // path: their corners come before everything else, in the order the
+    // HIP will need them.
+    const std::vector<std::pair<unsigned int, double>> needed =
+      path_corners(hip, velocity);
     const auto needed_at = [&](const unsigned int p) {
       const auto it = std::lower_bound(needed.begin(),
                                        needed.end(),

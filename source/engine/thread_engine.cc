@@ -67,6 +67,18 @@ namespace palpate
     std::function<bool()>
     left_behind(const unsigned int target) const;
 
+    /**
+     * With every worker busy and corners of the HIP's cell or of the cells
+     * on its predicted path waiting (Task::corner, first in the queue):
+     * give up as many running states as wait, of those that are no such
+     * corner (Scheduler::path_corners()), the farthest from the path
+     * first. On a real organ a state takes seconds: a corner that waits
+     * for one is missing data when the hand gets there. (Mutex held.)
+     */
+    void
+    preempt_for_path_corners(const Utilities::Point3 &position,
+                             const Utilities::Point3 &velocity);
+
     /** The scheduler's view of a point (call with the mutex held). */
     PointKnowledge
     knowledge(const unsigned int p) const
@@ -125,12 +137,17 @@ namespace palpate
     std::atomic<bool>        is_running{false};
     bool                     started_once = false;
     std::vector<std::thread> workers;
-    std::thread              scheduler_thread;
-    Clock::time_point        t0;
-    EngineStatistics         stats;
-    EngineFaults             faults;
-    unsigned int             plans  = 0;
-    bool                     failed = false; // the scheduler threw
+    // Per worker: the point it solves (~0u: none; under the mutex), and
+    // whether a corner of the HIP's path asked for the worker (read by the
+    // solve's stop check).
+    std::vector<unsigned int>            solving;
+    std::unique_ptr<std::atomic<bool>[]> preempted;
+    std::thread                          scheduler_thread;
+    Clock::time_point                    t0;
+    EngineStatistics                     stats;
+    EngineFaults                         faults;
+    unsigned int                         plans  = 0;
+    bool                                 failed = false; // the scheduler threw
   };
 
 
@@ -215,6 +232,7 @@ namespace palpate
               }))
             ++stats.dropped;
         queue.assign(plan.begin(), plan.end());
+        preempt_for_path_corners(position, velocity);
         nothing_to_plan  = plan.empty();
         finished_at_plan = finished;
         replan           = false;
@@ -259,6 +277,44 @@ namespace palpate
 
 
   void
+  ThreadEngine::Impl::preempt_for_path_corners(
+    const Utilities::Point3 &position,
+    const Utilities::Point3 &velocity)
+  {
+    if (busy < solvers.size())
+      return; // a worker is free: it takes the corner
+    unsigned int waiting = 0;
+    for (const Task &t : queue)
+      if (t.corner)
+        ++waiting;
+    for (unsigned int w = 0; w < solvers.size(); ++w)
+      if (solving[w] != ~0u && preempted[w].load())
+        waiting = waiting > 0 ? waiting - 1 : 0; // already freeing
+    if (waiting == 0)
+      return;
+    const auto corners = scheduler.path_corners(position, velocity);
+    const auto needed  = [&](const unsigned int p) {
+      return std::binary_search(corners.begin(),
+                                corners.end(),
+                                std::make_pair(p, 0.0),
+                                [](const auto &a, const auto &b) {
+                                  return a.first < b.first;
+                                });
+    };
+    std::vector<std::pair<double, unsigned int>> victims; // (distance, w)
+    for (unsigned int w = 0; w < solvers.size(); ++w)
+      if (solving[w] != ~0u && !preempted[w].load() && !needed(solving[w]))
+        victims.emplace_back(scheduler.distance_to_path(
+                               grid.position(solving[w]), position, velocity),
+                             w);
+    std::sort(victims.rbegin(), victims.rend());
+    for (unsigned int k = 0; k < waiting && k < victims.size(); ++k)
+      preempted[victims[k].second].store(true);
+  }
+
+
+
+  void
   ThreadEngine::Impl::worker_loop(const unsigned int worker)
   {
     // Below the haptic thread: a worker must never delay a haptic tick.
@@ -282,6 +338,8 @@ namespace palpate
           if (!schedulable(knowledge(task.target)))
             continue;
           in_progress[task.target] = 1;
+          solving[worker]          = task.target;
+          preempted[worker].store(false);
           ++busy;
           generation = cache.generation();
           start      = now();
@@ -292,7 +350,10 @@ namespace palpate
         // real organ a state takes seconds, in which a hand moves
         // centimetres): the worker is free for the states the HIP now
         // needs. Asked at every Newton iteration.
-        solver.set_stop_check(left_behind(task.target));
+        solver.set_stop_check(
+          [left = left_behind(task.target), &flag = preempted[worker]] {
+            return flag.load(std::memory_order_relaxed) || left();
+          });
 
         // solve() reports numerical failures as failure points; anything
         // else that goes wrong (out of memory, a library error) must not
@@ -363,6 +424,7 @@ namespace palpate
         {
           std::lock_guard<std::mutex> lock(mutex);
           in_progress[task.target] = 0;
+          solving[worker]          = ~0u;
           --busy;
           running_since -= start;
           ++finished;
@@ -447,6 +509,8 @@ namespace palpate
       s.replan          = false;
       s.bridge.reset();
     }
+    s.solving.assign(s.solvers.size(), ~0u);
+    s.preempted = std::make_unique<std::atomic<bool>[]>(s.solvers.size());
     for (unsigned int w = 0; w < s.solvers.size(); ++w)
       s.workers.emplace_back([&s, w] { s.worker_loop(w); });
     s.scheduler_thread = std::thread([&s] { s.scheduler_loop(); });

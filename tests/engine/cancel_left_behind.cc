@@ -12,9 +12,15 @@
 //   within a Newton iteration (the workers free in well under the time a
 //   state takes); a cancelled state is neither a state nor a failure point
 //   (the cache holds only converged states, no failure point), and it is
-//   counted as cancelled, not failed.
+//   counted as cancelled, not failed;
+// - preemption: with both workers on states of the cloud and the HIP
+//   moving on to cells whose corners are not computed yet (they wait in
+//   the queue: corners of the cells on the predicted path come first), a
+//   running state that is no such corner is given up for them, within a
+//   fifth of a state's time, and the HIP's new cell gets its corners.
 
 #include <palpate/engine/hip_channel.h>
+#include <palpate/engine/scheduler.h>
 #include <palpate/engine/thread_engine.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -105,4 +111,61 @@ main(int argc, char **argv)
   deallog << ok(converged) << std::endl;
   std::cout << "state time " << state_time << " s, freed after " << freed
             << " s, cancelled " << stats.cancelled << std::endl;
+
+  // Preemption for the corners on the HIP's path.
+  {
+    palpate::StateCache      cache(grid, 1 << 28);
+    palpate::HipChannel      hip;
+    palpate::ThreadEngine    engine(body.mesh, body.nodes, p, grid, cache, hip);
+    const palpate::Scheduler scheduler(grid,
+                                       p.scheduler.cloud_radius,
+                                       p.scheduler.look_ahead_time);
+    // Where the HIP goes: 7.5 mm along x, moving on at 10 mm/s.
+    const palpate::Utilities::Point3 x{{0.0075, 0.0025, 0.0025}},
+      v{{0.01, 0, 0}};
+    const auto path    = scheduler.path_corners(x, v);
+    const auto on_path = [&](const unsigned int q) {
+      for (const auto &c : path)
+        if (c.first == q)
+          return true;
+      return false;
+    };
+    engine.start();
+    // Until both workers solve states of the cloud that are not corners
+    // of the cells on that path.
+    const bool ready = wait_for(
+                         [&] {
+                           const auto l = engine.load();
+                           if (l.in_progress.size() != 2)
+                             return false;
+                           for (const unsigned int q : l.in_progress)
+                             if (on_path(q))
+                               return false;
+                           return true;
+                         },
+                         120) >= 0;
+    hip.write(x, v);
+    const double preempted =
+      wait_for([&] { return engine.statistics().cancelled >= 1; }, 60);
+    palpate::GridIndex    cell;
+    std::array<double, 3> local;
+    grid.locate(x, cell, local);
+    const double corners = wait_for(
+      [&] {
+        for (const unsigned int c : grid.corners(cell))
+          if (cache.status(c) != palpate::PointStatus::available)
+            return false;
+        return true;
+      },
+      120);
+    engine.stop();
+    deallog << "preemption: both workers on cloud states off the new path "
+            << ok(ready) << "; the HIP moves on: a running state given up "
+            << ok(preempted >= 0 && preempted < 0.2 * state_time)
+            << ", the HIP's new cell complete " << ok(corners >= 0)
+            << ", no failure point " << ok(cache.counts().second == 0)
+            << std::endl;
+    std::cout << "preempted after " << preempted << " s, cell complete after "
+              << corners << " s" << std::endl;
+  }
 }

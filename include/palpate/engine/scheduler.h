@@ -175,6 +175,16 @@ namespace palpate
              const Utilities::Point3 &hip,
              const Utilities::Point3 &velocity) const;
 
+    /**
+     * The corners of the cells the HIP is in and will pass through (its
+     * predicted path, at least a grid spacing long along the motion), each
+     * with the arc length (m) at which the path first enters one of its
+     * cells; sorted by point. plan() puts these first (Task::corner).
+     */
+    std::vector<std::pair<unsigned int, double>>
+    path_corners(const Utilities::Point3 &hip,
+                 const Utilities::Point3 &velocity) const;
+
     /** Distance of @p x from the predicted path of the HIP (m). */
     double
     distance_to_path(const Utilities::Point3 &x,
