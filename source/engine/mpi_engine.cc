@@ -177,6 +177,17 @@ namespace palpate
     void
     cancel_left_behind();
 
+    /** With @p waiting corners of the HIP's path that found no free
+     * server: cancel as many running tasks that are no such corner, the
+     * farthest from the path first (as the thread engine does); and the
+     * running task of each server in @p queued_corners, which has a
+     * corner in its second place, unless it is a corner itself. */
+    void
+    preempt_for_path_corners(const unsigned int       waiting,
+                             const std::vector<int>  &queued_corners,
+                             const Utilities::Point3 &position,
+                             const Utilities::Point3 &velocity);
+
     Parameters::AllParameters parameters;
     const StateGrid          &grid;
     StateCache               &cache;
@@ -544,11 +555,18 @@ namespace palpate
 
     // Most urgent first; each to a free server that holds its source if
     // there is one (no transfer), else to the first free server, told
-    // which server to fetch the source from.
+    // which server to fetch the source from. Corners of the HIP's path
+    // that find no free server preempt running tasks (below).
+    unsigned int     corners_waiting = 0;
+    std::vector<int> queued_corners; // servers with a corner in second place
     for (const Task &task : plan)
       {
         if (free.empty())
-          break;
+          {
+            corners_waiting +=
+              task.corner && schedulable(knowledge(task.target));
+            continue;
+          }
         if (!schedulable(knowledge(task.target)) || holders[task.source] == 0)
           continue;
         // Among the places of the least loaded servers (an idle server
@@ -604,6 +622,8 @@ namespace palpate
         Server &s = servers[rank];
         if (s.tasks.empty())
           s.task_start = Clock::now();
+        else if (task.corner)
+          queued_corners.push_back(rank); // behind the task it runs
         s.tasks.push_back(task.target);
         in_progress[task.target] = rank;
         // Cancelled once farther from the predicted path than the cloud
@@ -617,6 +637,73 @@ namespace palpate
         ++busy;
         free.erase(chosen);
       }
+    preempt_for_path_corners(corners_waiting,
+                             queued_corners,
+                             position,
+                             velocity);
+  }
+
+
+
+  void
+  MpiEngine::Impl::preempt_for_path_corners(
+    const unsigned int       waiting,
+    const std::vector<int>  &queued_corners,
+    const Utilities::Point3 &position,
+    const Utilities::Point3 &velocity)
+  {
+    if (waiting == 0 && queued_corners.empty())
+      return;
+    const auto corners = scheduler.path_corners(position, velocity);
+    const auto corner  = [&](const unsigned int p) {
+      return std::binary_search(corners.begin(),
+                                corners.end(),
+                                std::make_pair(p, 0.0),
+                                [](const auto &a, const auto &b) {
+                                  return a.first < b.first;
+                                });
+    };
+    const auto cancel = [&](const unsigned int p) {
+      Header h;
+      h.kind  = Kind::cancel;
+      h.point = p;
+      if (messenger.send(in_progress[p], pack(h)))
+        cancel_limit[p].second = true;
+    };
+    // A corner queued behind a task that is none: that task goes.
+    for (const int r : queued_corners)
+      {
+        const unsigned int p = servers[r].tasks.front();
+        if (!corner(p) && !cancel_limit[p].second)
+          cancel(p);
+      }
+    if (waiting == 0)
+      return;
+    // Corners that found no server: the running tasks (each server's
+    // first) that are no corner and not cancelled yet, the farthest from
+    // the path first.
+    std::vector<std::pair<double, unsigned int>> victims; // (distance, point)
+    unsigned int                                 freeing = 0;
+    for (unsigned int r = 1; r < servers.size(); ++r)
+      {
+        const Server &s = servers[r];
+        if (s.lost || s.tasks.empty())
+          continue;
+        const unsigned int p     = s.tasks.front();
+        const auto         limit = cancel_limit.find(p);
+        if (limit != cancel_limit.end() && limit->second.second)
+          {
+            ++freeing;
+            continue;
+          }
+        if (corner(p))
+          continue;
+        victims.emplace_back(
+          scheduler.distance_to_path(grid.position(p), position, velocity), p);
+      }
+    std::sort(victims.rbegin(), victims.rend());
+    for (unsigned int k = 0; k + freeing < waiting && k < victims.size(); ++k)
+      cancel(victims[k].second);
   }
 
 

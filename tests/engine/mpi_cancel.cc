@@ -5,8 +5,9 @@
 // engine (issue 25; the threaded engine: engine/cancel_left_behind): the
 // client sends the server a cancel, the server's solve stops at its next
 // Newton iteration (a queued task ends when its turn comes) and reports it
-// stopped. The client and two solver servers on the paper's liver, each
-// state made slow (40 increments, about a second):
+// stopped; with the path's corners waiting, a server gives up a state that
+// is none (preemption). The client and two solver servers on the paper's liver,
+// each state made slow (40 increments, about a second):
 // - the HIP moves 4 mm while states run (less than two grid spacings
 //   beyond the cloud): nothing is cancelled;
 // - the HIP jumps 9 cm away: the states running near rest are cancelled
@@ -17,6 +18,7 @@
 
 #include <palpate/engine/hip_channel.h>
 #include <palpate/engine/mpi_engine.h>
+#include <palpate/engine/scheduler.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/state_space/state_cache.h>
@@ -88,6 +90,58 @@ main(int argc, char **argv)
   std::sort(durations.begin(), durations.end());
   const double state_time =
     durations.empty() ? 0 : durations[durations.size() / 2];
+
+  // Preemption: with both servers on cloud states off the path the HIP
+  // now takes (7.5 mm along x, moving on at 10 mm/s), the path's corners
+  // that wait make a server give up its state.
+  {
+    const palpate::Scheduler         scheduler(grid,
+                                       p.scheduler.cloud_radius,
+                                       p.scheduler.look_ahead_time);
+    const palpate::Utilities::Point3 x{{0.0075, 0.0025, 0.0025}},
+      v{{0.01, 0, 0}};
+    const auto path    = scheduler.path_corners(x, v);
+    const auto on_path = [&](const unsigned int q) {
+      for (const auto &c : path)
+        if (c.first == q)
+          return true;
+      return false;
+    };
+    hip.write({{0, 0, 0}}, {{0, 0, 0}});
+    const bool ready = wait_for(
+                         [&] {
+                           const auto l = engine.load();
+                           if (l.in_progress.size() < 2)
+                             return false;
+                           for (const unsigned int q : l.in_progress)
+                             if (on_path(q))
+                               return false;
+                           return true;
+                         },
+                         120) >= 0;
+    const unsigned int before = engine.statistics().cancelled;
+    hip.write(x, v);
+    const double preempted =
+      wait_for([&] { return engine.statistics().cancelled > before; }, 60);
+    palpate::GridIndex    cell;
+    std::array<double, 3> local;
+    grid.locate(x, cell, local);
+    const double corners = wait_for(
+      [&] {
+        for (const unsigned int c : grid.corners(cell))
+          if (cache.status(c) != palpate::PointStatus::available)
+            return false;
+        return true;
+      },
+      120);
+    deallog << "preemption: both servers on cloud states off the new path "
+            << ok(ready) << "; the HIP moves on: a running state given up "
+            << ok(preempted >= 0 && preempted < 0.2 * state_time)
+            << ", the HIP's new cell complete " << ok(corners >= 0)
+            << std::endl;
+    std::cout << "preempted after " << preempted << " s, cell complete after "
+              << corners << " s" << std::endl;
+  }
 
   // Away: the running states are left behind.
   wait_for([&] { return engine.load().busy >= 2; }, 60);
