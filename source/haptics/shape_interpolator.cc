@@ -19,11 +19,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -64,7 +66,11 @@ namespace palpate
     unsigned long                 due   = 0; // moving frames, for decimation
     ShapeFrames                   frames;
     std::atomic<bool>             running{false};
-    std::atomic<unsigned int>     written{0}, skipped{0}, busy{0}, over{0},
+    // stop() wakes the thread from its wait for the next frame (at a slow
+    // Shape output rate that wait is minutes long).
+    std::mutex                wait_mutex;
+    std::condition_variable   wake;
+    std::atomic<unsigned int> written{0}, skipped{0}, busy{0}, over{0},
       thinned{0};
     std::string failure; // written by the thread before it ends
     std::vector<std::pair<double, std::string>> records;
@@ -211,7 +217,12 @@ namespace palpate
             busy += static_cast<unsigned int>((now - next) / period);
             next = now;
           }
-        std::this_thread::sleep_until(next);
+        {
+          std::unique_lock<std::mutex> lock(wait_mutex);
+          wake.wait_until(lock, next, [this] { return !running.load(); });
+        }
+        if (!running.load())
+          break;
 
         const double t =
           clock ? clock() :
@@ -350,8 +361,12 @@ namespace palpate
   void
   ShapeInterpolator::stop()
   {
-    if (!impl->running.exchange(false))
-      return;
+    {
+      std::lock_guard<std::mutex> lock(impl->wait_mutex);
+      if (!impl->running.exchange(false))
+        return;
+    }
+    impl->wake.notify_all();
     impl->thread.join();
     const std::string file = impl->directory + "/" + impl->stem + "-shape.pvd";
     std::ofstream     pvd(file);

@@ -244,4 +244,26 @@ main(int argc, char **argv)
               << " bytes" << std::endl;
     std::filesystem::remove_all("limited");
   }
+
+  {
+    // A slow Shape output rate (a frame every 1000 s): stop() wakes the
+    // shape thread from its wait at once (it slept until its next frame,
+    // and an interaction of 1 s then took 1000 s to end).
+    deallog << "--- stop() at a Shape output rate of 1e-3 Hz" << std::endl;
+    std::filesystem::remove_all("slow");
+    palpate::Interaction       interaction(scene);
+    palpate::ShapeInterpolator shape(interaction, 1e-3, "slow", "beam");
+    shape.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const auto start = std::chrono::steady_clock::now();
+    shape.stop();
+    const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+        .count();
+    deallog << "stop() returned within 1 s: " << (took < 1 ? "yes" : "NO")
+            << ", PVD written: "
+            << (std::filesystem::exists("slow/beam-shape.pvd") ? "yes" : "NO")
+            << std::endl;
+    std::filesystem::remove_all("slow");
+  }
 }
