@@ -1492,6 +1492,13 @@ namespace palpate
       throw error("Effects/Shape output rate",
                   "the rate must be positive",
                   "use 30 Hz.");
+    if (p.effects.shape_output && p.effects.shape_output_rate < 1.0 / 3600)
+      throw error("Effects/Shape output rate",
+                  "at least one frame an hour (" +
+                    Utilities::to_string(1.0 / 3600, 3) +
+                    " Hz): a motion lasts at most an hour, so a slower "
+                    "rate writes no frame",
+                  "use 30 Hz.");
     if (p.effects.shape_output &&
         p.effects.shape_output_rate > max_shape_output_rate)
       throw error("Effects/Shape output rate",

@@ -416,6 +416,10 @@ main(int argc, char **argv)
         "cutbacks.prm",
         beam + "subsection Nonlinear solver\n"
                "  set Maximum cutbacks = 1000000000\nend\n");
+  scene("Shape output rate = 1e-15 Hz",
+        "shape-rate.prm",
+        beam + "subsection Effects\n  set Shape output = true\n"
+               "  set Shape output rate = 1e-15\nend\n");
   // Tolerances that make every state wrong or every state a failure point,
   // increments too short to reach anything, a density in g/cm^3 x 1e6.
   scene("Residual tolerance = 1",
