@@ -559,6 +559,11 @@ namespace palpate
                     "give 127.0.0.1 (this machine only, the default), "
                     "0.0.0.0 (every interface) or one of this machine's "
                     "addresses.");
+                // An IPv6 address as a URL writes it, [::1]: the address
+                // itself is inside the brackets.
+                if (host.size() > 2 && host.front() == '[' &&
+                    host.back() == ']')
+                  host = host.substr(1, host.size() - 2);
               }
             else
               throw unexpected(args[i]);

@@ -20,6 +20,7 @@
 #include <functional>
 #include <iomanip>
 #include <ostream>
+#include <sstream>
 #include <thread>
 
 namespace palpate
@@ -265,6 +266,7 @@ namespace palpate
       summary.shape_frames = shape->frames().first;
     out << "\n";
     summary.print(out);
+    out << std::flush; // kept even if a second Ctrl-C ends what follows
 
     // Machine-readable copies and logs, only when asked for.
     const auto write = [&](const std::string           &file,
@@ -316,7 +318,10 @@ namespace palpate
           const HyperelasticSystem system(interaction.mesh(),
                                           interaction.nodes(),
                                           p);
-          std::ofstream            csv(index);
+          // The index is written after the states, and each state under a
+          // temporary name first: a second Ctrl-C meanwhile leaves no
+          // truncated file, only whole states and no index.
+          std::ostringstream csv;
           csv << "point,i,j,k,x_m,y_m,z_m,fx_N,fy_N,fz_N,file\n"
               << std::setprecision(9);
           unsigned int written = 0, not_held = 0;
@@ -332,7 +337,9 @@ namespace palpate
               const std::string file = stem + "-state-" + std::to_string(g[0]) +
                                        "_" + std::to_string(g[1]) + "_" +
                                        std::to_string(g[2]) + ".vtu";
-              system.write_vtu(*state, p.output.directory + "/" + file);
+              const std::string path = p.output.directory + "/" + file;
+              system.write_vtu(*state, path + ".part");
+              std::filesystem::rename(path + ".part", path);
               csv << point << "," << g[0] << "," << g[1] << "," << g[2] << ","
                   << state->active_displacement[0] << ","
                   << state->active_displacement[1] << ","
@@ -341,7 +348,10 @@ namespace palpate
                   << file << "\n";
               ++written;
             }
-          if (!csv)
+          std::ofstream index_file(index);
+          index_file << csv.str();
+          index_file.close();
+          if (!index_file)
             throw std::runtime_error("cannot write '" + index + "'");
           out << "  wrote " << written
               << " states the haptic loop used as VTU (" << stem

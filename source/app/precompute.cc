@@ -140,6 +140,25 @@ namespace palpate
           << " after " << Utilities::to_string(t, 3) << " s: " << c.first
           << " states and " << c.second << " failure points in the cache; "
           << interaction.store_report() << "\n";
+      // Points of the region no state reached: every path to them from
+      // rest passes a failure point (the engine computes a state only from
+      // a converged neighbour), so they are not computed, and said so.
+      if (!stop.requested() && lock.failure().empty())
+        {
+          const auto  &grid        = interaction.grid();
+          unsigned int unreachable = 0;
+          for (unsigned int q = 0; q < grid.size(); ++q)
+            if (Utilities::norm(grid.position(q)) <=
+                  p.scheduler.cloud_radius &&
+                interaction.cache().status(q) == PointStatus::missing)
+              ++unreachable;
+          if (unreachable > 0)
+            out << "  not reached:   " << unreachable << " grid points within "
+                << 1000 * p.scheduler.cloud_radius
+                << " mm: every way to them from rest passes a failure point "
+                   "(a state is computed only from a converged neighbour); "
+                   "status -1 in the ParaView export below\n";
+        }
     }
     // What the store keeps, read back from the file (the interaction has
     // closed it; the lock still keeps other writers out): the number a

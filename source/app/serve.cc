@@ -33,12 +33,14 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -412,7 +414,7 @@ namespace palpate
           if (used == value.size())
             {
               std::ostringstream s;
-              s << x;
+              s << std::setprecision(10) << x;
               return s.str();
             }
         }
@@ -1521,7 +1523,25 @@ namespace palpate
           }
         const std::string entry = Utilities::trim(req.body.substr(0, eq));
         const std::string value = Utilities::trim(req.body.substr(eq + 1));
-        std::string       refused, before;
+        // A number deal.II's pattern takes but cannot convert (1e-320, a
+        // subnormal) or that is not finite: refused here, in words (the
+        // scene file's reader does the same).
+        {
+          char        *end = nullptr;
+          const double x   = std::strtod(value.c_str(), &end);
+          if (!value.empty() && end == value.c_str() + value.size() &&
+              (!std::isfinite(x) ||
+               (x != 0 && std::abs(x) < std::numeric_limits<double>::min())))
+            {
+              res.status = 400;
+              res.set_content("refused: " + entry + " = " + value +
+                                " is not a number palpate can compute with "
+                                "(beyond a double's normal range)",
+                              "text/plain");
+              return;
+            }
+        }
+        std::string refused, before;
         try
           {
             refused = s.change(
@@ -1913,13 +1933,21 @@ namespace palpate
     const std::size_t head = s.log_head.load(std::memory_order_acquire);
     std::size_t       tail = s.log_tail.load(std::memory_order_relaxed);
     const std::size_t n    = head - tail;
+    // The rows in one write, then flushed: a process killed meanwhile
+    // leaves whole rows (a row cut in two by the stream's buffer was what
+    // a SIGKILL left before).
+    std::ostringstream rows;
+    rows << std::setprecision(9);
     for (; tail != head; ++tail)
       {
         const auto &r = s.log_ring[tail & (s.log_ring.size() - 1)];
-        csv << r.t << "," << r.x[0] << "," << r.x[1] << "," << r.x[2] << ","
-            << r.f[0] << "," << r.f[1] << "," << r.f[2] << "\n";
+        rows << r.t << "," << r.x[0] << "," << r.x[1] << "," << r.x[2] << ","
+             << r.f[0] << "," << r.f[1] << "," << r.f[2] << "\n";
       }
     s.log_tail.store(tail, std::memory_order_release);
+    const std::string text = rows.str();
+    csv.write(text.data(), static_cast<std::streamsize>(text.size()));
+    csv.flush();
     return n;
   }
 

@@ -630,6 +630,16 @@ namespace palpate
           try
             {
               const Body check(f);
+              // Not finer than the scene's: the mesh knob would measure
+              // no refinement (0 % differences), which looks like a result.
+              const Mesh scene_mesh = Mesh::create(scene);
+              if (check.mesh.n_vertices() <= scene_mesh.n_vertices())
+                out << "warning: --finer-mesh " << options.finer_mesh
+                    << " has " << check.mesh.n_vertices()
+                    << " nodes, not more than the scene's mesh ("
+                    << scene_mesh.n_vertices()
+                    << "): the mesh knob then measures no refinement. Give a "
+                       "finer mesh of the same organ.\n";
             }
           catch (const InputError &e)
             {

@@ -19,8 +19,14 @@ namespace palpate
     Utilities::Point3
     normalized(const Utilities::Point3 &v)
     {
-      const double n = Utilities::norm(v);
-      return {{v[0] / n, v[1] / n, v[2] / n}};
+      // Scaled by the largest component first: a direction of 1e308 (or
+      // 1e-300) in each component has a norm beyond (below) a double's
+      // range, but a perfectly good direction.
+      const double m =
+        std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+      const Utilities::Point3 u{{v[0] / m, v[1] / m, v[2] / m}};
+      const double            n = Utilities::norm(u);
+      return {{u[0] / n, u[1] / n, u[2] / n}};
     }
   } // namespace
 

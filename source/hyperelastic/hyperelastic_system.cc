@@ -27,6 +27,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 namespace palpate
 {
@@ -1525,10 +1526,14 @@ namespace palpate
     data_out.add_data_vector(scalar, fixed, "fixed");
     data_out.add_data_vector(scalar, active, "active");
     data_out.build_patches(s.mapping, 1);
+    // Into memory first: deal.II asserts on a stream that failed (a full
+    // disk), which is an output error to report, not an internal one.
+    std::ostringstream vtu;
+    data_out.write_vtu(vtu);
     std::ofstream out(filename);
     if (!out)
       throw std::runtime_error("cannot write the file '" + filename + "'");
-    data_out.write_vtu(out);
+    out << vtu.str();
     out.flush();
     if (!out)
       throw std::runtime_error("writing the file '" + filename +

@@ -5,6 +5,8 @@
 // and must exit with status 2 (input error) and a message that names the
 // file, the line if there is one, the entry, and what to do.
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -416,6 +418,15 @@ main(int argc, char **argv)
         "cutbacks.prm",
         beam + "subsection Nonlinear solver\n"
                "  set Maximum cutbacks = 1000000000\nend\n");
+  scene("Shape output limit = 1e303 MiB",
+        "shape-limit.prm",
+        beam + "subsection Effects\n  set Shape output = true\n"
+               "  set Shape output limit = 1e303\nend\n");
+  scene("a smooth random motion of radius 1e308 m",
+        "random-radius.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Type = smooth random\n    set Radius = 1e308\n"
+               "  end\nend\n");
   scene("Shape output rate = 1e-15 Hz",
         "shape-rate.prm",
         beam + "subsection Effects\n  set Shape output = true\n"
@@ -576,6 +587,11 @@ main(int argc, char **argv)
   write_file("not-a-mesh.msh", "hello\n");
   run("study --finer-mesh with a file that is not a mesh",
       "study good.prm --quick --finer-mesh not-a-mesh.msh");
+
+  // A scene that is a FIFO: refused, not waited on for ever.
+  std::filesystem::remove("scene.fifo");
+  if (mkfifo("scene.fifo", 0644) == 0)
+    run("a scene that is a FIFO (named pipe)", "scene.fifo");
 
   // The scene itself a loop of links: not "does not exist".
   std::filesystem::remove("scene-loop.prm");

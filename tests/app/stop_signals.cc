@@ -213,16 +213,32 @@ main()
     const bool  started = wait_for(out, "; motion starts");
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
     kill(pid, SIGINT);
-    // The VTU index is the first file the export creates.
+    // The export has begun once a state's file (or its temporary) is there.
+    const auto exporting_now = [&] {
+      for (const auto &f : std::filesystem::directory_iterator(dir))
+        if (f.path().filename().string().rfind("paper-stvk-state-", 0) == 0)
+          return true;
+      return false;
+    };
     bool exporting = false;
     for (unsigned int i = 0; i < 60000 && !exporting; ++i)
       {
-        exporting = std::filesystem::exists(dir + "/paper-stvk-states.csv");
+        exporting = exporting_now();
         if (!exporting)
           std::this_thread::sleep_for(std::chrono::microseconds(500));
       }
     kill(pid, SIGINT);
     const int status = wait_status(pid);
+    // No state file cut short under its name: every .vtu is whole (one
+    // being written when the signal came is left as NAME.vtu.part).
+    bool no_partial = true;
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() == ".vtu")
+        no_partial =
+          no_partial &&
+          read_file(f.path().string()).find("</VTKFile>") != std::string::npos;
+    const bool summary_kept =
+      read_file(out).find("Run summary") != std::string::npos;
     deallog << "second SIGINT during the VTU export: motion started "
             << ok(started) << ", export began " << ok(exporting)
             << ", ended (status 130 or killed by SIGINT) "
@@ -232,7 +248,8 @@ main()
             << ", summaries written "
             << ok(std::filesystem::exists(dir + "/paper-stvk-summary.csv") &&
                   std::filesystem::exists(dir + "/paper-stvk-summary.json"))
-            << std::endl;
+            << ", the printed summary kept " << ok(summary_kept)
+            << ", no state file cut short " << ok(no_partial) << std::endl;
   }
 
   // `palpate solve` stopped in the middle of a long path (1000 increments):
@@ -359,6 +376,17 @@ main()
                   std::string::npos)
             << ", force log written "
             << ok(std::filesystem::exists(dir + "/paper-stvk-forces.csv"))
+            << std::endl;
+  }
+
+  // --print-parameters on a full device: an output error (it was an
+  // internal error: deal.II asserted on the failed stream).
+  {
+    const pid_t pid    = start({"--print-parameters"}, "/dev/full", err);
+    const int   status = wait_status(pid);
+    deallog << "--print-parameters > /dev/full: exit status " << status << " "
+            << ok(status == 6) << ", no internal error "
+            << ok(read_file(err).find("internal error") == std::string::npos)
             << std::endl;
   }
 
