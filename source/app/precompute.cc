@@ -148,8 +148,7 @@ namespace palpate
           const auto  &grid        = interaction.grid();
           unsigned int unreachable = 0;
           for (unsigned int q = 0; q < grid.size(); ++q)
-            if (Utilities::norm(grid.position(q)) <=
-                  p.scheduler.cloud_radius &&
+            if (Utilities::norm(grid.position(q)) <= p.scheduler.cloud_radius &&
                 interaction.cache().status(q) == PointStatus::missing)
               ++unreachable;
           if (unreachable > 0)

@@ -634,8 +634,8 @@ namespace palpate
               // no refinement (0 % differences), which looks like a result.
               const Mesh scene_mesh = Mesh::create(scene);
               if (check.mesh.n_vertices() <= scene_mesh.n_vertices())
-                out << "warning: --finer-mesh " << options.finer_mesh
-                    << " has " << check.mesh.n_vertices()
+                out << "warning: --finer-mesh " << options.finer_mesh << " has "
+                    << check.mesh.n_vertices()
                     << " nodes, not more than the scene's mesh ("
                     << scene_mesh.n_vertices()
                     << "): the mesh knob then measures no refinement. Give a "
