@@ -23,6 +23,7 @@
 #include <iomanip>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -209,6 +210,8 @@ namespace palpate
     // beyond which it is cancelled (left_behind()), and whether the cancel
     // was sent.
     std::map<unsigned int, std::pair<double, bool>> cancel_limit;
+    // The points whose cancel was a preemption (counted apart).
+    std::set<unsigned int> preempted_points;
     // States the client asked for (lazy transfer to the shape output):
     // when, and from whom.
     std::map<unsigned int, std::pair<Clock::time_point, int>> requested;
@@ -307,6 +310,7 @@ namespace palpate
             what << " " << t;
             in_progress[t] = 0;
             cancel_limit.erase(t);
+            preempted_points.erase(t);
             --busy;
             ++finished;
           }
@@ -401,8 +405,10 @@ namespace palpate
             cancel_limit.erase(h.point);
             if (static_cast<SolveStatus>(h.status) == SolveStatus::stopped)
               {
-                // Cancelled (the HIP moved away): nothing learnt.
-                ++stats.cancelled;
+                // Cancelled (the HIP moved away) or preempted: nothing
+                // learnt.
+                ++(preempted_points.erase(h.point) > 0 ? stats.preempted :
+                                                         stats.cancelled);
                 stats.busy_time += h.duration;
                 break;
               }
@@ -664,6 +670,7 @@ namespace palpate
                                 });
     };
     const auto cancel = [&](const unsigned int p) {
+      preempted_points.insert(p);
       Header h;
       h.kind  = Kind::cancel;
       h.point = p;

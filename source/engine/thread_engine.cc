@@ -65,7 +65,7 @@ namespace palpate
     /** A stop check for a solve toward @p target: true once the HIP has
      * moved away from it (StateSolver::set_stop_check()). */
     std::function<bool()>
-    left_behind(const unsigned int target) const;
+    left_behind(const Task &task) const;
 
     /**
      * With every worker busy and corners of the HIP's cell or of the cells
@@ -253,19 +253,24 @@ namespace palpate
 
 
   std::function<bool()>
-  ThreadEngine::Impl::left_behind(const unsigned int target) const
+  ThreadEngine::Impl::left_behind(const Task &task) const
   {
     // Left behind: farther from the HIP's predicted path than the cloud
-    // reaches, and than when it started, each by two grid spacings (a
+    // reaches, and than when it was planned, each by two grid spacings (a
     // bridge's target lies outside the cloud but gets nearer; a hand that
-    // wavers back and forth must not cancel what it comes back to).
-    const Utilities::Point3 x = grid.position(target);
+    // wavers back and forth must not cancel what it comes back to). When
+    // it was planned, not when it starts: a task queued before the HIP
+    // jumped and taken after it is left behind from its first iteration.
+    // (Task::priority is the distance from the path at the plan, or for a
+    // corner of a cell on the path its arc length there: near, either way.)
+    const Utilities::Point3 x = grid.position(task.target);
     Utilities::Point3       position, velocity;
     hip.read(position, velocity);
     const double margin = 2 * grid.spacing();
     const double limit =
       std::max(parameters.scheduler.cloud_radius,
-               scheduler.distance_to_path(x, position, velocity)) +
+               std::min(task.priority,
+                        scheduler.distance_to_path(x, position, velocity))) +
       margin;
     return [this, x, limit] {
       Utilities::Point3 position, velocity;
@@ -351,7 +356,7 @@ namespace palpate
         // centimetres): the worker is free for the states the HIP now
         // needs. Asked at every Newton iteration.
         solver.set_stop_check(
-          [left = left_behind(task.target), &flag = preempted[worker]] {
+          [left = left_behind(task), &flag = preempted[worker]] {
             return flag.load(std::memory_order_relaxed) || left();
           });
 
@@ -431,7 +436,7 @@ namespace palpate
           replan = true;
           if (result.status == SolveStatus::stopped)
             {
-              ++stats.cancelled;
+              ++(preempted[worker].load() ? stats.preempted : stats.cancelled);
               stats.busy_time += duration;
             }
           if (solved)

@@ -690,7 +690,7 @@ namespace palpate
     r.states_computed        = e.computed;
     r.states_failed          = e.failed;
     r.tasks_dropped          = e.dropped;
-    r.tasks_cancelled        = e.cancelled;
+    r.tasks_cancelled        = e.cancelled + e.preempted;
     r.results_discarded      = e.discarded;
     r.solver_errors          = e.errors;
     r.last_solver_error      = e.last_error;

@@ -197,8 +197,9 @@ namespace palpate
       << " % of the time\n"
       << "  scheduling:        " << tasks_dropped
       << " queued tasks dropped (left the cloud), " << tasks_cancelled
-      << " running states cancelled (the HIP moved away), " << results_discarded
-      << " results discarded (parameters changed)\n"
+      << " running states given up (the HIP moved away, or preempted for "
+         "a corner on its path), "
+      << results_discarded << " results discarded (parameters changed)\n"
       << "  cache:             " << corner_hits << " of " << corner_reads
       << " corner reads found a state\n"
       << "  missing data:      " << missing_events << " events, "

@@ -8,7 +8,8 @@
 // stopped; with the path's corners waiting, a server gives up a state that
 // is none (preemption). The client and two solver servers on the paper's liver,
 // each state made slow (40 increments, about a second):
-// - the HIP moves 4 mm while states run (less than two grid spacings
+// - the HIP moves 4 mm within its cell while states run (less than two grid
+// spacings
 //   beyond the cloud): nothing is cancelled;
 // - the HIP jumps 9 cm away: the states running near rest are cancelled
 //   within a Newton iteration (the workers free in well under the time a
@@ -74,7 +75,21 @@ main(int argc, char **argv)
   engine.start();
   // Both servers on the cloud around rest.
   const bool busy = wait_for([&] { return engine.load().busy >= 2; }, 60) >= 0;
-  hip.write({{0.004, 0, 0}}, {{0, 0, 0}});
+  {
+    // 4 mm, inside the cell the rest position is located in (its corners
+    // were computed first): a move that leaves no corner of the HIP's cell
+    // waiting, so that nothing is preempted either.
+    palpate::GridIndex    rest_cell;
+    std::array<double, 3> local;
+    grid.locate({{0, 0, 0}}, rest_cell, local);
+    palpate::Utilities::Point3 centre = grid.position(rest_cell);
+    for (auto &c : centre)
+      c += 0.5 * grid.spacing();
+    const double n = palpate::Utilities::norm(centre);
+    hip.write(
+      {{0.004 * centre[0] / n, 0.004 * centre[1] / n, 0.004 * centre[2] / n}},
+      {{0, 0, 0}});
+  }
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
   const auto near = engine.statistics();
   deallog << "both servers busy: " << ok(busy)
@@ -119,10 +134,10 @@ main(int argc, char **argv)
                            return true;
                          },
                          120) >= 0;
-    const unsigned int before = engine.statistics().cancelled;
+    const unsigned int before = engine.statistics().preempted;
     hip.write(x, v);
     const double preempted =
-      wait_for([&] { return engine.statistics().cancelled > before; }, 60);
+      wait_for([&] { return engine.statistics().preempted > before; }, 60);
     palpate::GridIndex    cell;
     std::array<double, 3> local;
     grid.locate(x, cell, local);

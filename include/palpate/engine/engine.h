@@ -45,6 +45,7 @@ namespace palpate
     unsigned int failed    = 0; // failure points
     unsigned int dropped   = 0; // queued tasks that fell out of the cloud
     unsigned int cancelled = 0; // running states the HIP moved away from
+    unsigned int preempted = 0; // running states given up for path corners
     unsigned int discarded = 0; // results for a generation that changed
     double       busy_time = 0; // seconds workers spent solving
     /** Solves that threw (out of memory, a library error): counted as
