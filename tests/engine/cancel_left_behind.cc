@@ -89,7 +89,9 @@ main(int argc, char **argv)
       {{0.004 * centre[0] / n, 0.004 * centre[1] / n, 0.004 * centre[2] / n}},
       {{0, 0, 0}});
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  // Until a few states are computed there (however slow the machine is:
+  // the time of a state is measured from them below).
+  wait_for([&] { return engine.statistics().computed >= 4; }, 300);
   const auto near = engine.statistics();
   deallog << "both workers busy: " << ok(busy)
           << "; the HIP moves 4 mm: nothing cancelled "
