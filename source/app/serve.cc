@@ -608,16 +608,7 @@ namespace palpate
         // The thread serving it sees the end of the stream and returns.
         ::shutdown(slowest->socket, SHUT_RDWR);
         slowest->closed = true;
-        ++n_closed;
         return true;
-      }
-
-      /** Connections closed because a request did not come whole in
-       * time, or to make room. */
-      unsigned int
-      closed_slow() const
-      {
-        return n_closed.load();
       }
 
     private:
@@ -783,12 +774,6 @@ namespace palpate
                                      [this, sock](httplib::Request &) {
                                        set_waiting(sock, false);
                                      });
-            if (stream.late)
-              {
-                std::lock_guard<std::mutex> lock(mutex);
-                if (!connections[sock].closed)
-                  ++n_closed;
-              }
             if (!result || closed || stream.late)
               break;
             set_waiting(sock, true);
@@ -814,7 +799,6 @@ namespace palpate
       const Clock::duration          request_limit;
       std::mutex                     mutex;
       std::map<socket_t, Connection> connections;
-      std::atomic<unsigned int>      n_closed{0};
     };
   } // namespace
 
