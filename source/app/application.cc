@@ -164,9 +164,15 @@ namespace palpate
           // until the client, stopping through its normal path, releases
           // it (mpirun kills what is left after its own grace period).
           const StopRequest stop;
-          return run_solver_server(scene, mesh, nodes) == 0 ?
-                   ExitStatus::success :
-                   ExitStatus::internal_error;
+          switch (run_solver_server(scene, mesh, nodes))
+            {
+              case 0:
+                return ExitStatus::success;
+              case 2: // the client was lost (it said so on stderr)
+                return ExitStatus::server_lost;
+              default:
+                return ExitStatus::internal_error;
+            }
         }
       catch (const InputError &)
         {

@@ -55,6 +55,28 @@ namespace palpate
       messenger.flush(5, lost);
       servers_released = true;
     }
+
+
+
+    // Tell every ready server not lost that the client is alive, at most
+    // every 0.1 s (a server that hears nothing from the client for Engine
+    // / Server timeout ends: run_solver_server()).
+    template <typename Servers>
+    void
+    send_heartbeats(Messenger         &messenger,
+                    const Servers     &servers,
+                    Clock::time_point &last)
+    {
+      if (Clock::now() - last < std::chrono::milliseconds(100))
+        return;
+      last = Clock::now();
+      Header beat;
+      beat.kind          = Kind::heartbeat;
+      const auto message = pack(beat);
+      for (unsigned int r = 1; r < servers.size(); ++r)
+        if (servers[r].ready && !servers[r].lost)
+          messenger.send(r, message);
+    }
   } // namespace
 
 
@@ -244,8 +266,10 @@ namespace palpate
     const auto        deadline = Clock::now() + std::chrono::seconds(600);
     unsigned int      ready    = 0;
     std::vector<char> message;
+    Clock::time_point last_beat{};
     while (ready + 1 < servers.size())
       {
+        send_heartbeats(messenger, servers, last_beat);
         int from = 0;
         if (messenger.receive(from, message))
           {
@@ -759,12 +783,14 @@ namespace palpate
       std::chrono::duration<double>(1.0 / parameters.scheduler.rate));
     next_tick = Clock::now();
     std::vector<char> message;
+    Clock::time_point last_beat{};
     while (!quit)
       {
         bool activity = false;
         {
           std::lock_guard<std::mutex> lock(mutex);
-          int                         from = 0;
+          send_heartbeats(messenger, servers, last_beat);
+          int from = 0;
           while (messenger.receive(from, message))
             {
               activity = true;

@@ -30,6 +30,7 @@
 #include <condition_variable>
 #include <csignal>
 #include <deque>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -270,7 +271,7 @@ namespace palpate
           State      state;
           solver->set_stop_check([&shared, point = task.point] {
             std::lock_guard<std::mutex> guard(shared.mutex);
-            return shared.cancelled.count(point) > 0;
+            return shared.stop || shared.cancelled.count(point) > 0;
           });
           try
             {
@@ -339,7 +340,14 @@ namespace palpate
     auto              last_heartbeat = Clock::now() - std::chrono::seconds(1);
     unsigned int      tasks_received = 0;
     bool              running        = true;
+    bool              client_lost    = false;
     std::vector<char> message;
+    // The client's words (its heartbeats come every 0.1 s once its engine
+    // runs). Before the first, the client may still be setting up (reading
+    // a store, solving references): it has as long as it gives servers to
+    // report ready.
+    auto last_from_client  = Clock::now();
+    bool heard_from_client = false;
     while (running)
       {
         bool activity = false;
@@ -348,6 +356,11 @@ namespace palpate
           {
             activity       = true;
             const Header h = header_of(message);
+            if (from == client_rank)
+              {
+                last_from_client  = Clock::now();
+                heard_from_client = true;
+              }
             switch (h.kind)
               {
                 case Kind::task:
@@ -440,6 +453,7 @@ namespace palpate
                   if (h.flags & Flags::peers_lost)
                     Environment::peer_lost();
                   break;
+                case Kind::heartbeat: // the client is alive
                 default:
                   break;
               }
@@ -483,6 +497,27 @@ namespace palpate
             messenger.send(client_rank, pack(beat));
             last_heartbeat = Clock::now();
           }
+        // A client that went silent was killed, or is cut off: nobody will
+        // ever read what this server computes, and under mpirun
+        // --enable-recovery nobody else ends it.
+        if (const double silent = seconds_since(last_from_client);
+            running &&
+            silent > (heard_from_client ? p.engine.server_timeout : 600.0))
+          {
+            std::cerr << "\npalpate (solver server, MPI rank "
+                      << messenger.rank() << "): the client (rank "
+                      << client_rank << ") sent nothing for "
+                      << Utilities::to_string(silent, 3) << " s ("
+                      << (heard_from_client ?
+                            "Engine / Server timeout" :
+                            "since this server was ready; it has 600 s")
+                      << "): it is lost (killed, or cut off), and this "
+                         "server ends.\n"
+                      << std::flush;
+            Environment::peer_lost();
+            running     = false;
+            client_lost = true;
+          }
         messenger.progress();
         // Polling every millisecond costs the solver thread (which may
         // share the core) little and delays a reply by at most that; the
@@ -498,6 +533,8 @@ namespace palpate
       shared.wake_solver.notify_all();
     }
     solver_thread.join();
+    if (client_lost)
+      return 2;
     messenger.flush(5);
     return 0;
   }

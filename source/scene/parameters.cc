@@ -1066,7 +1066,10 @@ namespace palpate
                           "Type = mpi: a solver server that has sent "
                           "nothing (it sends a heartbeat every 0.1 s) for "
                           "this long is lost: it gets no more work and its "
-                          "task is planned again (s).");
+                          "task is planned again. The other way round, a "
+                          "server that has heard nothing from the client "
+                          "(rank 0, also every 0.1 s) for this long ends, "
+                          "saying so (s).");
         prm.declare_entry("Task timeout",
                           "60",
                           Patterns::Double(0.1),

@@ -27,69 +27,11 @@
 
 #include "../tests.h"
 
+#include "../processes.h"
+
 namespace
 {
-  /** Start palpate with @p args, its stdout in @p out_file (or /dev/full),
-   * or, if @p out_fd >= 0, into that descriptor (the write end of a pipe);
-   * stderr in @p err_file. */
-  pid_t
-  start(const std::vector<std::string> &args,
-        const std::string              &out_file,
-        const std::string              &err_file,
-        const int                       out_fd = -1)
-  {
-    const pid_t pid = fork();
-    if (pid == 0)
-      {
-        const int out =
-          out_fd >= 0 ?
-            out_fd :
-            open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int err =
-          open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        dup2(out, 1);
-        dup2(err, 2);
-        std::vector<char *> argv;
-        argv.push_back(const_cast<char *>(palpate_executable.c_str()));
-        for (const auto &a : args)
-          argv.push_back(const_cast<char *>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(argv[0], argv.data());
-        _exit(127);
-      }
-    return pid;
-  }
-
-  int
-  wait_status(const pid_t pid)
-  {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) :
-                               1000 + WTERMSIG(status); // killed: a failure
-  }
-
-  /** Wait (at most 120 s) until @p file contains @p text. */
-  bool
-  wait_for(const std::string &file, const std::string &text)
-  {
-    for (unsigned int i = 0; i < 1200; ++i)
-      {
-        if (read_file(file).find(text) != std::string::npos)
-          return true;
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      }
-    return false;
-  }
-
-  std::string
-  line_with(const std::string &text, const std::string &what)
-  {
-    const auto at = text.find(what);
-    if (at == std::string::npos)
-      return "(none)";
-    return text.substr(at, text.find('\n', at) - at);
-  }
+  using namespace test_processes;
 
   /** The last force-log row's time (s), and the number of rows. */
   std::pair<double, unsigned int>
@@ -107,16 +49,6 @@ namespace
           ++rows;
         }
     return {last, rows};
-  }
-
-  unsigned int
-  count(const std::string &text, const std::string &what)
-  {
-    unsigned int n = 0;
-    for (auto at = text.find(what); at != std::string::npos;
-         at      = text.find(what, at + 1))
-      ++n;
-    return n;
   }
 } // namespace
 
@@ -154,8 +86,8 @@ main()
         if (f.path().extension() != ".txt")
           std::filesystem::remove(f.path());
       std::filesystem::remove(out); // not the last run's "motion starts"
-      const pid_t pid     = start(interaction, out, err);
-      const bool  started = wait_for(out, "; motion starts");
+      const pid_t pid     = start_palpate(interaction, out, err);
+      const bool  started = wait_for_text(out, "; motion starts");
       std::this_thread::sleep_for(std::chrono::milliseconds(1500));
       kill(pid, signal);
       const int         status = wait_status(pid);
@@ -209,8 +141,8 @@ main()
     auto with_vtu = interaction;
     with_vtu.push_back("--set");
     with_vtu.push_back("Effects/VTU export=true");
-    const pid_t pid     = start(with_vtu, out, err);
-    const bool  started = wait_for(out, "; motion starts");
+    const pid_t pid     = start_palpate(with_vtu, out, err);
+    const bool  started = wait_for_text(out, "; motion starts");
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
     kill(pid, SIGINT);
     // The export has begun once a state's file (or its temporary) is there.
@@ -257,21 +189,22 @@ main()
   // writes the shape output and the force log, and exits 128 + 2.
   {
     std::filesystem::remove(out);
-    const pid_t pid     = start({"solve",
-                                 scene,
-                                 "--to",
-                                 "0,0,-0.02",
-                                 "--set",
-                                 "Nonlinear solver/Number of increments=1000",
-                                 "--set",
-                                 "Effects/Force log=true",
-                                 "--set",
-                                 "Effects/Shape output=true",
-                                 "--set",
-                                 "Output/Directory=" + dir},
-                            out,
-                            err);
-    const bool  started = wait_for(out, "active node:    from rest");
+    const pid_t pid =
+      start_palpate({"solve",
+                     scene,
+                     "--to",
+                     "0,0,-0.02",
+                     "--set",
+                     "Nonlinear solver/Number of increments=1000",
+                     "--set",
+                     "Effects/Force log=true",
+                     "--set",
+                     "Effects/Shape output=true",
+                     "--set",
+                     "Output/Directory=" + dir},
+                    out,
+                    err);
+    const bool started = wait_for_text(out, "active node:    from rest");
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
     kill(pid, SIGINT);
     const int         status  = wait_status(pid);
@@ -301,23 +234,23 @@ main()
   {
     std::filesystem::remove(out);
     const std::string port      = std::to_string(20000 + getpid() % 20000);
-    const pid_t       pid       = start({"serve",
-                                         scene,
-                                         "--port",
-                                         port,
-                                         "--set",
-                                         "Effects/Force log=true",
-                                         "--set",
-                                         "Effects/Shape output=true",
-                                         "--set",
-                                         "Output/Summary formats=json",
-                                         "--set",
-                                         "State space/Store=" + dir + "/serve.h5",
-                                         "--set",
-                                         "Output/Directory=" + dir},
-                            out,
-                            err);
-    const bool        listening = wait_for(out, "Live view: open");
+    const pid_t       pid       = start_palpate({"serve",
+                                                 scene,
+                                                 "--port",
+                                                 port,
+                                                 "--set",
+                                                 "Effects/Force log=true",
+                                                 "--set",
+                                                 "Effects/Shape output=true",
+                                                 "--set",
+                                                 "Output/Summary formats=json",
+                                                 "--set",
+                                                 "State space/Store=" + dir + "/serve.h5",
+                                                 "--set",
+                                                 "Output/Directory=" + dir},
+                                    out,
+                                    err);
+    const bool        listening = wait_for_text(out, "Live view: open");
     std::this_thread::sleep_for(std::chrono::milliseconds(2000));
     kill(pid, SIGINT);
     const int         status = wait_status(pid);
@@ -349,7 +282,7 @@ main()
     if (pipe(fds) != 0)
       return 1;
     fcntl(fds[0], F_SETFD, FD_CLOEXEC); // the child keeps only the write end
-    const pid_t pid = start(interaction, "", err, fds[1]);
+    const pid_t pid = start_palpate(interaction, "", err, fds[1]);
     close(fds[1]);
     char c = 0;
     while (read(fds[0], &c, 1) == 1 && c != '\n')
@@ -368,7 +301,7 @@ main()
   // Standard output on a full device.
   {
     std::filesystem::remove(dir + "/paper-stvk-forces.csv");
-    const pid_t pid    = start(interaction, "/dev/full", err);
+    const pid_t pid    = start_palpate(interaction, "/dev/full", err);
     const int   status = wait_status(pid);
     deallog << "/dev/full: exit status " << status << " " << ok(status == 6)
             << ", message "
@@ -382,7 +315,7 @@ main()
   // --print-parameters on a full device: an output error (it was an
   // internal error: deal.II asserted on the failed stream).
   {
-    const pid_t pid    = start({"--print-parameters"}, "/dev/full", err);
+    const pid_t pid = start_palpate({"--print-parameters"}, "/dev/full", err);
     const int   status = wait_status(pid);
     deallog << "--print-parameters > /dev/full: exit status " << status << " "
             << ok(status == 6) << ", no internal error "
@@ -395,18 +328,18 @@ main()
   {
     const std::string csv = dir + "/study.csv";
     std::filesystem::remove(out);
-    const pid_t pid     = start({"study",
-                                 scene,
-                                 "--quick",
-                                 "--csv",
-                                 csv,
-                                 "--set",
-                                 "Output/Directory=" + dir},
-                            out,
-                            err);
-    const bool  started = wait_for(out, "  ... ");
+    const pid_t pid     = start_palpate({"study",
+                                         scene,
+                                         "--quick",
+                                         "--csv",
+                                         csv,
+                                         "--set",
+                                         "Output/Directory=" + dir},
+                                    out,
+                                    err);
+    const bool  started = wait_for_text(out, "  ... ");
     // Past the reference solves, into the grid knob's states.
-    const bool in_grid = wait_for(out, ": grid ");
+    const bool in_grid = wait_for_text(out, ": grid ");
     std::this_thread::sleep_for(std::chrono::milliseconds(3000));
     kill(pid, SIGINT);
     const int         status = wait_status(pid);
@@ -430,19 +363,19 @@ main()
   // The study's time budget: the same path, exit status 0.
   {
     const std::string csv    = dir + "/study-budget.csv";
-    const pid_t       pid    = start({"study",
-                                      scene,
-                                      "--quick",
-                                      "--skip",
-                                      "element,mesh",
-                                      "--time-limit",
-                                      "1",
-                                      "--csv",
-                                      csv,
-                                      "--set",
-                                      "Output/Directory=" + dir},
-                            out,
-                            err);
+    const pid_t       pid    = start_palpate({"study",
+                                              scene,
+                                              "--quick",
+                                              "--skip",
+                                              "element,mesh",
+                                              "--time-limit",
+                                              "1",
+                                              "--csv",
+                                              csv,
+                                              "--set",
+                                              "Output/Directory=" + dir},
+                                    out,
+                                    err);
     const int         status = wait_status(pid);
     const std::string text   = read_file(out);
     deallog << "study, --time-limit 1: exit status " << status << " "

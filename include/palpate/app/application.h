@@ -22,7 +22,8 @@ namespace palpate
     /** A static solve ended in a failure point (no equilibrium found). */
     constexpr int solve_failed = 4;
     /** An MPI solver server was lost during the run (the summary says
-     * which and why); what the others computed was used. */
+     * which and why); what the others computed was used. A server whose
+     * client was lost ends with it too. */
     constexpr int server_lost = 5;
     /** The run finished, but an output file could not be written. */
     constexpr int output_failed = 6;

@@ -105,8 +105,12 @@ namespace palpate
   /**
    * A solver server (ranks 1..N-1 of an MPI run): set up the solver for
    * @p scene, then compute what the client asks until it says shutdown.
-   * Returns 0, or non-zero if the solver could not be set up (the client
-   * reports why).
+   * Returns 0; 1 if the solver could not be set up (the client reports
+   * why); 2 if the client was lost: it sent nothing (it sends a heartbeat
+   * every 0.1 s) for Engine / Server timeout, or nothing at all within
+   * 600 s of this server's "ready" (a client still setting up). The server
+   * then says so on standard error and ends: a killed client must not
+   * leave its servers computing for ever under mpirun --enable-recovery.
    */
   int
   run_solver_server(const Scene         &scene,
