@@ -1079,10 +1079,43 @@ namespace palpate
     progress.finish();
     if (!result.stopped.empty())
       out << "\nThe study ended early: " << result.stopped << " after "
-          << fixed(seconds_since(study_start), 0) << " s. What it measured "
-          << "until then follows (" << result.rows.size()
-          << " rows); the knobs and values not reached are not in it, and "
-             "the recommendation is among the rows measured.\n";
+          << fixed(seconds_since(study_start), 0) << " s."
+          << (result.rows.empty() ?
+                std::string() :
+                " What it measured until then follows (" +
+                  std::to_string(result.rows.size()) +
+                  " rows); the knobs and values not reached are not in it, "
+                  "and the recommendation is among the rows measured.")
+          << "\n";
+    const auto reference_line = [&] {
+      return reference.empty() ? "the " + std::to_string(positions.size()) +
+                                   " reference solves did not finish.\n" :
+                                 std::to_string(n_reference) + " of " +
+                                   std::to_string(positions.size()) +
+                                   " reference solves converged.\n";
+    };
+    // Nothing measured (cut short during the reference solves, or every
+    // knob skipped): no table, and no recommendation made of no rows.
+    if (result.rows.empty())
+      {
+        out << "\nNothing was measured, so there is no table and no "
+               "recommendation"
+            << (!result.stopped.empty() && reference.empty() ?
+                  ": the study ended during its first step, the reference "
+                  "solves (direct solves at " +
+                    std::to_string(positions.size()) +
+                    " positions). Give it more time (--time-limit S, or "
+                    "none)" :
+                  ". Give it more time (--time-limit S, or none), or leave "
+                  "fewer knobs out (--skip)")
+            << ".\n";
+        write_csv();
+        out << "The CSV (its header only): " << result.csv_file << "\n";
+        result.seconds = seconds_since(study_start);
+        out << "Study time " << fixed(result.seconds, 0) << " s; "
+            << reference_line();
+        return result;
+      }
 
     // --- The discretisation error of the scene's own mesh and element,
     // for the scene's own probe: the largest p95 difference to the finer
@@ -1288,8 +1321,8 @@ namespace palpate
               << command << "\n";
       }
     result.seconds = seconds_since(study_start);
-    out << "Study time " << fixed(result.seconds, 0) << " s; " << n_reference
-        << " of " << positions.size() << " reference solves converged.\n";
+    out << "Study time " << fixed(result.seconds, 0) << " s; "
+        << reference_line();
     return result;
   }
 } // namespace palpate

@@ -18,9 +18,11 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -147,7 +149,8 @@ namespace palpate
   {
     std::ofstream out(file);
     if (!out)
-      throw std::runtime_error("cannot write the file '" + file + "'");
+      throw std::runtime_error("cannot write the file '" + file +
+                               "': " + std::strerror(errno));
     out << std::setprecision(7)
         << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" "
            "version=\"0.1\" byte_order=\"LittleEndian\">\n"
@@ -165,9 +168,20 @@ namespace palpate
           << "\n";
     out << "</DataArray>\n" << flags << "</PointData>\n" << geometry;
     out.flush();
-    return static_cast<double>(out.tellp());
+    const double bytes = static_cast<double>(out.tellp());
+    out.close();
     if (!out)
-      throw std::runtime_error("cannot write the file '" + file + "'");
+      {
+        // A full disk (or a file size limit): the frame is cut. It is
+        // removed, which also gives back the room the index needs; the
+        // caller stops writing frames.
+        const int       error = errno;
+        std::error_code ignored;
+        std::filesystem::remove(file, ignored);
+        throw std::runtime_error("cannot write the file '" + file +
+                                 "': " + std::strerror(error));
+      }
+    return bytes;
   }
 
 
@@ -369,21 +383,38 @@ namespace palpate
     impl->wake.notify_all();
     impl->thread.join();
     const std::string file = impl->directory + "/" + impl->stem + "-shape.pvd";
-    std::ofstream     pvd(file);
-    // deal.II asserts on a stream that failed (a full disk): that is this
-    // output's failure, reported with the others, not an internal error.
+    // The index is built in memory and written whole, under a temporary
+    // name first: on a full disk there is either an index of every frame
+    // written or none, never a cut one. deal.II asserts on a stream that
+    // failed: that is this output's failure, reported with the others.
+    std::ostringstream index;
     try
       {
-        if (pvd)
-          dealii::DataOutBase::write_pvd_record(pvd, impl->records);
-        pvd.close();
+        dealii::DataOutBase::write_pvd_record(index, impl->records);
       }
     catch (const std::exception &)
       {
-        pvd.setstate(std::ios::failbit);
+        index.setstate(std::ios::failbit);
       }
-    if (!pvd && impl->failure.empty())
-      impl->failure = "cannot write the file '" + file + "'";
+    const std::string part = file + ".part";
+    std::ofstream     pvd(part);
+    pvd << index.str();
+    pvd.close();
+    const int       error = errno;
+    std::error_code renamed;
+    if (pvd && index)
+      std::filesystem::rename(part, file, renamed);
+    if (!pvd || !index || renamed)
+      {
+        std::error_code ignored;
+        std::filesystem::remove(part, ignored);
+        const std::string why =
+          "the index '" + file + "' could not be written (" +
+          (renamed ? renamed.message() : std::string(std::strerror(error))) +
+          "): the " + std::to_string(impl->written.load()) +
+          " frames written are on disk without it";
+        impl->failure += (impl->failure.empty() ? "" : "; ") + why;
+      }
   }
 
 

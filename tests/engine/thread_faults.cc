@@ -9,7 +9,10 @@
 //   the cloud;
 // - the shape output's directory is replaced by a file in mid-run: the
 //   shape thread stops with the error, the frames written before it stay
-//   listed in the PVD file, and the interaction goes on.
+//   listed in the PVD file, and the interaction goes on;
+// - the disk fills during the shape output (a file size limit): the thread
+//   stops at the first frame that could not be written and removes it;
+//   the count, the frame files and the PVD index agree.
 
 #include <palpate/engine/hip_channel.h>
 #include <palpate/engine/thread_engine.h>
@@ -20,7 +23,10 @@
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
+#include <sys/resource.h>
+
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <thread>
 
@@ -181,6 +187,83 @@ main(int argc, char **argv)
     deallog << "the interaction still answers: force at rest "
             << (all_finite(f) ? "finite" : "NOT FINITE") << std::endl;
     std::filesystem::remove("shapes");
+  }
+
+  {
+    // A full disk, as a file size limit (RLIMIT_FSIZE) below a frame's
+    // size set in mid-run: writes of frames fail (EFBIG), small files such
+    // as the index still fit. Before, the failed write went unnoticed: the
+    // count went on, cut and empty frames were left, and the index listed
+    // them.
+    deallog << "--- the disk fills during the shape output" << std::endl;
+    std::filesystem::remove_all("full");
+    palpate::Interaction interaction(scene);
+    interaction.attach();
+    wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
+    palpate::ShapeInterpolator shape(interaction, 50, "full", "beam");
+    shape.start();
+    unsigned int step = 0;
+    const auto   move = [&] {
+      interaction.force({{1e-5 * (++step % 20), 0, 0}});
+    };
+    const bool some = wait_for(
+      [&] {
+        move();
+        return shape.frames().first >= 3;
+      },
+      60);
+    const auto frame_size =
+      std::filesystem::file_size("full/beam-shape-00000.vtu");
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit old_limit{};
+    getrlimit(RLIMIT_FSIZE, &old_limit);
+    rlimit full   = old_limit;
+    full.rlim_cur = frame_size / 2;
+    setrlimit(RLIMIT_FSIZE, &full);
+    for (unsigned int k = 0; k < 40; ++k)
+      {
+        move();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    shape.stop();
+    setrlimit(RLIMIT_FSIZE, &old_limit);
+    interaction.detach();
+
+    unsigned int on_disk = 0, whole = 0;
+    for (const auto &f : std::filesystem::directory_iterator("full"))
+      if (f.path().extension() == ".vtu")
+        {
+          ++on_disk;
+          const std::string text = read_file(f.path().string());
+          whole += text.size() == frame_size ||
+                   text.find("</VTKFile>") != std::string::npos;
+        }
+    const std::string  pvd    = read_file("full/beam-shape.pvd");
+    unsigned int       listed = 0;
+    const unsigned int count  = shape.frames().first;
+    for (auto at = pvd.find("<DataSet"); at != std::string::npos;
+         at      = pvd.find("<DataSet", at + 1))
+      ++listed;
+    deallog << "frames before the disk filled: " << (some ? ">= 3" : "FEWER")
+            << " (a frame is larger than 8 KiB: " << ok(frame_size > 8192)
+            << ")" << std::endl;
+    deallog << "frames counted = frame files on disk = frames in the index: "
+            << ok(count == on_disk && on_disk == listed && count >= 3)
+            << ", every file a whole frame: " << ok(whole == on_disk)
+            << ", index closed: "
+            << ok(pvd.find("</VTKFile>") != std::string::npos) << std::endl;
+    if (count != on_disk || on_disk != listed)
+      deallog << "  (" << count << " counted, " << on_disk << " on disk, "
+              << listed << " listed)" << std::endl;
+    const std::string &failure = shape.failure();
+    deallog << "failure names the frame and the cause: "
+            << ok(failure.find("cannot write the file 'full/beam-shape-") !=
+                    std::string::npos &&
+                  failure.find("File too large") != std::string::npos)
+            << std::endl;
+    if (failure.find("File too large") == std::string::npos)
+      deallog << "  ('" << failure << "')" << std::endl;
+    std::filesystem::remove_all("full");
   }
 
   {
