@@ -234,13 +234,28 @@ namespace palpate
       {
         const std::string file =
           p.output.directory + "/" + stem + "-forces.csv";
+        // The force at the last equilibrium reached on the path: the
+        // target itself if the solve converged; where a stop signal or a
+        // failure point ended it otherwise (reached_fraction < 1), so that
+        // a stopped solve's row holds the force it printed, not zero.
+        const Utilities::Point3 at = state.converged ? target : reached_at;
+        const Utilities::Point3 force =
+          state.converged ? state.force :
+          reached > 0     ? reached_force :
+                            Utilities::Point3{{0, 0, 0}};
         std::ofstream csv(file);
         csv << "target_x_m,target_y_m,target_z_m,force_x_N,force_y_N,force_z_N,"
-               "converged,newton_iterations\n"
+               "converged,newton_iterations,reached_fraction,reached_x_m,"
+               "reached_y_m,reached_z_m\n"
             << std::setprecision(10) << target[0] << "," << target[1] << ","
-            << target[2] << "," << state.force[0] << "," << state.force[1]
-            << "," << state.force[2] << "," << (state.converged ? 1 : 0) << ","
-            << state.newton_iterations << "\n";
+            << target[2] << "," << force[0] << "," << force[1] << ","
+            << force[2] << "," << (state.converged ? 1 : 0) << ","
+            << state.newton_iterations << ","
+            << (state.converged ? 1.0 : reached) << "," << at[0] << "," << at[1]
+            << "," << at[2] << "\n";
+        csv.close();
+        if (!csv)
+          throw OutputError("cannot write the file '" + file + "'");
         out << "  wrote " << file << "\n";
       }
     if (stopped)

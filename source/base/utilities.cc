@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -118,6 +120,26 @@ namespace palpate
 
 
     std::string
+    to_string_exact(const double x)
+    {
+      // As to_string() shows it (six significant digits, %g: 0.0001,
+      // 20000, 1e+13) unless that reads back as another number; then the
+      // fewest digits that read back as x. A fixed precision either loses
+      // digits (6) or shows round-off noise (17 digits print 0.1 as
+      // 0.10000000000000001).
+      char buffer[64];
+      for (int digits = 6; digits <= 17; ++digits)
+        {
+          std::snprintf(buffer, sizeof(buffer), "%.*g", digits, x);
+          if (std::strtod(buffer, nullptr) == x)
+            break;
+        }
+      return buffer;
+    }
+
+
+
+    std::string
     to_string(const Point3 &p, const unsigned int precision)
     {
       std::ostringstream s;
@@ -186,6 +208,73 @@ namespace palpate
     }
 
 
+    namespace
+    {
+      /**
+       * The length of the valid UTF-8 sequence at text[i] (a byte >= 0x80):
+       * a lead byte 110xxxxx, 1110xxxx or 11110xxx and that many
+       * continuation bytes 10xxxxxx, not an overlong form, a surrogate or
+       * beyond U+10FFFF; 0 if it is not one.
+       */
+      unsigned int
+      utf8_length(const std::string &text, const std::size_t i)
+      {
+        const auto         c      = static_cast<unsigned char>(text[i]);
+        const unsigned int length = c >= 0xc2 && c <= 0xdf ? 2 :
+                                    c >= 0xe0 && c <= 0xef ? 3 :
+                                    c >= 0xf0 && c <= 0xf4 ? 4 :
+                                                             0;
+        bool               valid  = length > 0 && i + length <= text.size();
+        for (unsigned int k = 1; valid && k < length; ++k)
+          valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        if (valid && length > 2)
+          {
+            const auto second = static_cast<unsigned char>(text[i + 1]);
+            valid             = !(c == 0xe0 && second < 0xa0) && // overlong
+                    !(c == 0xed && second > 0x9f) &&             // surrogate
+                    !(c == 0xf0 && second < 0x90) &&             // overlong
+                    !(c == 0xf4 && second > 0x8f);               // > U+10FFFF
+          }
+        return valid ? length : 0;
+      }
+    } // namespace
+
+
+
+    std::string
+    quoted_excerpt(const std::string &text, const std::size_t max_characters)
+    {
+      static const char hex[] = "0123456789abcdef";
+      std::string       out;
+      std::size_t       shown = 0, unprintable = 0, i = 0;
+      for (; i < text.size() && shown < max_characters; ++i, ++shown)
+        {
+          const auto c = static_cast<unsigned char>(text[i]);
+          if (c >= 0x20 && c < 0x7f)
+            out += static_cast<char>(c);
+          else if (const unsigned int length =
+                     c >= 0x80 ? utf8_length(text, i) : 0;
+                   length > 0)
+            {
+              out.append(text, i, length);
+              i += length - 1;
+            }
+          else
+            {
+              out += "\\x";
+              out += hex[c >> 4];
+              out += hex[c & 0xf];
+              ++unprintable;
+            }
+        }
+      if (4 * unprintable > shown)
+        return "binary data (" + std::to_string(text.size()) +
+               " bytes that are not text)";
+      return "'" + out + (i < text.size() ? "...'" : "'");
+    }
+
+
+
     /**
      * @p text as a JSON string (RFC 8259, section 7): quotes, backslashes
      * and every control character below 0x20 escaped (the short forms
@@ -239,25 +328,8 @@ namespace palpate
               out += static_cast<char>(c);
               continue;
             }
-          // A multi-byte UTF-8 sequence: a lead byte 110xxxxx, 1110xxxx or
-          // 11110xxx and that many continuation bytes 10xxxxxx, not an
-          // overlong form, a surrogate or beyond U+10FFFF.
-          const unsigned int length = c >= 0xc2 && c <= 0xdf ? 2 :
-                                      c >= 0xe0 && c <= 0xef ? 3 :
-                                      c >= 0xf0 && c <= 0xf4 ? 4 :
-                                                               0;
-          bool               valid  = length > 0 && i + length <= text.size();
-          for (unsigned int k = 1; valid && k < length; ++k)
-            valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
-          if (valid && length > 2)
-            {
-              const auto second = static_cast<unsigned char>(text[i + 1]);
-              valid             = !(c == 0xe0 && second < 0xa0) && // overlong
-                      !(c == 0xed && second > 0x9f) &&             // surrogate
-                      !(c == 0xf0 && second < 0x90) &&             // overlong
-                      !(c == 0xf4 && second > 0x8f);               // > U+10FFFF
-            }
-          if (valid)
+          const unsigned int length = utf8_length(text, i);
+          if (length > 0)
             {
               out.append(text, i, length);
               i += length - 1;

@@ -67,20 +67,6 @@ namespace palpate
       return {key, Field::Kind::boolean, value ? "true" : "false"};
     }
 
-    /**
-     * A finite double in the shortest form that reads back as the same
-     * double: 0.5 stays "0.5", 0.1 stays "0.1", 1/3 gets its 16-17 digits.
-     * std::to_chars does exactly this; a fixed precision either loses
-     * digits (6) or shows round-off noise (max_digits10 prints 0.1 as
-     * 0.10000000000000001).
-     */
-    std::string
-    shortest(const double x)
-    {
-      char       buffer[64];
-      const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-      return std::string(buffer, result.ptr);
-    }
 
 
     /** A JSON value: numbers bare, NaN and infinities null (JSON has no
@@ -93,7 +79,8 @@ namespace palpate
           case Field::Kind::text:
             return Utilities::json_string(f.text);
           case Field::Kind::real:
-            return std::isfinite(f.real) ? shortest(f.real) : "null";
+            return std::isfinite(f.real) ? Utilities::to_string_exact(f.real) :
+                                           "null";
           default:
             return f.text;
         }
@@ -114,7 +101,7 @@ namespace palpate
       if (f.kind == Field::Kind::real)
         value = std::isnan(f.real) ? "nan" :
                 std::isinf(f.real) ? (f.real > 0 ? "inf" : "-inf") :
-                                     shortest(f.real);
+                                     Utilities::to_string_exact(f.real);
       std::string out = "\"";
       for (const char c : value)
         out += c == '"' ? std::string("\"\"") : std::string(1, c);

@@ -206,6 +206,22 @@ namespace palpate
     while (std::getline(in, line))
       {
         ++number;
+        // A byte order mark (some editors begin UTF-8 with one) is not
+        // part of the first line; UTF-16 is not a CSV palpate reads.
+        if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
+          line.erase(0, 3);
+        else if (number == 1 && line.size() >= 2 &&
+                 (line.rfind("\xFF\xFE", 0) == 0 ||
+                  line.rfind("\xFE\xFF", 0) == 0))
+          throw InputError(
+            filename,
+            1,
+            "trajectory replay (Haptics / Trajectory / File name)",
+            "the file is UTF-16 text (it begins with a UTF-16 byte order "
+            "mark); a recording is plain text (ASCII or UTF-8)",
+            "save it as UTF-8 or ASCII, or convert it: iconv -f UTF-16 -t "
+            "UTF-8 '" +
+              filename + "' > recording.csv");
         const std::string t = Utilities::trim(line);
         if (t.empty() || t[0] == '#' ||
             std::isalpha(static_cast<unsigned char>(t[0])))
@@ -353,7 +369,16 @@ namespace palpate
                                             t.seed);
     const std::string path = scene.resolve_path(t.file_name);
     std::error_code   error;
-    if (!std::filesystem::exists(path, error))
+    const bool        exists = std::filesystem::exists(path, error);
+    // A name the file system refuses (a loop of links, too long) is not a
+    // missing file: say what it said.
+    if (error)
+      throw scene.error("Haptics/Trajectory/File name",
+                        "the recording '" + path +
+                          "' cannot be opened: " + error.message(),
+                        "check the path and the links on the way to the "
+                        "recording's CSV file.");
+    if (!exists)
       throw scene.error("Haptics/Trajectory/File name",
                         "the recording '" + t.file_name +
                           "' was not found: looked for " +

@@ -236,8 +236,8 @@ namespace palpate
   std::string
   StVenantKirchhoff::description() const
   {
-    return "E = " + Utilities::to_string(E) +
-           " Pa, nu = " + Utilities::to_string(nu);
+    return "E = " + Utilities::to_string_exact(E) +
+           " Pa, nu = " + Utilities::to_string_exact(nu);
   }
 
 
@@ -353,8 +353,8 @@ namespace palpate
   std::string
   NeoHookean::description() const
   {
-    return "E = " + Utilities::to_string(E) +
-           " Pa, nu = " + Utilities::to_string(nu);
+    return "E = " + Utilities::to_string_exact(E) +
+           " Pa, nu = " + Utilities::to_string_exact(nu);
   }
 
 
@@ -682,12 +682,12 @@ namespace palpate
   std::string
   MooneyRivlin::description() const
   {
-    return "C10 = " + Utilities::to_string(c10) +
-           " Pa, C01 = " + Utilities::to_string(c01) + " Pa, " +
+    return "C10 = " + Utilities::to_string_exact(c10) +
+           " Pa, C01 = " + Utilities::to_string_exact(c01) + " Pa, " +
            (mixed.pressure == Formulation::Pressure::exact ?
               "exactly incompressible, " + mixed.element + " elements" :
               "nearly incompressible, bulk modulus " +
-                Utilities::to_string(mixed.bulk_modulus) + " Pa");
+                Utilities::to_string_exact(mixed.bulk_modulus) + " Pa");
   }
 
 

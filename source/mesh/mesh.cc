@@ -5,6 +5,7 @@
 #include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/mesh_file.h>
+#include <palpate/mesh/surface.h>
 #include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
@@ -311,6 +312,11 @@ namespace palpate
     // because an inverted element in a file means a broken mesher or a
     // wrong node-order convention, and the user must know.
     impl->min_volume = std::numeric_limits<double>::max();
+    // Each tetrahedron's sorted nodes: the same four twice is a duplicated
+    // element (its faces are all shared by two, so the face check below
+    // would take two copies for a body without surface, and the stiffness
+    // there would count twice).
+    std::map<std::array<unsigned int, 4>, unsigned int> cell_with_nodes;
     for (unsigned int c = 0; c < data.tetrahedra.size(); ++c)
       {
         std::array<unsigned int, 4> t;
@@ -319,10 +325,43 @@ namespace palpate
         std::array<unsigned int, 4> s = t;
         std::sort(s.begin(), s.end());
         if (std::adjacent_find(s.begin(), s.end()) != s.end())
+          {
+            // The same node number twice, or two numbers whose nodes are
+            // at the same point (merged above): said apart, since the fix
+            // differs.
+            const auto &raw = data.tetrahedra[c];
+            for (unsigned int i = 0; i < 4; ++i)
+              for (unsigned int j = i + 1; j < 4; ++j)
+                if (t[i] == t[j] && raw[i] == raw[j])
+                  throw error(data.tetrahedron_lines[c],
+                              element_name(data, c),
+                              "the tetrahedron uses node " +
+                                std::to_string(data.node_ids[raw[i]]) +
+                                " twice",
+                              "the mesh is broken; regenerate it (TetGen, "
+                              "Gmsh).");
+                else if (t[i] == t[j])
+                  throw error(data.tetrahedron_lines[c],
+                              element_name(data, c),
+                              "two of the tetrahedron's nodes, " +
+                                std::to_string(data.node_ids[raw[i]]) +
+                                " and " +
+                                std::to_string(data.node_ids[raw[j]]) +
+                                ", are at the same point (" +
+                                Utilities::to_string(data.nodes[raw[i]]) +
+                                "): the element has no volume",
+                              "the mesh has duplicate nodes; merge them (Gmsh: "
+                              "Coherence) or regenerate the mesh.");
+          }
+        if (const auto [earlier, first] = cell_with_nodes.emplace(s, c); !first)
           throw error(data.tetrahedron_lines[c],
                       element_name(data, c),
-                      "the tetrahedron uses the same node twice",
-                      "the mesh is broken; regenerate it (TetGen, Gmsh).");
+                      "the tetrahedron has the same four nodes as " +
+                        element_name(data, earlier->second) +
+                        " (a duplicated element, or nodes at the same "
+                        "points)",
+                      "the mesh is broken; remove the duplicate or "
+                      "regenerate the mesh (TetGen, Gmsh).");
         const double       v = signed_volume(impl->vertices[t[0]],
                                        impl->vertices[t[1]],
                                        impl->vertices[t[2]],
@@ -527,6 +566,14 @@ namespace palpate
           return mesh;
         }
 
+      // (.vtk holds either, and its reader tells them apart.)
+      if (is_surface_file_name(p.file_name) &&
+          std::filesystem::path(p.file_name).extension() != ".vtk")
+        throw scene.error("Mesh/Source",
+                          "Source = file reads a tetrahedral mesh, but '" +
+                            p.file_name + "' is a surface",
+                          "set Source = surface: palpate then meshes the "
+                          "surface (and keeps the mesh for the next run).");
       const std::string path = scene.resolve_path(p.file_name);
       // error_code: a name the file system refuses (too long, a loop of
       // links) is reported below as a file that cannot be read.

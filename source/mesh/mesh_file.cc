@@ -133,7 +133,8 @@ namespace palpate
       T                  value;
       s >> value;
       if (s.fail() || !s.eof())
-        throw reader.error("'" + token + "' is not a valid " + what,
+        throw reader.error(Utilities::quoted_excerpt(token) +
+                             " is not a valid " + what,
                            "check the line; the file may be damaged.");
       return value;
     }
@@ -361,8 +362,9 @@ namespace palpate
                 ;
             }
           else
-            throw reader.error("unexpected line '" + line +
-                                 "' between sections",
+            throw reader.error("unexpected line " +
+                                 Utilities::quoted_excerpt(line) +
+                                 " between sections",
                                "the file is damaged; export it again.");
         }
       if (!have_nodes || !have_elements)
@@ -650,7 +652,8 @@ namespace palpate
                    keyword == "FIELD")
             break; // palpate needs no data arrays
           else
-            throw reader.error("unexpected keyword '" + keyword + "'",
+            throw reader.error("unexpected keyword " +
+                                 Utilities::quoted_excerpt(keyword),
                                "palpate reads POINTS, CELLS and CELL_TYPES "
                                "of an unstructured grid.");
         }

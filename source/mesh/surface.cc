@@ -383,7 +383,8 @@ namespace palpate
                     {
                       throw bad(filename,
                                 line_number,
-                                "'" + token + "' is not a vertex number",
+                                Utilities::quoted_excerpt(token) +
+                                  " is not a vertex number",
                                 damaged);
                     }
                   polygon.push_back(

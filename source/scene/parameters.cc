@@ -710,7 +710,10 @@ namespace palpate
                           "a CSV file (time s, position m, force N): in an "
                           "interaction one row per haptic tick from the "
                           "motion's start (time 0) on; with palpate solve, "
-                          "the target and the force.");
+                          "the target, the force at the last equilibrium "
+                          "reached, and how far along the path that is (1: "
+                          "the target; less if a stop signal or a failure "
+                          "point ended the solve).");
       }
       prm.leave_subsection();
     }

@@ -3,7 +3,6 @@
 
 #include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/material.h>
-#include <palpate/mesh/surface.h>
 #include <palpate/scene/scene.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -711,6 +710,22 @@ namespace palpate
                        "kB of text",
                        "check that this is the scene (.prm) and not a mesh or "
                        "an output file.");
+    // A byte order mark: some editors (Notepad) begin UTF-8 with one; it
+    // is not part of the text. UTF-16 is not a scene file palpate reads:
+    // named, instead of "a NUL byte" in column 2.
+    if (content.rfind("\xEF\xBB\xBF", 0) == 0)
+      content.erase(0, 3);
+    else if (content.rfind("\xFF\xFE", 0) == 0 ||
+             content.rfind("\xFE\xFF", 0) == 0)
+      throw InputError(filename,
+                       1,
+                       "(the scene file itself)",
+                       "the file is UTF-16 text (it begins with a UTF-16 byte "
+                       "order mark); a scene file is plain text (ASCII or "
+                       "UTF-8)",
+                       "save it as UTF-8 (in Notepad: Save as, Encoding "
+                       "UTF-8), or convert it: iconv -f UTF-16 -t UTF-8 '" +
+                         filename + "' > scene.prm");
     {
       unsigned int line = 1, column = 1;
       for (const char c : content)
@@ -998,10 +1013,22 @@ namespace palpate
 
 
   InputError
-  Scene::error(const std::string &entry,
-               const std::string &problem,
-               const std::string &fix) const
+  Scene::error(const std::string              &entry,
+               const std::string              &problem_alone,
+               const std::string              &fix,
+               const std::vector<std::string> &with) const
   {
+    // A relation between entries (Extent against Grid spacing) is blamed
+    // on one of them; if another was set on the command line, the problem
+    // says so, or the user would look for it in the file.
+    std::string also;
+    for (const std::string &other : with)
+      for (const std::string &setting : command_line_settings_)
+        if (setting.compare(0, other.size() + 1, other + "=") == 0)
+          also += (also.empty() ? "" : ", ") + ("--set " + setting);
+    const std::string problem =
+      also.empty() ? problem_alone :
+                     problem_alone + " (with " + also + " on the command line)";
     std::string shown = std::regex_replace(entry, std::regex("/"), " / ");
     const auto  value = entry_values_.find(entry);
     for (const std::string &setting : command_line_settings_)
@@ -1203,13 +1230,6 @@ namespace palpate
                   "set Source = file (a tetrahedral mesh) or Source = "
                   "surface (an organ's surface, meshed by palpate), or "
                   "remove File name.");
-    if (p.mesh.source == "file" && is_surface_file_name(p.mesh.file_name) &&
-        std::filesystem::path(p.mesh.file_name).extension() != ".vtk")
-      throw error("Mesh/Source",
-                  "Source = file reads a tetrahedral mesh, but '" +
-                    p.mesh.file_name + "' is a surface",
-                  "set Source = surface: palpate then meshes the surface "
-                  "(and keeps the mesh for the next run).");
     if (p.mesh.scale_factor <= 0)
       throw error("Mesh/Scale factor",
                   "the scale factor must be positive",
@@ -1330,7 +1350,8 @@ namespace palpate
                   "the grid extent is smaller than one grid spacing, so the "
                   "grid has no cell",
                   "make Extent at least Grid spacing (typically 0.1 m, the "
-                  "paper's largest displacement).");
+                  "paper's largest displacement).",
+                  {"State space/Grid spacing"});
     {
       // Every grid point costs about 70 bytes of bookkeeping, computed or
       // not: 2e7 points are 1.4 GB.
@@ -1343,7 +1364,8 @@ namespace palpate
                       " points; at most 2e7 are allowed (about 70 bytes "
                       "each, computed or not)",
                     "reduce Extent or increase Grid spacing (0.1 m with "
-                    "0.005 m gives 41^3 = 68921 points).");
+                    "0.005 m gives 41^3 = 68921 points).",
+                    {"State space/Grid spacing"});
     }
     if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
       throw error(
@@ -1353,7 +1375,8 @@ namespace palpate
           Utilities::to_string(std::sqrt(3.) * p.state_space.grid_spacing, 4) +
           " m",
         "increase Cloud radius or decrease State space / Grid "
-        "spacing.");
+        "spacing.",
+        {"State space/Grid spacing"});
     if (p.scheduler.rate <= 0)
       throw error("Scheduler/Rate", "the rate must be positive", "use 100 Hz.");
     if (p.scheduler.cloud_radius > p.state_space.extent)
@@ -1364,7 +1387,8 @@ namespace palpate
                     " m): the initial cloud alone would be most of the "
                     "grid's points, and the motion would wait for them",
                   "keep the cloud local: a radius of 4-6 grid spacings (the "
-                  "default 0.025 m with 0.005 m spacing); at most Extent.");
+                  "default 0.025 m with 0.005 m spacing); at most Extent.",
+                  {"State space/Extent"});
     if (p.scheduler.rate > max_scheduler_rate)
       throw error("Scheduler/Rate",
                   "at most " + Utilities::to_string(max_scheduler_rate, 4) +
@@ -1475,7 +1499,8 @@ namespace palpate
                     Utilities::to_string(p.state_space.extent, 3) +
                     " m), where no force is computed",
                   "give the radius in metres, e.g. 0.01, at most the "
-                  "extent.");
+                  "extent.",
+                  {"State space/Extent"});
     if ((t.type == "circle" || t.type == "smooth random") &&
         !(t.radius >= 1e-4))
       throw error("Haptics/Trajectory/Radius",

@@ -543,16 +543,29 @@ namespace palpate
       // (NAME_MAX, 255 on Linux), or the failure looks like a full disk.
       if (const std::size_t n = path.filename().string().size();
           writing && n + std::strlen(".creating") > NAME_MAX)
-        store_error(file,
-                    "its file name has " + std::to_string(n) +
-                      " characters; palpate makes '" +
-                      path.filename().string().substr(0, 20) +
-                      "....creating' and '....lock' beside it, and a file "
-                      "name may have at most " +
-                      std::to_string(NAME_MAX) + " characters",
-                    "use a name of at most " +
-                      std::to_string(NAME_MAX - std::strlen(".creating")) +
-                      " characters, e.g. 'liver.h5'.");
+        {
+          // The limit is in bytes; a character outside ASCII takes 2-4 of
+          // them in UTF-8, so a name's characters are said too when they
+          // differ.
+          const std::string name       = path.filename().string();
+          std::size_t       characters = 0;
+          for (const char c : name)
+            characters += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
+          store_error(
+            file,
+            "its file name has " + std::to_string(n) + " bytes" +
+              (characters != n ?
+                 " (" + std::to_string(characters) +
+                   " characters: one outside ASCII takes 2-4 bytes in "
+                   "UTF-8)" :
+                 std::string()) +
+              "; palpate makes NAME.creating and NAME.lock beside it, and "
+              "a file name may have at most " +
+              std::to_string(NAME_MAX) + " bytes",
+            "use a name of at most " +
+              std::to_string(NAME_MAX - std::strlen(".creating")) +
+              " bytes (as many ASCII characters), e.g. 'liver.h5'.");
+        }
       const fs::file_status status = fs::status(path, error);
       if (status.type() == fs::file_type::none ||
           (error && status.type() != fs::file_type::not_found))

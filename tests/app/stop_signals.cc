@@ -224,8 +224,27 @@ main()
             << ", PVD closed with frames "
             << ok(pvd.find("</VTKFile>") != std::string::npos &&
                   count(pvd, "<DataSet") > 1)
-            << ", force log row (not converged) "
-            << ok(log.find(",0,") != std::string::npos) << std::endl;
+            << std::endl;
+    // The force log's row: not converged, the part of the path reached
+    // and the force there (what the summary printed), not zero.
+    std::vector<double> row;
+    {
+      std::istringstream lines(log);
+      std::string        line;
+      std::getline(lines, line); // the header
+      std::getline(lines, line);
+      std::istringstream fields(line);
+      for (std::string field; std::getline(fields, field, ',');)
+        row.push_back(std::atof(field.c_str()));
+    }
+    deallog << "  force log row: not converged "
+            << ok(row.size() == 12 && row[6] == 0)
+            << ", the part of the path reached "
+            << ok(row.size() == 12 && row[8] > 0 && row[8] < 1)
+            << ", the force there "
+            << ok(row.size() == 12 &&
+                  std::abs(row[3]) + std::abs(row[4]) + std::abs(row[5]) > 0)
+            << std::endl;
   }
 
   // `palpate serve`: SIGINT is its normal end (status 0). The summary
@@ -346,10 +365,13 @@ main()
     const std::string text   = read_file(out);
     // The rows it says it measured (printed in the tables after the
     // message) are the CSV's rows.
+    // (None, if the stop came before the first knob setting was complete.)
     unsigned int printed = ~0u;
     if (const auto at = text.find("What it measured until then follows (");
         at != std::string::npos)
       printed = std::stoul(text.substr(at + 37));
+    else if (text.find("Nothing was measured") != std::string::npos)
+      printed = 0;
     const unsigned int in_csv = count(read_file(csv), "\n") - 1;
     deallog << "study, SIGINT: progress seen " << ok(started && in_grid)
             << ", exit status " << status << " " << ok(status == 130)

@@ -3,10 +3,10 @@
 
 // Broken mesh files are refused with the file, the line and a fix, never a
 // crash and never a silently repaired mesh: an inverted tetrahedron, a
-// degenerate one, a repeated node, an undefined node, a hexahedron, a
-// second-order tetrahedron, a Gmsh 4 file, a binary file, a truncated
-// file, two disconnected bodies, a boundary triangle that is no face, and
-// an unknown extension.
+// degenerate one, a repeated node, two nodes at one point, a duplicated
+// tetrahedron, an undefined node, a hexahedron, a second-order tetrahedron,
+// a Gmsh 4 file, a binary file, a truncated file, two disconnected bodies, a
+// boundary triangle that is no face, and an unknown extension.
 
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/mesh.h>
@@ -69,6 +69,19 @@ main(int argc, char **argv)
   check("a repeated node",
         "repeated.msh",
         nodes + elements({"1 4 2 1 1 1 2 2 4"}));
+  // Two node numbers at one point (a mesh with duplicate nodes): said as
+  // such, with the point, not as a repeated node.
+  check("two nodes at one point",
+        "coincident.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 "
+        "0\n3 0 1 0\n4 0 0 1\n5 1 0 0\n$EndNodes\n" +
+          elements({"1 4 2 1 1 1 2 3 4", "2 4 2 1 1 2 5 3 4"}));
+  // The same four nodes twice (here through node 5 at node 2's point).
+  check("a duplicated tetrahedron",
+        "duplicated.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 "
+        "0\n3 0 1 0\n4 0 0 1\n5 1 0 0\n$EndNodes\n" +
+          elements({"1 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 5 3 4"}));
   check("an undefined node",
         "undefined.msh",
         nodes + elements({"1 4 2 1 1 1 2 3 9"}));

@@ -80,6 +80,17 @@ namespace palpate
     std::string
     to_string(const double x, const unsigned int precision = 6);
 
+    /**
+     * @p x as to_string() shows it (six significant digits) unless that
+     * reads back as another double; then with the fewest digits that read
+     * back as @p x: 0.5 stays "0.5", 0.1 stays "0.1", 0.4999999 stays
+     * "0.4999999" (which six digits would show as 0.5), 1/3 gets its 16-17
+     * digits. For values the user set, echoed back (a material's
+     * constants, the JSON summary).
+     */
+    std::string
+    to_string_exact(const double x);
+
     /** Format @p p as "x, y, z" with @p precision significant digits. */
     std::string
     to_string(const Point3 &p, const unsigned int precision = 6);
@@ -90,6 +101,17 @@ namespace palpate
      */
     Point3
     parse_point(const std::string &text);
+
+    /**
+     * Text read from a file, for a message: in quotes, at most
+     * @p max_characters characters (then "..."), bytes that are neither
+     * printable ASCII nor valid UTF-8 as \xNN; if more than a quarter of
+     * it is such bytes, "binary data (N bytes that are not text)" instead
+     * of echoing it to the terminal.
+     */
+    std::string
+    quoted_excerpt(const std::string &text,
+                   const std::size_t  max_characters = 60);
 
     /**
      * @p text as a JSON string, quotes included (RFC 8259, section 7):

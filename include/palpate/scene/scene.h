@@ -117,12 +117,15 @@ namespace palpate
     /**
      * An InputError about @p entry of this scene: the file and line are
      * filled in, and the entry is shown as "A / B / name = value" when the
-     * file sets it, or as "A / B / name (default 'value')" when not.
+     * file sets it, or as "A / B / name (default 'value')" when not. For
+     * a relation between entries, @p with names the others: those set by
+     * --set are named in the problem.
      */
     InputError
-    error(const std::string &entry,
-          const std::string &problem,
-          const std::string &fix) const;
+    error(const std::string              &entry,
+          const std::string              &problem,
+          const std::string              &fix,
+          const std::vector<std::string> &with = {}) const;
 
     /** Check relations between parameters that no single pattern can. */
     void

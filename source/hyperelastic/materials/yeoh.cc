@@ -130,13 +130,13 @@ namespace palpate
       std::string
       description() const override
       {
-        return "C10 = " + Utilities::to_string(c[0]) +
-               " Pa, C20 = " + Utilities::to_string(c[1]) +
-               " Pa, C30 = " + Utilities::to_string(c[2]) + " Pa, " +
+        return "C10 = " + Utilities::to_string_exact(c[0]) +
+               " Pa, C20 = " + Utilities::to_string_exact(c[1]) +
+               " Pa, C30 = " + Utilities::to_string_exact(c[2]) + " Pa, " +
                (mixed.pressure == Formulation::Pressure::exact ?
                   "exactly incompressible, " + mixed.element + " elements" :
                   "nearly incompressible, bulk modulus " +
-                    Utilities::to_string(mixed.bulk_modulus) + " Pa");
+                    Utilities::to_string_exact(mixed.bulk_modulus) + " Pa");
       }
 
     private:
