@@ -19,6 +19,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <thread>
@@ -65,335 +66,462 @@ namespace palpate
 
 
 
+  namespace
+  {
+    using Clock = std::chrono::steady_clock;
+
+    /**
+     * One interaction, in the steps run_interaction() takes: set up the
+     * device, the haptic loop and the shape output; report; move (attach,
+     * wait for the initial cloud, run the motion, watching for events and
+     * stop signals); summarise; write the outputs.
+     */
+    class InteractionRun
+    {
+    public:
+      InteractionRun(std::ostream &out, const Scene &scene)
+        : out(out)
+        , scene(scene)
+        , p(scene.parameters)
+        , wait_limit(p.haptics.trajectory.initial_cloud_time_limit)
+        , stem(scene.file().empty() ?
+                 "default" :
+                 std::filesystem::path(scene.file()).stem().string())
+      {}
+
+      /** Check the output directory and the trajectory, build the
+       * interaction, the device, the haptic loop and the shape output. */
+      void
+      set_up();
+
+      /** What will run: the state space, the device, the haptic loop. */
+      void
+      report() const;
+
+      /** Attach, start the loop, wait for the initial cloud and run the
+       * motion, reporting events as they happen, until its end or a stop
+       * signal. */
+      void
+      move();
+
+      /** Stop the shape output, detach, print the run summary. */
+      RunSummary
+      summarise();
+
+      /** The CSV/JSON summaries, the store's line, the force log, the VTU
+       * export and the shape output's line; an OutputError listing what
+       * could not be written, after everything else was. */
+      void
+      write_outputs(const RunSummary &summary);
+
+    private:
+      /** Whether the motion may start: the 27 grid points around rest, or
+       * the whole initial cloud (Haptics / Trajectory / Start). */
+      bool
+      ready_to_move() const;
+
+      /** The VTU export of the states the haptic loop used, and its
+       * index. */
+      void
+      write_states();
+
+      std::ostream                    &out;
+      const Scene                     &scene;
+      const Parameters::AllParameters &p;
+      // How long the initial cloud may take before the motion starts
+      // anyway.
+      const double      wait_limit;
+      const std::string stem;
+
+      double                             duration = 0, reach = 0;
+      std::unique_ptr<Interaction>       interaction;
+      std::unique_ptr<SimulatedDevice>   device;
+      std::unique_ptr<HapticLoop>        loop;
+      std::unique_ptr<ShapeInterpolator> shape;
+
+      // From move(): its stop handler, why it stopped early (empty: it did
+      // not), the initial cloud.
+      std::optional<StopRequest> stop_request;
+      std::string                stopped_by;
+      unsigned int               cloud_states   = 0;
+      bool                       cloud_complete = false;
+      // What could not be written is collected and reported after
+      // everything else was written: one lost file does not lose the
+      // others.
+      std::vector<std::string> output_failures;
+    };
+
+
+
+    void
+    InteractionRun::set_up()
+    {
+      // The output directory is checked before anything runs, so that no
+      // work is lost to an unwritable directory at the end.
+      const bool files = p.effects.force_log ||
+                         !p.output.summary_formats.empty() ||
+                         p.effects.shape_output;
+      if (files)
+        check_output_directory(scene);
+
+      auto trajectory = Trajectory::create(scene);
+      duration        = trajectory->duration();
+      // How far the scene's own trajectory takes the probe from rest, along
+      // any axis: beyond the grid's extent the force fades to zero.
+      for (unsigned int k = 0; k <= 1000; ++k)
+        for (const double x : trajectory->position(duration * k / 1000))
+          reach = std::max(reach, std::abs(x));
+      if (duration > Limits::max_motion_duration)
+        throw InputError(
+          scene.resolve_path(p.haptics.trajectory.file_name),
+          0,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "the recording lasts " + Utilities::to_string(duration, 4) +
+            " s; at most " +
+            Utilities::to_string(Limits::max_motion_duration, 4) +
+            " s (one hour) are allowed: the haptic loop preallocates its "
+            "statistics and force log for every tick of the run",
+          "check the time column (seconds, not milliseconds), or split the "
+          "recording.");
+      interaction              = std::make_unique<Interaction>(scene);
+      const double max_seconds = wait_limit + duration + 1;
+      device                   = std::make_unique<SimulatedDevice>(
+        std::move(trajectory),
+        p.effects.force_log ?
+                            HapticLoop::max_ticks(p.haptics.loop_rate, max_seconds) :
+                            0);
+      loop = std::make_unique<HapticLoop>(*interaction,
+                                          *device,
+                                          p.haptics.loop_rate,
+                                          max_seconds);
+
+      if (p.effects.shape_output)
+        shape = std::make_unique<ShapeInterpolator>(
+          *interaction,
+          p.effects.shape_output_rate,
+          p.output.directory,
+          stem,
+          [this] { return loop->motion_time(); },
+          p.effects.shape_output_limit * 1048576.0);
+    }
+
+
+
+    void
+    InteractionRun::report() const
+    {
+      const auto &grid = interaction->grid();
+      out << "\nInteraction\n"
+          << "  state space:   grid spacing " << 1000 * grid.spacing()
+          << " mm, extent +-" << 1000 * grid.half_width() * grid.spacing()
+          << " mm (" << grid.size() << " points), cloud radius "
+          << 1000 * p.scheduler.cloud_radius << " mm, look-ahead "
+          << p.scheduler.look_ahead_time << " s\n"
+          << "  device:        " << device->description() << "\n"
+          << "  haptic loop:   " << p.haptics.loop_rate << " Hz, force limit "
+          << p.haptics.force_limit << " N, at most "
+          << p.haptics.max_force_change << " N change per tick\n";
+      if (reach > grid.half_width() * grid.spacing())
+        out << "  warning:       the trajectory goes " << 1000 * reach
+            << " mm from rest, beyond the state space's extent of +-"
+            << 1000 * grid.half_width() * grid.spacing()
+            << " mm: there the force fades to zero. Enlarge State space / "
+               "Extent to at least "
+            << 1000 * reach << " mm.\n";
+      out << std::flush;
+    }
+
+
+
+    bool
+    InteractionRun::ready_to_move() const
+    {
+      return p.haptics.trajectory.start == "after rest neighbourhood" ?
+               interaction->rest_neighbourhood_missing() == 0 :
+               interaction->initial_cloud_complete();
+    }
+
+
+
+    void
+    InteractionRun::move()
+    {
+      // From here on a stop signal ends the run through the path below, and
+      // the outputs are still written after it (doc/bad-input.md, "Stops"):
+      // it lives as long as this run.
+      const StopRequest &stop = stop_request.emplace();
+
+      const auto t0 = Clock::now();
+      interaction->attach();
+      loop->start(duration);
+      if (shape)
+        shape->start();
+      bool moving = p.haptics.trajectory.start == "immediately";
+      // Start = after rest neighbourhood: the motion waits only for the 27
+      // grid points around rest, the rest of the cloud comes during it.
+      const bool neighbourhood =
+        p.haptics.trajectory.start == "after rest neighbourhood";
+      if (moving)
+        loop->start_motion();
+      else
+        out << "  initial cloud: " << interaction->initial_cloud_size()
+            << " grid points around the rest position; the motion starts when "
+            << (neighbourhood ?
+                  "the 27 around it are computed (Start = after rest "
+                  "neighbourhood; the others during the motion)" :
+                  "they are computed")
+            << " (at most " << wait_limit
+            << " s: Haptics / Trajectory / Initial cloud time "
+               "limit)\n"
+            << std::flush;
+      double next_progress = 10; // s: a word every 10 s while waiting
+
+      // Watch: report events as they happen, start the motion once the
+      // initial cloud is there.
+      while (!loop->finished())
+        {
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          interaction->poll_events(out);
+          const double t =
+            std::chrono::duration<double>(Clock::now() - t0).count();
+          // A stop signal, or nobody left to read the output (a closed pipe,
+          // a full disk: SIGPIPE is ignored, so the write fails instead):
+          // end the motion here and write what the run has.
+          if (stop.requested() || !out)
+            {
+              const double motion = loop->motion_time();
+              stopped_by =
+                (stop.requested() ? "by " + stop.description() :
+                                    std::string("because standard output "
+                                                "could not be written")) +
+                (motion >= 0 ?
+                   " after " + Utilities::to_string(motion, 3) + " s of the " +
+                     Utilities::to_string(duration, 3) + " s motion" :
+                   " before the motion started (" + Utilities::to_string(t, 3) +
+                     " s into the initial cloud)");
+              loop->join();
+              break;
+            }
+          if (!moving && t > next_progress && !ready_to_move())
+            {
+              const auto counts = interaction->cache().counts();
+              out << "  initial cloud: " << counts.first << " of "
+                  << interaction->initial_cloud_size() << " states computed ("
+                  << counts.second << " failure points) after "
+                  << std::setprecision(3) << t << " s\n"
+                  << std::flush;
+              next_progress += 10;
+            }
+          if (!moving && (ready_to_move() || t > wait_limit))
+            {
+              const auto counts = interaction->cache().counts();
+              cloud_states      = counts.first;
+              cloud_complete    = t <= wait_limit;
+              out << "  initial cloud: " << counts.first << " states computed, "
+                  << counts.second << " failure points, in "
+                  << std::setprecision(3) << t << " s"
+                  << (neighbourhood && t <= wait_limit ?
+                        " (the 27 grid points around rest are there; the "
+                        "rest of the cloud is computed during the motion)" :
+                        std::string())
+                  << (t > wait_limit ?
+                        " (not complete after Initial cloud time limit = " +
+                          Utilities::to_string(wait_limit, 4) +
+                          " s: starting anyway)" :
+                        std::string())
+                  << "; motion starts\n"
+                  << std::flush;
+              loop->start_motion();
+              moving = true;
+            }
+        }
+      loop->join();
+    }
+
+
+
+    RunSummary
+    InteractionRun::summarise()
+    {
+      if (shape)
+        {
+          shape->stop();
+          if (!shape->failure().empty())
+            output_failures.push_back("the shape output stopped after " +
+                                      std::to_string(shape->frames().first) +
+                                      " frames: " + shape->failure());
+        }
+      interaction->detach();
+      interaction->poll_events(out);
+
+      RunSummary summary = interaction->summary();
+      loop->add_to(summary);
+      summary.trajectory             = device->description();
+      summary.stopped_by             = stopped_by;
+      summary.stop_signal            = stop_request->signal_number();
+      summary.initial_cloud_states   = cloud_states;
+      summary.initial_cloud_complete = cloud_complete;
+      if (shape)
+        summary.shape_frames = shape->frames().first;
+      out << "\n";
+      summary.print(out);
+      out << std::flush; // kept even if a second Ctrl-C ends what follows
+
+      return summary;
+    }
+
+
+
+    void
+    InteractionRun::write_outputs(const RunSummary &summary)
+    {
+      // Machine-readable copies and logs, only when asked for.
+      const auto write = [&](const std::string           &file,
+                             const std::function<void()> &how) {
+        try
+          {
+            std::filesystem::create_directories(p.output.directory);
+            how();
+            out << "  wrote " << file << "\n";
+          }
+        catch (const std::exception &e)
+          {
+            output_failures.push_back(file + ": " + e.what());
+          }
+      };
+      for (const auto &format : p.output.summary_formats)
+        {
+          const std::string file =
+            p.output.directory + "/" + stem + "-summary." + format;
+          write(file, [&] {
+            if (format == "csv")
+              summary.write_csv(file);
+            else
+              summary.write_json(file);
+          });
+        }
+      if (const std::string store = interaction->store_report(); !store.empty())
+        {
+          out << "  state store:   " << store << "\n";
+          if (interaction->store_write_failed())
+            output_failures.push_back("the state store " + p.state_space.store +
+                                      " stopped taking states: " + store);
+        }
+      if (p.effects.force_log)
+        {
+          const std::string file =
+            p.output.directory + "/" + stem + "-forces.csv";
+          write(file, [&] { device->write_force_log(file); });
+        }
+      // The states as VTU come last: they take longest (seconds on a real
+      // organ), and a second Ctrl-C while they are written, which ends the
+      // process at once, must find the force log and summaries on disk.
+      if (p.effects.vtu_export)
+        {
+          // The states the haptic loop used, for ParaView, and an index.
+          const std::string index =
+            p.output.directory + "/" + stem + "-states.csv";
+          write(index, [&] { write_states(); });
+        }
+      if (shape)
+        out << "  wrote " << p.output.directory << "/" << stem << "-shape.pvd ("
+            << shape->frames().first << " frames while the probe moved, "
+            << shape->frames().second << " skipped for missing states, "
+            << shape->frames_skipped_busy()
+            << " skipped while the machine was busy"
+            << (shape->frames_decimated() > 0 ?
+                  ", " + std::to_string(shape->frames_decimated()) +
+                    " thinned out (past half of Shape output limit = " +
+                    Utilities::to_string(p.effects.shape_output_limit, 4) +
+                    " MiB the rate halves, past 3/4 it halves again, ...)" :
+                  std::string())
+            << (shape->frames_over_limit() > 0 ?
+                  ", " + std::to_string(shape->frames_over_limit()) +
+                    " left out beyond Shape output limit = " +
+                    Utilities::to_string(p.effects.shape_output_limit, 4) +
+                    " MiB" :
+                  std::string())
+            << ")\n";
+      if (!output_failures.empty())
+        {
+          std::string what;
+          for (const auto &f : output_failures)
+            what += "\n  " + f;
+          throw OutputError(
+            "the interaction finished (its summary is above), but " +
+            std::to_string(output_failures.size()) +
+            " output(s) could not be written:" + what +
+            "\n  Check the disk and Output / Directory (" + p.output.directory +
+            ").");
+        }
+    }
+
+
+
+    void
+    InteractionRun::write_states()
+    {
+      const std::string index = p.output.directory + "/" + stem + "-states.csv";
+
+      const HyperelasticSystem system(interaction->mesh(),
+                                      interaction->nodes(),
+                                      p);
+      // The index is written after the states, and each state under a
+      // temporary name first: a second Ctrl-C meanwhile leaves no
+      // truncated file, only whole states and no index.
+      std::ostringstream csv;
+      csv << "point,i,j,k,x_m,y_m,z_m,fx_N,fy_N,fz_N,file\n"
+          << std::setprecision(9);
+      unsigned int written = 0, not_held = 0;
+      for (const unsigned int point : interaction->used_points())
+        {
+          const auto state = interaction->cache().state(point);
+          if (!state)
+            {
+              ++not_held; // dropped for the memory budget, or on a server
+              continue;
+            }
+          const GridIndex   g    = interaction->grid().index(point);
+          const std::string file = stem + "-state-" + std::to_string(g[0]) +
+                                   "_" + std::to_string(g[1]) + "_" +
+                                   std::to_string(g[2]) + ".vtu";
+          const std::string path = p.output.directory + "/" + file;
+          system.write_vtu(*state, path + ".part");
+          std::filesystem::rename(path + ".part", path);
+          csv << point << "," << g[0] << "," << g[1] << "," << g[2] << ","
+              << state->active_displacement[0] << ","
+              << state->active_displacement[1] << ","
+              << state->active_displacement[2] << "," << state->force[0] << ","
+              << state->force[1] << "," << state->force[2] << "," << file
+              << "\n";
+          ++written;
+        }
+      std::ofstream index_file(index);
+      index_file << csv.str();
+      index_file.close();
+      if (!index_file)
+        throw std::runtime_error("cannot write '" + index + "'");
+      out << "  wrote " << written << " states the haptic loop used as VTU ("
+          << stem << "-state-I_J_K.vtu; warp by 'displacement' in ParaView)"
+          << (not_held > 0 ? ", " + std::to_string(not_held) +
+                               " not held here (dropped for the memory "
+                               "budget, or kept by an MPI server)" :
+                             std::string())
+          << "\n";
+    }
+  } // namespace
+
+
+
   RunSummary
   run_interaction(std::ostream &out, const Scene &scene)
   {
-    using Clock   = std::chrono::steady_clock;
-    const auto &p = scene.parameters;
-
-    // How long the initial cloud may take before the motion starts anyway.
-    const double wait_limit = p.haptics.trajectory.initial_cloud_time_limit;
-
-    // The output directory is checked before anything runs, so that no
-    // work is lost to an unwritable directory at the end.
-    const bool files = p.effects.force_log ||
-                       !p.output.summary_formats.empty() ||
-                       p.effects.shape_output;
-    if (files)
-      check_output_directory(scene);
-
-    auto         trajectory = Trajectory::create(scene);
-    const double duration   = trajectory->duration();
-    // How far the scene's own trajectory takes the probe from rest, along
-    // any axis: beyond the grid's extent the force fades to zero.
-    double reach = 0;
-    for (unsigned int k = 0; k <= 1000; ++k)
-      for (const double x : trajectory->position(duration * k / 1000))
-        reach = std::max(reach, std::abs(x));
-    if (duration > Limits::max_motion_duration)
-      throw InputError(
-        scene.resolve_path(p.haptics.trajectory.file_name),
-        0,
-        "trajectory replay (Haptics / Trajectory / File name)",
-        "the recording lasts " + Utilities::to_string(duration, 4) +
-          " s; at most " +
-          Utilities::to_string(Limits::max_motion_duration, 4) +
-          " s (one hour) are allowed: the haptic loop preallocates its "
-          "statistics and force log for every tick of the run",
-        "check the time column (seconds, not milliseconds), or split the "
-        "recording.");
-    Interaction     interaction(scene);
-    const auto     &grid        = interaction.grid();
-    const double    max_seconds = wait_limit + duration + 1;
-    SimulatedDevice device(std::move(trajectory),
-                           p.effects.force_log ?
-                             HapticLoop::max_ticks(p.haptics.loop_rate,
-                                                   max_seconds) :
-                             0);
-
-    out << "\nInteraction\n"
-        << "  state space:   grid spacing " << 1000 * grid.spacing()
-        << " mm, extent +-" << 1000 * grid.half_width() * grid.spacing()
-        << " mm (" << grid.size() << " points), cloud radius "
-        << 1000 * p.scheduler.cloud_radius << " mm, look-ahead "
-        << p.scheduler.look_ahead_time << " s\n"
-        << "  device:        " << device.description() << "\n"
-        << "  haptic loop:   " << p.haptics.loop_rate << " Hz, force limit "
-        << p.haptics.force_limit << " N, at most " << p.haptics.max_force_change
-        << " N change per tick\n";
-    if (reach > grid.half_width() * grid.spacing())
-      out << "  warning:       the trajectory goes " << 1000 * reach
-          << " mm from rest, beyond the state space's extent of +-"
-          << 1000 * grid.half_width() * grid.spacing()
-          << " mm: there the force fades to zero. Enlarge State space / "
-             "Extent to at least "
-          << 1000 * reach << " mm.\n";
-    out << std::flush;
-
-    const std::string stem =
-      scene.file().empty() ?
-        "default" :
-        std::filesystem::path(scene.file()).stem().string();
-    std::unique_ptr<ShapeInterpolator> shape;
-    HapticLoop loop(interaction, device, p.haptics.loop_rate, max_seconds);
-    if (p.effects.shape_output)
-      shape = std::make_unique<ShapeInterpolator>(
-        interaction,
-        p.effects.shape_output_rate,
-        p.output.directory,
-        stem,
-        [&loop] { return loop.motion_time(); },
-        p.effects.shape_output_limit * 1048576.0);
-
-    // From here on a stop signal ends the run through the path below, which
-    // writes every output (doc/bad-input.md, "Stops").
-    const StopRequest stop;
-    std::string       stopped_by;
-
-    const auto t0 = Clock::now();
-    interaction.attach();
-    loop.start(duration);
-    if (shape)
-      shape->start();
-    bool         moving         = p.haptics.trajectory.start == "immediately";
-    unsigned int cloud_states   = 0;
-    bool         cloud_complete = false;
-    // Start = after rest neighbourhood: the motion waits only for the 27
-    // grid points around rest, the rest of the cloud comes during it.
-    const bool neighbourhood =
-      p.haptics.trajectory.start == "after rest neighbourhood";
-    const auto ready = [&] {
-      return neighbourhood ? interaction.rest_neighbourhood_missing() == 0 :
-                             interaction.initial_cloud_complete();
-    };
-    if (moving)
-      loop.start_motion();
-    else
-      out << "  initial cloud: " << interaction.initial_cloud_size()
-          << " grid points around the rest position; the motion starts when "
-          << (neighbourhood ?
-                "the 27 around it are computed (Start = after rest "
-                "neighbourhood; the others during the motion)" :
-                "they are computed")
-          << " (at most " << wait_limit
-          << " s: Haptics / Trajectory / Initial cloud time "
-             "limit)\n"
-          << std::flush;
-    double next_progress = 10; // s: a word every 10 s while waiting
-
-    // Watch: report events as they happen, start the motion once the
-    // initial cloud is there.
-    while (!loop.finished())
-      {
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        interaction.poll_events(out);
-        const double t =
-          std::chrono::duration<double>(Clock::now() - t0).count();
-        // A stop signal, or nobody left to read the output (a closed pipe,
-        // a full disk: SIGPIPE is ignored, so the write fails instead):
-        // end the motion here and write what the run has.
-        if (stop.requested() || !out)
-          {
-            const double motion = loop.motion_time();
-            stopped_by =
-              (stop.requested() ? "by " + stop.description() :
-                                  std::string("because standard output "
-                                              "could not be written")) +
-              (motion >= 0 ?
-                 " after " + Utilities::to_string(motion, 3) + " s of the " +
-                   Utilities::to_string(duration, 3) + " s motion" :
-                 " before the motion started (" + Utilities::to_string(t, 3) +
-                   " s into the initial cloud)");
-            loop.join();
-            break;
-          }
-        if (!moving && t > next_progress && !ready())
-          {
-            const auto counts = interaction.cache().counts();
-            out << "  initial cloud: " << counts.first << " of "
-                << interaction.initial_cloud_size() << " states computed ("
-                << counts.second << " failure points) after "
-                << std::setprecision(3) << t << " s\n"
-                << std::flush;
-            next_progress += 10;
-          }
-        if (!moving && (ready() || t > wait_limit))
-          {
-            const auto counts = interaction.cache().counts();
-            cloud_states      = counts.first;
-            cloud_complete    = t <= wait_limit;
-            out << "  initial cloud: " << counts.first << " states computed, "
-                << counts.second << " failure points, in "
-                << std::setprecision(3) << t << " s"
-                << (neighbourhood && t <= wait_limit ?
-                      " (the 27 grid points around rest are there; the "
-                      "rest of the cloud is computed during the motion)" :
-                      std::string())
-                << (t > wait_limit ?
-                      " (not complete after Initial cloud time limit = " +
-                        Utilities::to_string(wait_limit, 4) +
-                        " s: starting anyway)" :
-                      std::string())
-                << "; motion starts\n"
-                << std::flush;
-            loop.start_motion();
-            moving = true;
-          }
-      }
-    loop.join();
-    // What could not be written is collected and reported after everything
-    // else was written: one lost file does not lose the others.
-    std::vector<std::string> output_failures;
-    if (shape)
-      {
-        shape->stop();
-        if (!shape->failure().empty())
-          output_failures.push_back("the shape output stopped after " +
-                                    std::to_string(shape->frames().first) +
-                                    " frames: " + shape->failure());
-      }
-    interaction.detach();
-    interaction.poll_events(out);
-
-    RunSummary summary = interaction.summary();
-    loop.add_to(summary);
-    summary.trajectory             = device.description();
-    summary.stopped_by             = stopped_by;
-    summary.stop_signal            = stop.signal_number();
-    summary.initial_cloud_states   = cloud_states;
-    summary.initial_cloud_complete = cloud_complete;
-    if (shape)
-      summary.shape_frames = shape->frames().first;
-    out << "\n";
-    summary.print(out);
-    out << std::flush; // kept even if a second Ctrl-C ends what follows
-
-    // Machine-readable copies and logs, only when asked for.
-    const auto write = [&](const std::string           &file,
-                           const std::function<void()> &how) {
-      try
-        {
-          std::filesystem::create_directories(p.output.directory);
-          how();
-          out << "  wrote " << file << "\n";
-        }
-      catch (const std::exception &e)
-        {
-          output_failures.push_back(file + ": " + e.what());
-        }
-    };
-    for (const auto &format : p.output.summary_formats)
-      {
-        const std::string file =
-          p.output.directory + "/" + stem + "-summary." + format;
-        write(file, [&] {
-          if (format == "csv")
-            summary.write_csv(file);
-          else
-            summary.write_json(file);
-        });
-      }
-    if (const std::string store = interaction.store_report(); !store.empty())
-      {
-        out << "  state store:   " << store << "\n";
-        if (interaction.store_write_failed())
-          output_failures.push_back("the state store " + p.state_space.store +
-                                    " stopped taking states: " + store);
-      }
-    if (p.effects.force_log)
-      {
-        const std::string file =
-          p.output.directory + "/" + stem + "-forces.csv";
-        write(file, [&] { device.write_force_log(file); });
-      }
-    // The states as VTU come last: they take longest (seconds on a real
-    // organ), and a second Ctrl-C while they are written, which ends the
-    // process at once, must find the force log and summaries on disk.
-    if (p.effects.vtu_export)
-      {
-        // The states the haptic loop used, for ParaView, and an index.
-        const std::string index =
-          p.output.directory + "/" + stem + "-states.csv";
-        write(index, [&] {
-          const HyperelasticSystem system(interaction.mesh(),
-                                          interaction.nodes(),
-                                          p);
-          // The index is written after the states, and each state under a
-          // temporary name first: a second Ctrl-C meanwhile leaves no
-          // truncated file, only whole states and no index.
-          std::ostringstream csv;
-          csv << "point,i,j,k,x_m,y_m,z_m,fx_N,fy_N,fz_N,file\n"
-              << std::setprecision(9);
-          unsigned int written = 0, not_held = 0;
-          for (const unsigned int point : interaction.used_points())
-            {
-              const auto state = interaction.cache().state(point);
-              if (!state)
-                {
-                  ++not_held; // dropped for the memory budget, or on a server
-                  continue;
-                }
-              const GridIndex   g    = interaction.grid().index(point);
-              const std::string file = stem + "-state-" + std::to_string(g[0]) +
-                                       "_" + std::to_string(g[1]) + "_" +
-                                       std::to_string(g[2]) + ".vtu";
-              const std::string path = p.output.directory + "/" + file;
-              system.write_vtu(*state, path + ".part");
-              std::filesystem::rename(path + ".part", path);
-              csv << point << "," << g[0] << "," << g[1] << "," << g[2] << ","
-                  << state->active_displacement[0] << ","
-                  << state->active_displacement[1] << ","
-                  << state->active_displacement[2] << "," << state->force[0]
-                  << "," << state->force[1] << "," << state->force[2] << ","
-                  << file << "\n";
-              ++written;
-            }
-          std::ofstream index_file(index);
-          index_file << csv.str();
-          index_file.close();
-          if (!index_file)
-            throw std::runtime_error("cannot write '" + index + "'");
-          out << "  wrote " << written
-              << " states the haptic loop used as VTU (" << stem
-              << "-state-I_J_K.vtu; warp by 'displacement' in ParaView)"
-              << (not_held > 0 ? ", " + std::to_string(not_held) +
-                                   " not held here (dropped for the memory "
-                                   "budget, or kept by an MPI server)" :
-                                 std::string())
-              << "\n";
-        });
-      }
-    if (shape)
-      out << "  wrote " << p.output.directory << "/" << stem << "-shape.pvd ("
-          << shape->frames().first << " frames while the probe moved, "
-          << shape->frames().second << " skipped for missing states, "
-          << shape->frames_skipped_busy()
-          << " skipped while the machine was busy"
-          << (shape->frames_decimated() > 0 ?
-                ", " + std::to_string(shape->frames_decimated()) +
-                  " thinned out (past half of Shape output limit = " +
-                  Utilities::to_string(p.effects.shape_output_limit, 4) +
-                  " MiB the rate halves, past 3/4 it halves again, ...)" :
-                std::string())
-          << (shape->frames_over_limit() > 0 ?
-                ", " + std::to_string(shape->frames_over_limit()) +
-                  " left out beyond Shape output limit = " +
-                  Utilities::to_string(p.effects.shape_output_limit, 4) +
-                  " MiB" :
-                std::string())
-          << ")\n";
-    if (!output_failures.empty())
-      {
-        std::string what;
-        for (const auto &f : output_failures)
-          what += "\n  " + f;
-        throw OutputError(
-          "the interaction finished (its summary is above), but " +
-          std::to_string(output_failures.size()) +
-          " output(s) could not be written:" + what +
-          "\n  Check the disk and Output / Directory (" + p.output.directory +
-          ").");
-      }
+    InteractionRun run(out, scene);
+    run.set_up();
+    run.report();
+    run.move();
+    const RunSummary summary = run.summarise();
+    run.write_outputs(summary);
     return summary;
   }
 } // namespace palpate
