@@ -1097,6 +1097,37 @@ namespace palpate
   void
   Scene::validate() const
   {
+    check_material();
+    check_effects();
+    check_probe();
+    check_mesh();
+    check_fixed_nodes();
+    check_solver_tolerances();
+    check_state_space();
+    check_newton_counts();
+    check_haptics();
+  }
+
+
+
+  bool
+  Scene::sets(const std::string &entry) const
+  {
+    return line_of(entry) > 0 ||
+           std::any_of(command_line_settings_.begin(),
+                       command_line_settings_.end(),
+                       [&](const std::string &setting) {
+                         return setting.compare(0,
+                                                entry.size() + 1,
+                                                entry + "=") == 0;
+                       });
+  }
+
+
+
+  void
+  Scene::check_material() const
+  {
     using namespace Limits;
     const auto &p = parameters;
 
@@ -1146,28 +1177,6 @@ namespace palpate
                     "(liver: E = 15465 Pa, or C10 = 2148, C01 = 430).");
       }
 
-    // Effects: each plug-in checks its entries.
-    try
-      {
-        Effect::create_enabled(p.effects);
-      }
-    catch (const Plugins::EntryError &e)
-      {
-        throw error("Effects/" + e.entry, e.problem, e.fix);
-      }
-
-    // Whether the scene file or the command line (--set) sets an entry.
-    const auto sets = [this](const std::string &entry) {
-      return line_of(entry) > 0 ||
-             std::any_of(command_line_settings_.begin(),
-                         command_line_settings_.end(),
-                         [&](const std::string &setting) {
-                           return setting.compare(0,
-                                                  entry.size() + 1,
-                                                  entry + "=") == 0;
-                         });
-    };
-
     // An element pair (Taylor-Hood, P1-P1) fixes the displacement degree.
     if (const Formulation f = material->formulation();
         f.displacement_degree > 0 && sets("Discretization/Polynomial degree") &&
@@ -1179,6 +1188,34 @@ namespace palpate
                   "remove this entry (Material model / " + m.model_name +
                     " / Element chooses the degree), or choose the "
                     "element pair with the degree you want.");
+  }
+
+
+
+  void
+  Scene::check_effects() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
+
+    // Effects: each plug-in checks its entries.
+    try
+      {
+        Effect::create_enabled(p.effects);
+      }
+    catch (const Plugins::EntryError &e)
+      {
+        throw error("Effects/" + e.entry, e.problem, e.fix);
+      }
+  }
+
+
+
+  void
+  Scene::check_probe() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
 
     // The probe's tip: a radius means something only for a glued tip or a
     // sphere (before Tip existed, Tip radius > 0 meant glued nodes).
@@ -1208,6 +1245,15 @@ namespace palpate
                       Utilities::to_string(max_sphere_radius, 3) + " m)",
                     "give the radius in metres (a 1 cm probe: 0.01).");
     }
+  }
+
+
+
+  void
+  Scene::check_mesh() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
 
     // Mesh.
     if (p.mesh.source == "file" && p.mesh.file_name.empty())
@@ -1270,6 +1316,15 @@ namespace palpate
                       "every semi-axis must be positive: a blob with a zero "
                       "or negative semi-axis has no volume",
                       "give three lengths in metres, e.g. 0.125, 0.09, 0.07.");
+  }
+
+
+
+  void
+  Scene::check_fixed_nodes() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
 
     // Fixed nodes: the region must be well-defined.
     const auto &f = p.boundary_conditions.fixed_nodes;
@@ -1291,6 +1346,15 @@ namespace palpate
       throw error("Boundary conditions/Fixed nodes/Node ids",
                   "Selection = node list, but the list is empty",
                   "list the node numbers to fix, separated by commas.");
+  }
+
+
+
+  void
+  Scene::check_solver_tolerances() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
 
     // Solver tolerances.
     const auto &n = p.nonlinear_solver;
@@ -1339,6 +1403,15 @@ namespace palpate
                     "22,590): the density is in kg/m^3, and tissue's is "
                     "about 1,000-1,100",
                   "use 1060 (liver) or your tissue's density in kg/m^3.");
+  }
+
+
+
+  void
+  Scene::check_state_space() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
 
     // State space and cloud.
     if (p.state_space.grid_spacing <= 0)
@@ -1416,6 +1489,16 @@ namespace palpate
                     "cores) or at most " +
                       std::to_string(cores) + ".");
     }
+  }
+
+
+
+  void
+  Scene::check_newton_counts() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
+    const auto &n = p.nonlinear_solver;
 
     // The Newton solver's loop counts.
     const auto count_bound = [&](const std::string &entry,
@@ -1459,6 +1542,15 @@ namespace palpate
                     " MiB (1 TiB): more than any machine palpate runs on, "
                     "and beyond it the budget's byte count overflows",
                   "give the memory for cached states in MiB, e.g. 1024.");
+  }
+
+
+
+  void
+  Scene::check_haptics() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
 
     // Haptics.
     const auto &h = p.haptics;

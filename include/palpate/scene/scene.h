@@ -132,6 +132,48 @@ namespace palpate
     validate() const;
 
   private:
+    /** Whether the scene file or the command line (--set) sets @p entry. */
+    bool
+    sets(const std::string &entry) const;
+
+    /** validate(): the material plug-in's constants, their bounds, and the
+     * element pair's degree. */
+    void
+    check_material() const;
+
+    /** validate(): each enabled effect plug-in's entries. */
+    void
+    check_effects() const;
+
+    /** validate(): the probe's tip and its radius. */
+    void
+    check_probe() const;
+
+    /** validate(): the mesh's source, file, scale and size. */
+    void
+    check_mesh() const;
+
+    /** validate(): the fixed-node region. */
+    void
+    check_fixed_nodes() const;
+
+    /** validate(): the Newton solver's tolerances and staging. */
+    void
+    check_solver_tolerances() const;
+
+    /** validate(): the state grid, the cloud, the scheduler and the engine. */
+    void
+    check_state_space() const;
+
+    /** validate(): the Newton solver's loop counts, and the engine's
+     * memory budget. */
+    void
+    check_newton_counts() const;
+
+    /** validate(): the haptic loop and the trajectory. */
+    void
+    check_haptics() const;
+
     /** A scene whose parameters are not parsed yet (for read()). */
     struct Unparsed
     {};
