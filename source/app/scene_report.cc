@@ -157,7 +157,7 @@ namespace palpate
       const double nu = material->poissons_ratio();
       if (material->formulation().pressure == Formulation::Pressure::none &&
           nu >= 0.495 && p.discretization.polynomial_degree == 1)
-        s << "  warning:       nu = " << nu
+        s << "  warning:       nu = " << Utilities::to_string_exact(nu)
           << " on linear tetrahedra locks (volumetric locking): the body "
              "is too stiff and Newton may stagnate. For a nearly "
              "incompressible organ use Mooney-Rivlin (mixed u-p, exactly "

@@ -79,6 +79,12 @@ namespace palpate
         << "\n"
         << "  active node:    from rest to (" << Utilities::to_string(target, 4)
         << ") m\n"
+        << (p.output.summary_formats.empty() ?
+              std::string() :
+              "  note:           Output / Summary formats: a static solve "
+              "has no run summary to write; its results are printed here "
+              "and written by Effects / Force log, Shape output and VTU "
+              "export.\n")
         << std::flush; // the solve can take minutes: say what it does first
 
     // Shape output: the path from rest, a frame per converged increment.

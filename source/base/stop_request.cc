@@ -4,6 +4,7 @@
 #include <palpate/base/stop_request.h>
 
 #include <signal.h>
+#include <time.h>
 
 #include <atomic>
 #include <csignal>
@@ -21,11 +22,31 @@ namespace palpate
 
     struct sigaction previous[3];
 
+    // When the first one came (CLOCK_MONOTONIC, ns), to tell a second
+    // Ctrl-C from one signal delivered twice.
+    std::atomic<long long> received_at{0};
+    static_assert(std::atomic<long long>::is_always_lock_free);
+
+    long long
+    now_ns() noexcept
+    {
+      timespec t{}; // clock_gettime is async-signal-safe
+      clock_gettime(CLOCK_MONOTONIC, &t);
+      return static_cast<long long>(t.tv_sec) * 1000000000LL + t.tv_nsec;
+    }
+
     void
     on_stop_signal(const int signal)
     {
       int expected = 0;
-      if (!received.compare_exchange_strong(expected, signal))
+      if (received.compare_exchange_strong(expected, signal))
+        received_at.store(now_ns());
+      // A second stop signal within half a second of the first is the same
+      // stop: `timeout`, a terminal or a process manager may deliver one
+      // signal to the process and again to its group, and the run would
+      // then end at once without its outputs. A person's second Ctrl-C
+      // comes later.
+      else if (now_ns() - received_at.load() >= 500000000LL)
         {
           // The second one: the default action, now (sigaction and raise
           // are async-signal-safe).

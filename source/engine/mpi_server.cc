@@ -262,6 +262,10 @@ namespace palpate
       // servers to report ready.
       Clock::time_point last_from_client  = Clock::now();
       bool              heard_from_client = false;
+      // The communicator's last turn, and the longest time this process
+      // stood still between two (s).
+      Clock::time_point last_loop   = Clock::now();
+      double            stalled_for = 0;
     };
 
 
@@ -479,6 +483,12 @@ namespace palpate
       std::vector<char> message;
       while (true)
         {
+          // A loop that took seconds means this process itself was
+          // stopped (SIGSTOP, a frozen machine): remembered for the
+          // message if the client then seems silent.
+          if (const double gap = seconds_since(last_loop); gap > 1)
+            stalled_for = gap;
+          last_loop     = Clock::now();
           bool activity = false;
           int  from     = 0;
           while (messenger.receive(from, message))
@@ -670,6 +680,13 @@ namespace palpate
                       "since this server was ready; it has 600 s")
                 << "): it is lost (killed, or cut off), and this server ends.\n"
                 << std::flush;
+      if (stalled_for >= 0.5 * silent)
+        std::cerr << "  (this server itself stood still for "
+                  << Utilities::to_string(stalled_for, 3)
+                  << " s - stopped (SIGSTOP) or frozen - so the client has "
+                     "declared it lost meanwhile; it is not the client's "
+                     "fault)\n"
+                  << std::flush;
       Environment::peer_lost();
       return true;
     }

@@ -15,8 +15,11 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -109,12 +112,33 @@ namespace palpate
           << impl->position[k][1] << "," << impl->position[k][2] << ","
           << impl->force[k][0] << "," << impl->force[k][1] << ","
           << impl->force[k][2] << "\n";
-    // A full disk shows only here: a cut log is an output error.
+    // A full disk shows only here: a cut log is an output error. What was
+    // written is cut back to its last whole row, so that no row holds a
+    // cut number, and the message says how many rows it keeps.
     out.close();
     if (!out)
-      throw std::runtime_error("'" + filename +
-                               "' could not be written whole (is the disk "
-                               "full?)");
+      {
+        const int   error = errno;
+        std::string text;
+        {
+          std::ifstream      in(filename, std::ios::binary);
+          std::ostringstream s;
+          s << in.rdbuf();
+          text = s.str();
+        }
+        const auto        end  = text.rfind('\n');
+        const std::size_t keep = end == std::string::npos ? 0 : end + 1;
+        std::error_code   ignored;
+        std::filesystem::resize_file(filename, keep, ignored);
+        const std::size_t rows =
+          std::count(text.begin(), text.begin() + keep, '\n');
+        throw std::runtime_error(
+          "'" + filename + "' could not be written whole (" +
+          std::strerror(error) + "): it keeps " +
+          (rows > 0 ? "the first " + std::to_string(rows - 1) + " of " +
+                        std::to_string(impl->n) + " rows, cut at a whole row" :
+                      std::string("nothing")));
+      }
   }
 
 

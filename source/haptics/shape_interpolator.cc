@@ -59,6 +59,11 @@ namespace palpate
     void
     write_frames();
 
+    /** Write the PVD index of the frames written so far, whole (under a
+     * temporary name first); "" or why it could not be. */
+    std::string
+    write_index() const;
+
     const Interaction            &interaction;
     const double                  rate;
     const std::string             directory, stem;
@@ -214,8 +219,9 @@ namespace palpate
     using Clock = std::chrono::steady_clock;
     // Behind the solvers: a frame is for the eye, a state for the hand.
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
-    const auto t0     = Clock::now();
-    const auto period = std::chrono::duration_cast<Clock::duration>(
+    const auto t0         = Clock::now();
+    auto       last_index = t0;
+    const auto period     = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / rate));
     auto              next = t0;
     Utilities::Point3 last{{0, 0, 0}};
@@ -285,6 +291,14 @@ namespace palpate
           frames.write(blend.solution, blend.force, directory + "/" + file);
         records.emplace_back(t, file);
         ++written;
+        // The index is rewritten every few seconds as frames come, so that
+        // a run that ends without stop() (a kill, a crash) leaves its
+        // frames indexed, not only at the end.
+        if (Utilities::seconds_since(last_index) >= 5)
+          {
+            write_index();
+            last_index = Clock::now();
+          }
         last = x;
         any  = true;
       }
@@ -382,7 +396,16 @@ namespace palpate
     }
     impl->wake.notify_all();
     impl->thread.join();
-    const std::string file = impl->directory + "/" + impl->stem + "-shape.pvd";
+    if (const std::string why = impl->write_index(); !why.empty())
+      impl->failure += (impl->failure.empty() ? "" : "; ") + why;
+  }
+
+
+
+  std::string
+  ShapeInterpolator::Impl::write_index() const
+  {
+    const std::string file = directory + "/" + stem + "-shape.pvd";
     // The index is built in memory and written whole, under a temporary
     // name first: on a full disk there is either an index of every frame
     // written or none, never a cut one. deal.II asserts on a stream that
@@ -390,7 +413,7 @@ namespace palpate
     std::ostringstream index;
     try
       {
-        dealii::DataOutBase::write_pvd_record(index, impl->records);
+        dealii::DataOutBase::write_pvd_record(index, records);
       }
     catch (const std::exception &)
       {
@@ -404,17 +427,14 @@ namespace palpate
     std::error_code renamed;
     if (pvd && index)
       std::filesystem::rename(part, file, renamed);
-    if (!pvd || !index || renamed)
-      {
-        std::error_code ignored;
-        std::filesystem::remove(part, ignored);
-        const std::string why =
-          "the index '" + file + "' could not be written (" +
-          (renamed ? renamed.message() : std::string(std::strerror(error))) +
-          "): the " + std::to_string(impl->written.load()) +
-          " frames written are on disk without it";
-        impl->failure += (impl->failure.empty() ? "" : "; ") + why;
-      }
+    if (pvd && index && !renamed)
+      return "";
+    std::error_code ignored;
+    std::filesystem::remove(part, ignored);
+    return "the index '" + file + "' could not be written (" +
+           (renamed ? renamed.message() : std::string(std::strerror(error))) +
+           "): the " + std::to_string(written.load()) +
+           " frames written are on disk without it";
   }
 
 

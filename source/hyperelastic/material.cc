@@ -147,6 +147,15 @@ namespace palpate
     f.stabilization =
       f.element == "P1-P1" && prm.get("Stabilization") == "Brezzi-Pitkaranta";
     f.stabilization_factor = prm.get_double("Stabilization factor");
+    // alpha is of order 0.01-1 (Brezzi-Pitkaranta); beyond 100 the term
+    // swamps the equations it stabilises (1e308 made the rest state a
+    // failure point).
+    if (f.stabilization && !(f.stabilization_factor <= 100))
+      throw Plugins::EntryError(
+        "Stabilization factor",
+        "at most 100: alpha is of order 0.01-1, and a larger term swamps "
+        "the incompressibility it stabilises",
+        "use 0.05 (the default).");
     return f;
   }
 

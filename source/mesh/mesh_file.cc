@@ -91,6 +91,19 @@ namespace palpate
         while (std::getline(in, raw))
           {
             ++number;
+            // A byte order mark (some Windows tools begin UTF-8 with one)
+            // is not part of the first line; UTF-16 is no mesh text.
+            if (number == 1 && raw.rfind("\xEF\xBB\xBF", 0) == 0)
+              raw.erase(0, 3);
+            else if (number == 1 && (raw.rfind("\xFF\xFE", 0) == 0 ||
+                                     raw.rfind("\xFE\xFF", 0) == 0))
+              throw error(
+                "the file is UTF-16 text (it begins with a UTF-16 "
+                "byte order mark); mesh files are ASCII",
+                "export it again as ASCII, or convert it: iconv -f "
+                "UTF-16 -t UTF-8 '" +
+                  filename + "' > mesh" +
+                  std::filesystem::path(filename).extension().string());
             line = Utilities::trim(raw);
             if (!line.empty())
               return true;
@@ -236,6 +249,15 @@ namespace palpate
               for (long i = 0; i < n; ++i)
                 {
                   const auto t = tokens_of(reader.expect("a node"));
+                  // The section ended before the count: the header's count
+                  // is wrong, not the line.
+                  if (!t.empty() && t[0] == nodes_end)
+                    throw reader.error(
+                      "the node section's header says " + std::to_string(n) +
+                        " nodes, but it ends after " + std::to_string(i),
+                      "correct the count in the line after " + nodes_begin +
+                        " to " + std::to_string(i) +
+                        ", or export the mesh again.");
                   if (t.size() < 4)
                     throw reader.error("a node line needs 'number x y z'",
                                        "the file is damaged; export it "

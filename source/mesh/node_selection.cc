@@ -120,10 +120,11 @@ namespace palpate
      * sphere. For a node X at d = X - P from the unlifted centre P,
      * |d - t n| >= R holds for t >= d.n + sqrt((d.n)^2 - |d|^2 + R^2).
      */
-    void
+    double
     place_sphere(const Mesh              &mesh,
                  const double             R,
                  const Utilities::Point3 *point,
+                 const bool               midpoints,
                  NodeSelection           &selection)
     {
       using namespace Utilities;
@@ -186,6 +187,32 @@ namespace palpate
       selection.sphere_lift   = lift;
       selection.sphere_center = {
         {P[0] + lift * n[0], P[1] + lift * n[1], P[2] + lift * n[2]}};
+
+      // How far from the sphere's axis (through the anchor, along n) the
+      // nearest surface node is (a vertex; @p midpoints: or an edge
+      // midpoint, a P2 contact node). Pushed along -n, the sphere cuts the
+      // surface in a circle of at most its radius: a smaller sphere never
+      // has a node inside, and renders no force at any depth.
+      const auto lateral = [&](const Point3 &X) {
+        const Point3 d  = minus(X, anchor);
+        const double dn = dot(d, n);
+        return std::sqrt(std::max(0.0, dot(d, d) - dn * dn));
+      };
+      double nearest = std::numeric_limits<double>::max();
+      for (const auto &face : faces)
+        for (unsigned int i = 0; i < 3; ++i)
+          {
+            const Point3 &A = x[face.vertices[i]],
+                         &B = x[face.vertices[(i + 1) % 3]];
+            nearest         = std::min(nearest, lateral(A));
+            if (midpoints)
+              nearest = std::min(nearest,
+                                 lateral({{(A[0] + B[0]) / 2,
+                                           (A[1] + B[1]) / 2,
+                                           (A[2] + B[2]) / 2}}));
+          }
+      const double hole = nearest;
+      return hole;
     }
   } // namespace
 
@@ -359,10 +386,30 @@ namespace palpate
         "choose an active node outside the fixed region, or "
         "shrink the region.");
     if (a.tip == Parameters::ActiveNode::Tip::sphere)
-      place_sphere(mesh,
-                   a.tip_radius,
-                   a.selection == "node id" ? nullptr : &a.point,
-                   selection);
+      {
+        // With quadratic elements the edge midpoints are contact nodes
+        // too.
+        const double hole =
+          place_sphere(mesh,
+                       a.tip_radius,
+                       a.selection == "node id" ? nullptr : &a.point,
+                       scene.parameters.discretization.polynomial_degree == 2,
+                       selection);
+        if (a.tip_radius < hole)
+          throw scene.error(
+            "Boundary conditions/Active node/Tip radius",
+            "a sphere of " + Utilities::to_string(a.tip_radius, 3) +
+              " m radius is smaller than the distance from where it touches "
+              "the surface to the nearest surface node (" +
+              Utilities::to_string(hole, 3) +
+              " m, across the surface): the contact acts at nodes, so pushed "
+              "in, the sphere passes between them and renders no force",
+            "use a radius of at least " + Utilities::to_string(hole, 3) +
+              " m (twice that for a force at every depth), or a mesh finer "
+              "near the probe (Mesh / Source = surface grades it toward the "
+              "probe), or Polynomial degree = 2 (the "
+              "edge midpoints become contact nodes).");
+      }
     if (a.tip == Parameters::ActiveNode::Tip::glued_nodes)
       {
         selection.tip_neighbour_distance = std::numeric_limits<double>::max();

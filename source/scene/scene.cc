@@ -1062,6 +1062,13 @@ namespace palpate
     constexpr double min_modulus = 1e-3;
     /** Haptics / Loop rate (Hz): below this there is no haptic loop. */
     constexpr double min_loop_rate = 1;
+    /** Scheduler / Rate (Hz): below, planning lags the hand by seconds. */
+    constexpr double min_scheduler_rate = 1;
+    /** Haptics / Force limit (N): below, no force is rendered. */
+    constexpr double min_force_limit = 1e-3;
+    /** Haptics / Maximum force change (N per tick): below, a 1 N force
+     * takes more than 10 s to arrive at 1 kHz. */
+    constexpr double min_force_change = 1e-4;
     /** Nonlinear solver / Number of increments: each is a Newton solve. */
     constexpr unsigned int max_increments = 1000;
     /** Nonlinear solver / Maximum Newton iterations per increment. */
@@ -1450,8 +1457,13 @@ namespace palpate
         "increase Cloud radius or decrease State space / Grid "
         "spacing.",
         {"State space/Grid spacing"});
-    if (p.scheduler.rate <= 0)
-      throw error("Scheduler/Rate", "the rate must be positive", "use 100 Hz.");
+    if (!(p.scheduler.rate >= min_scheduler_rate))
+      throw error("Scheduler/Rate",
+                  "at least " + Utilities::to_string(min_scheduler_rate, 3) +
+                    " Hz: the scheduler re-plans the cloud around the moving "
+                    "HIP on each cycle; slower, the states the hand needs are "
+                    "planned seconds late and the force fades",
+                  "use 100 Hz (the paper's rate).");
     if (p.scheduler.cloud_radius > p.state_space.extent)
       throw error("Scheduler/Cloud radius",
                   "the cloud reaches beyond the state space (State space / "
@@ -1565,13 +1577,17 @@ namespace palpate
                     "thousands of ticks per second, and a run waits for "
                     "its ticks",
                   "use 1000 Hz.");
-    if (h.force_limit <= 0)
+    if (!(h.force_limit >= min_force_limit))
       throw error("Haptics/Force limit",
-                  "the force limit must be positive",
+                  "at least " + Utilities::to_string(min_force_limit, 3) +
+                    " N: below, the device renders (nearly) no force at all "
+                    "(haptic devices reach 1-40 N)",
                   "set the device's peak force in N, e.g. 8.");
-    if (h.max_force_change <= 0)
+    if (!(h.max_force_change >= min_force_change))
       throw error("Haptics/Maximum force change",
-                  "the force change per tick must be positive",
+                  "at least " + Utilities::to_string(min_force_change, 3) +
+                    " N per tick: below, a force of 1 N takes more than 10 s "
+                    "to arrive at 1 kHz, and the hand feels nothing",
                   "use e.g. 0.05 N.");
     if (h.loop_rate > max_loop_rate)
       throw error("Haptics/Loop rate",

@@ -453,6 +453,36 @@ main(int argc, char **argv)
         "density.prm",
         beam + "subsection Material model\n"
                "  set Density = 1e9\nend\n");
+  // The third re-run's bounds (issue 26): each made a run render no force
+  // with exit 0.
+  scene("Scheduler / Rate = 1e-9 Hz",
+        "scheduler-rate.prm",
+        beam + "subsection Scheduler\n  set Rate = 1e-9\nend\n");
+  scene("Haptics / Maximum force change = 1e-300 N",
+        "force-change.prm",
+        beam + "subsection Haptics\n  set Maximum force change = 1e-300\n"
+               "end\n");
+  scene("Mooney-Rivlin Stabilization factor = 1e308",
+        "stabilization.prm",
+        beam + "subsection Material model\n  set Model name = Mooney-Rivlin\n"
+               "  subsection Mooney-Rivlin\n"
+               "    set Stabilization factor = 1e308\n  end\nend\n");
+  scene("an unstable Yeoh law (C20 = -1e9 Pa)",
+        "yeoh-unstable.prm",
+        beam + "subsection Material model\n  set Model name = Yeoh\n"
+               "  subsection Yeoh\n    set C20 = -1e9\n  end\nend\n");
+  scene("a sphere probe smaller than the gaps between surface nodes",
+        "small-sphere.prm",
+        setup + "subsection Mesh\n  set Source = beam\nend\n"
+                "subsection Boundary conditions\n"
+                "  subsection Fixed nodes\n"
+                "    set Selection = boundary id\n"
+                "    set Boundary ids = 0\n"
+                "  end\n"
+                "  subsection Active node\n"
+                "    set Point = 0.055, 0.004, 0.01\n"
+                "    set Tip = sphere\n    set Tip radius = 0.0001\n"
+                "  end\nend\n");
   // Paths the file system refuses: a link to itself.
   std::filesystem::remove("loop");
   std::filesystem::create_symlink("loop", "loop");

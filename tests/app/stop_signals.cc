@@ -133,6 +133,30 @@ main()
   // A second Ctrl-C while the used states are written as VTU (the slowest
   // output) ends the process at once, as documented; the force log and the
   // summaries are on disk by then, since they are written before the VTU.
+  // One signal delivered twice within milliseconds (as `timeout` or a
+  // process manager may, to the process and to its group): the same stop,
+  // not "a second Ctrl-C, end at once" - everything is written.
+  {
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() != ".txt")
+        std::filesystem::remove(f.path());
+    std::filesystem::remove(out);
+    const pid_t pid     = start_palpate(interaction, out, err);
+    const bool  started = wait_for_text(out, "; motion starts");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    kill(pid, SIGTERM);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    kill(pid, SIGTERM);
+    const int status = wait_status(pid);
+    deallog << "SIGTERM twice within 5 ms: motion started " << ok(started)
+            << ", exit status 143 " << ok(status == 143) << ", summary printed "
+            << ok(read_file(out).find("Run summary") != std::string::npos)
+            << ", force log and JSON written "
+            << ok(force_log(dir + "/paper-stvk-forces.csv").second > 500 &&
+                  std::filesystem::exists(dir + "/paper-stvk-summary.json"))
+            << std::endl;
+  }
+
   {
     for (const auto &f : std::filesystem::directory_iterator(dir))
       if (f.path().extension() != ".txt")

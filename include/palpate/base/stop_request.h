@@ -22,7 +22,9 @@ namespace palpate
    * (130 for Ctrl-C), documented in doc/bad-input.md.
    *
    * A second such signal ends the process at once (the default action): a
-   * user who presses Ctrl-C twice means it.
+   * user who presses Ctrl-C twice means it. One that comes within 0.5 s
+   * of the first is the same stop delivered twice (`timeout` and process
+   * managers signal the process and its group) and is ignored.
    *
    * SIGPIPE is not among them: the program ignores it (see
    * ignore_broken_pipes()), so that a closed pipe on standard output

@@ -59,9 +59,29 @@ namespace palpate
       {
         const double c10 = prm.get_double("C10");
         check_modulus("C10", c10);
+        const double c20 = prm.get_double("C20"), c30 = prm.get_double("C30");
+        // The law must stay stable over the strains a probe causes:
+        // W'(x) = C10 + 2 C20 x + 3 C30 x^2 > 0 for x = I1bar - 3 in
+        // [0, 3] (stretches up to about 2.2). A negative C20 or C30 large
+        // against C10 makes the energy fall with strain: every state near
+        // rest is a failure point and the run renders no force.
+        for (unsigned int k = 0; k <= 30; ++k)
+          if (const double x = 0.1 * k;
+              !(c10 + 2 * c20 * x + 3 * c30 * x * x > 0))
+            throw Plugins::EntryError(
+              c20 < 0 ? "C20" : "C30",
+              "with C10 = " + Utilities::to_string(c10) +
+                ", C20 = " + Utilities::to_string(c20) +
+                " and C30 = " + Utilities::to_string(c30) +
+                " Pa the law is unstable: its stiffness C10 + 2 C20 x + 3 "
+                "C30 x^2 is not positive at I1 - 3 = " +
+                Utilities::to_string(x, 2) +
+                " (a strain a probe reaches), so no state there exists",
+              "make C20 and C30 positive (soft tissue stiffens with strain), "
+              "or small against C10.");
         return std::make_unique<Yeoh>(c10,
-                                      prm.get_double("C20"),
-                                      prm.get_double("C30"),
+                                      c20,
+                                      c30,
                                       parse_incompressibility(prm));
       }
 
