@@ -522,8 +522,17 @@ namespace palpate
             --waiting;
             if (!jobs.empty())
               {
-                auto job = std::move(jobs.front());
-                jobs.pop_front();
+                // Under a flood of connections queued for a thread (3,000
+                // idle connects delayed the page's next request by 10 s),
+                // the newest first: the page's reconnect is behind the
+                // flood, whose older connections wait and are then closed
+                // as idle or evicted.
+                const bool newest = jobs.size() > most / 8;
+                auto       job = std::move(newest ? jobs.back() : jobs.front());
+                if (newest)
+                  jobs.pop_back();
+                else
+                  jobs.pop_front();
                 lock.unlock();
                 job();
                 lock.lock();

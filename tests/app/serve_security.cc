@@ -47,6 +47,7 @@
 #include <httplib.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -671,6 +672,50 @@ main(int argc, char **argv)
     close(c);
     deallog << "a connection that sends nothing is closed after 1 s: "
             << ok(t > 0.5 && t < 2.5) << std::endl;
+  }
+  {
+    // A flood: 3,000 connections opened at once that send nothing (more
+    // than 10 times the threads). The page's next request, on a new
+    // connection behind them, waited 10 s; under a flood the newest
+    // connection is served first.
+    rlimit files{};
+    getrlimit(RLIMIT_NOFILE, &files);
+    const rlim_t wanted = 3100;
+    if (files.rlim_cur < wanted && files.rlim_max >= wanted)
+      {
+        files.rlim_cur = wanted;
+        setrlimit(RLIMIT_NOFILE, &files);
+      }
+    const unsigned int n =
+      std::min<rlim_t>(3000, files.rlim_cur > 100 ? files.rlim_cur - 100 : 0);
+    std::vector<int> flood;
+    sockaddr_in      to{};
+    to.sin_family      = AF_INET;
+    to.sin_port        = htons(port);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        const int c = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK, 0);
+        if (c < 0)
+          break;
+        connect(c, reinterpret_cast<const sockaddr *>(&to), sizeof to);
+        flood.push_back(c);
+      }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    httplib::Client client("127.0.0.1", port);
+    client.set_read_timeout(30, 0);
+    client.set_connection_timeout(30, 0);
+    const auto   sent_at = Clock::now();
+    const auto   a       = client.Get("/frame");
+    const double t       = seconds_since(sent_at);
+    for (const int c : flood)
+      close(c);
+    deallog << "a flood of " << (flood.size() >= 1000 ? ">= 1000" : "FEWER")
+            << " idle connections: /frame on a new connection answered "
+            << ok(a && a->status == 200) << " within 1 s " << ok(t < 1)
+            << std::endl;
+    std::cout << "/frame behind " << flood.size() << " idle connections: " << t
+              << " s" << std::endl;
   }
   server.stop();
 
