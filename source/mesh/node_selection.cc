@@ -395,20 +395,26 @@ namespace palpate
                        a.selection == "node id" ? nullptr : &a.point,
                        scene.parameters.discretization.polynomial_degree == 2,
                        selection);
-        if (a.tip_radius < hole)
+        // Pushed in by a depth d, the sphere cuts the surface in a circle of
+        // radius sqrt(2 R d - d^2), at most R (at d = R): a sphere smaller
+        // than the distance never meets a node. Measured on liver501 (the
+        // nearest node 4.3 mm away), a 6 mm sphere pushed 1 cm still
+        // passed between the nodes (0 N) and 1 cm rendered 0.27 N: twice
+        // the distance makes the first node touch within a quarter of it.
+        if (a.tip_radius < 2 * hole)
           throw scene.error(
             "Boundary conditions/Active node/Tip radius",
             "a sphere of " + Utilities::to_string(a.tip_radius, 3) +
-              " m radius is smaller than the distance from where it touches "
-              "the surface to the nearest surface node (" +
+              " m radius is too small for the gaps between the surface nodes "
+              "where it touches (the nearest is " +
               Utilities::to_string(hole, 3) +
-              " m, across the surface): the contact acts at nodes, so pushed "
-              "in, the sphere passes between them and renders no force",
-            "use a radius of at least " + Utilities::to_string(hole, 3) +
-              " m (twice that for a force at every depth), or a mesh finer "
-              "near the probe (Mesh / Source = surface grades it toward the "
-              "probe), or Polynomial degree = 2 (the "
-              "edge midpoints become contact nodes).");
+              " m away across the surface): the contact acts at nodes, so "
+              "pushed in, the sphere passes between them and renders no "
+              "force",
+            "use a radius of at least " + Utilities::to_string(2 * hole, 3) +
+              " m (twice that distance), or a mesh finer near the probe (Mesh "
+              "/ Source = surface grades it toward the probe), or Polynomial "
+              "degree = 2 (the edge midpoints become contact nodes).");
       }
     if (a.tip == Parameters::ActiveNode::Tip::glued_nodes)
       {
