@@ -5,8 +5,9 @@
 // crash and never a silently repaired mesh: an inverted tetrahedron, a
 // degenerate one, a repeated node, two nodes at one point, a duplicated
 // tetrahedron, an undefined node, a hexahedron, a second-order tetrahedron,
-// a Gmsh 4 file, a binary file, a truncated file, two disconnected bodies, a
-// boundary triangle that is no face, and an unknown extension.
+// a Gmsh 4 file, a binary file, UTF-16, a wrong node count, a truncated
+// file, two disconnected bodies, a boundary triangle that is no face, and an
+// unknown extension. A UTF-8 byte order mark is skipped.
 
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/mesh.h>
@@ -58,6 +59,24 @@ main(int argc, char **argv)
   check("a valid tetrahedron",
         "good.msh",
         nodes + elements({"1 4 2 1 1 1 2 3 4"}));
+  // Encodings: a UTF-8 byte order mark (some Windows tools write one) is
+  // skipped; UTF-16 is named, not "does not start with $MeshFormat".
+  check("a valid tetrahedron after a UTF-8 byte order mark",
+        "bom.msh",
+        "\xEF\xBB\xBF" + nodes + elements({"1 4 2 1 1 1 2 3 4"}));
+  {
+    const std::string text  = nodes + elements({"1 4 2 1 1 1 2 3 4"});
+    std::string       utf16 = "\xFF\xFE";
+    for (const char c : text)
+      utf16 += std::string(1, c) + '\0';
+    check("a mesh file in UTF-16", "utf16.msh", utf16);
+  }
+  // A node count larger than the section: the count is named.
+  check("a node count larger than the node section",
+        "count.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n999999999\n"
+        "1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n" +
+          elements({"1 4 2 1 1 1 2 3 4"}));
   check("an inverted tetrahedron",
         "inverted.msh",
         nodes + elements({"7 4 2 1 1 1 2 4 3"}));
