@@ -671,21 +671,26 @@ namespace palpate
       const double silent = seconds_since(last_from_client);
       if (silent <= (heard_from_client ? p.engine.server_timeout : 600.0))
         return false;
-      std::cerr << "\npalpate (solver server, MPI rank " << messenger.rank()
-                << "): the client (rank " << client_rank
-                << ") sent nothing for " << Utilities::to_string(silent, 3)
-                << " s ("
-                << (heard_from_client ?
-                      "Engine / Server timeout" :
-                      "since this server was ready; it has 600 s")
-                << "): it is lost (killed, or cut off), and this server ends.\n"
-                << std::flush;
       if (stalled_for >= 0.5 * silent)
-        std::cerr << "  (this server itself stood still for "
+        // This process stood still (SIGSTOP, a frozen machine): the client
+        // is fine, and has declared this server lost meanwhile.
+        std::cerr << "\npalpate (solver server, MPI rank " << messenger.rank()
+                  << "): this server stood still for "
                   << Utilities::to_string(stalled_for, 3)
-                  << " s - stopped (SIGSTOP) or frozen - so the client has "
-                     "declared it lost meanwhile; it is not the client's "
-                     "fault)\n"
+                  << " s (stopped with SIGSTOP, or frozen), longer than "
+                     "Engine / Server timeout: the client has declared it "
+                     "lost meanwhile, and it ends.\n"
+                  << std::flush;
+      else
+        std::cerr << "\npalpate (solver server, MPI rank " << messenger.rank()
+                  << "): the client (rank " << client_rank
+                  << ") sent nothing for " << Utilities::to_string(silent, 3)
+                  << " s ("
+                  << (heard_from_client ?
+                        "Engine / Server timeout" :
+                        "since this server was ready; it has 600 s")
+                  << "): it is lost (killed, or cut off), and this server "
+                     "ends.\n"
                   << std::flush;
       Environment::peer_lost();
       return true;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -223,9 +224,18 @@ namespace palpate
             "UTF-8 '" +
               filename + "' > recording.csv");
         const std::string t = Utilities::trim(line);
+        // Comments, and a header line before the data: one whose first
+        // field is not a number ("nan" and "inf" are numbers, refused
+        // below, not a header to skip).
+        const auto not_a_number = [](const std::string &field) {
+          char *end = nullptr;
+          std::strtod(field.c_str(), &end);
+          return end == field.c_str();
+        };
         if (t.empty() || t[0] == '#' ||
-            std::isalpha(static_cast<unsigned char>(t[0])))
-          continue; // comments and a header line
+            (times.empty() && std::isalpha(static_cast<unsigned char>(t[0])) &&
+             not_a_number(t.substr(0, t.find(',')))))
+          continue;
         const auto pieces = Utilities::split(t, ',');
         double     v[4];
         bool       ok = pieces.size() == 4;

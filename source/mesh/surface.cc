@@ -606,6 +606,17 @@ namespace palpate
         return v;
       };
       const auto values = [&](const std::size_t n, const std::string &type) {
+        // Every value takes at least a byte: a count beyond what is left
+        // of the file is a damaged header, refused before allocating (a
+        // POINTS count of 1e12 ended in std::bad_alloc).
+        if (n > data.size() - std::min(pos, data.size()))
+          throw bad(filename,
+                    0,
+                    "the file says " + std::to_string(n) +
+                      " values follow, but only " +
+                      std::to_string(data.size() - std::min(pos, data.size())) +
+                      " bytes are left in it",
+                    damaged);
         return binary ? binary_values(n, type) : ascii_values(n);
       };
 
@@ -621,9 +632,18 @@ namespace palpate
           words >> keyword;
           if (keyword == "POINTS")
             {
-              std::size_t n;
+              std::size_t n = 0;
               std::string type;
               words >> n >> type;
+              if (n > data.size() - std::min(pos, data.size()))
+                throw bad(filename,
+                          0,
+                          "the file says " + std::to_string(n) +
+                            " points follow, but only " +
+                            std::to_string(data.size() -
+                                           std::min(pos, data.size())) +
+                            " bytes are left in it",
+                          damaged);
               const auto v = values(3 * n, type);
               for (std::size_t i = 0; i < n; ++i)
                 s.vertices.push_back({{v[3 * i], v[3 * i + 1], v[3 * i + 2]}});
@@ -631,7 +651,7 @@ namespace palpate
           else if (keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS" ||
                    keyword == "VERTICES" || keyword == "LINES")
             {
-              std::size_t n, size;
+              std::size_t n = 0, size = 0;
               words >> n >> size;
               polygons          = keyword == "POLYGONS";
               const bool strips = keyword == "TRIANGLE_STRIPS";

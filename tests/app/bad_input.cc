@@ -177,6 +177,13 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = path.csv\n  end\nend\n");
+  // A NaN time was taken for a header line and dropped without a word.
+  write_file("nan.csv", "0, 0, 0, 0\nnan, 0, 0, 0\n0.002, 0, 0, 0\n");
+  scene("a replay trajectory with a NaN time",
+        "replay-nan.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = nan.csv\n  end\nend\n");
   scene("a replay trajectory that is /dev/zero",
         "replay-zero.prm",
         interaction + beam_body +
@@ -539,6 +546,12 @@ main(int argc, char **argv)
   std::filesystem::remove("zero.obj");
   std::filesystem::create_symlink("/dev/zero", "zero.obj");
   run("a surface file that is /dev/zero", "mesh zero.obj out.msh");
+  // A legacy VTK surface whose POINTS count is 1e12: it ended in
+  // std::bad_alloc (an internal error) before the count was checked.
+  write_file("huge.vtk",
+             "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\n"
+             "POINTS 1000000000000 float\n0 0 0\n");
+  run("a VTK surface whose POINTS count is 1e12", "mesh huge.vtk out.msh");
   run("a mesh whose direct solve needs more memory than the machine has",
       "solve good.prm --set 'Mesh/Beam/Subdivisions=100,30,30' --set "
       "'Discretization/Polynomial degree=2'");
