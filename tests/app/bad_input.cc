@@ -478,18 +478,18 @@ main(int argc, char **argv)
         "yeoh-unstable.prm",
         beam + "subsection Material model\n  set Model name = Yeoh\n"
                "  subsection Yeoh\n    set C20 = -1e9\n  end\nend\n");
-  scene("a sphere probe smaller than the gaps between surface nodes",
-        "small-sphere.prm",
-        setup + "subsection Mesh\n  set Source = beam\nend\n"
-                "subsection Boundary conditions\n"
-                "  subsection Fixed nodes\n"
-                "    set Selection = boundary id\n"
-                "    set Boundary ids = 0\n"
-                "  end\n"
-                "  subsection Active node\n"
-                "    set Point = 0.055, 0.004, 0.01\n"
-                "    set Tip = sphere\n    set Tip radius = 0.0001\n"
-                "  end\nend\n");
+  {
+    // The beam scene with its Point moved between nodes and a tiny sphere.
+    std::string       small_sphere = beam;
+    const std::string point        = "    set Point = 0.1, 0, 0.01\n";
+    small_sphere.replace(small_sphere.find(point),
+                         point.size(),
+                         "    set Point = 0.055, 0.004, 0.01\n"
+                         "    set Tip = sphere\n    set Tip radius = 0.0001\n");
+    scene("a sphere probe smaller than the gaps between surface nodes",
+          "small-sphere.prm",
+          small_sphere);
+  }
   // Paths the file system refuses: a link to itself.
   std::filesystem::remove("loop");
   std::filesystem::create_symlink("loop", "loop");
