@@ -202,6 +202,47 @@ namespace palpate
 
 
     Point3
+    closest_on_triangle(const Point3 &p,
+                        const Point3 &a,
+                        const Point3 &b,
+                        const Point3 &c)
+    {
+      const auto at = [&](const double v, const double w) {
+        return Point3{{a[0] + v * (b[0] - a[0]) + w * (c[0] - a[0]),
+                       a[1] + v * (b[1] - a[1]) + w * (c[1] - a[1]),
+                       a[2] + v * (b[2] - a[2]) + w * (c[2] - a[2])}};
+      };
+      const Point3 ab = minus(b, a), ac = minus(c, a), ap = minus(p, a);
+      const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+      if (d1 <= 0 && d2 <= 0)
+        return a;
+      const Point3 bp = minus(p, b);
+      const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+      if (d3 >= 0 && d4 <= d3)
+        return b;
+      const double vc = d1 * d4 - d3 * d2;
+      if (vc <= 0 && d1 >= 0 && d3 <= 0)
+        return at(d1 / (d1 - d3), 0);
+      const Point3 cp = minus(p, c);
+      const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+      if (d6 >= 0 && d5 <= d6)
+        return c;
+      const double vb = d5 * d2 - d1 * d6;
+      if (vb <= 0 && d2 >= 0 && d6 <= 0)
+        return at(0, d2 / (d2 - d6));
+      const double va = d3 * d6 - d5 * d4;
+      if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        {
+          const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+          return at(1 - w, w);
+        }
+      const double denominator = 1 / (va + vb + vc);
+      return at(vb * denominator, vc * denominator);
+    }
+
+
+
+    Point3
     scaled(const Point3 &a, const double s)
     {
       return {{s * a[0], s * a[1], s * a[2]}};

@@ -167,9 +167,14 @@ namespace palpate
       std::array<long, 9>         position_uu; // (u_a, u_b)
       long                        position_ll; // (lambda, lambda)
     };
-    std::vector<ContactNode>       contact;
-    unsigned int                   n_contact          = 0;
-    double                         sphere_radius      = 0;
+    std::vector<ContactNode> contact;
+    // With a sphere, the surface triangles as their vertices' x, y, z DoFs
+    // and reference positions: where the deformed surface is, to tell a
+    // sphere that touches it from one that went through it.
+    std::vector<std::array<std::array<unsigned int, 3>, 3>> surface_dofs;
+    std::vector<std::array<Utilities::Point3, 3>>           surface_rest;
+    unsigned int                                            n_contact     = 0;
+    double                                                  sphere_radius = 0;
     Utilities::Point3              sphere_rest_center = {{0, 0, 0}};
     std::vector<unsigned int>      multiplier_dof;
     std::vector<long>              position_lambda_u, position_u_lambda;
@@ -347,6 +352,18 @@ namespace palpate
                 node_dofs[key][component] = dofs[i];
                 node_position[key]        = dof_position[dofs[i]];
               }
+          }
+        for (const auto &face : mesh.surface_faces())
+          {
+            std::array<std::array<unsigned int, 3>, 3> d;
+            std::array<Utilities::Point3, 3>           X;
+            for (unsigned int i = 0; i < 3; ++i)
+              {
+                d[i] = node_dofs.at(face.vertices[i]);
+                X[i] = node_position.at(face.vertices[i]);
+              }
+            surface_dofs.push_back(d);
+            surface_rest.push_back(X);
           }
         // A node with some components fixed (a symmetry plane) slides on
         // its plane and may touch; one fixed entirely cannot move.
@@ -933,6 +950,54 @@ namespace palpate
   {
     const auto &c = impl->sphere_rest_center;
     return {{c[0] + target[0], c[1] + target[1], c[2] + target[2]}};
+  }
+
+
+
+  double
+  HyperelasticSystem::sphere_center_distance(
+    const std::vector<double> &x,
+    const Utilities::Point3   &target) const
+  {
+    using namespace Utilities;
+    const Impl &s = *impl;
+    if (!has_contact())
+      return std::numeric_limits<double>::infinity();
+    s.expand(x, s.u_work);
+    const Point3 c       = sphere_center(target);
+    double       nearest = std::numeric_limits<double>::infinity();
+    // Inside or outside by the parity of the crossings of a ray from the
+    // centre (Moller and Trumbore's ray-triangle test), in a direction no
+    // mesh is likely to line up with.
+    const Point3 ray       = {{0.5377, 0.3107, 0.7836}};
+    unsigned int crossings = 0;
+    for (unsigned int f = 0; f < s.surface_dofs.size(); ++f)
+      {
+        std::array<Point3, 3> X;
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int a = 0; a < 3; ++a)
+            X[i][a] =
+              s.surface_rest[f][i][a] + s.u_work[s.surface_dofs[f][i][a]];
+        nearest =
+          std::min(nearest,
+                   distance(c, closest_on_triangle(c, X[0], X[1], X[2])));
+        const Point3 e1 = minus(X[1], X[0]), e2 = minus(X[2], X[0]);
+        const Point3 h   = cross(ray, e2);
+        const double det = dot(e1, h);
+        if (std::abs(det) < 1e-300)
+          continue;
+        const Point3 t0 = minus(c, X[0]);
+        const double u  = dot(t0, h) / det;
+        if (u < 0 || u > 1)
+          continue;
+        const Point3 q = cross(t0, e1);
+        const double v = dot(ray, q) / det;
+        if (v < 0 || u + v > 1)
+          continue;
+        if (dot(e2, q) / det > 0)
+          ++crossings;
+      }
+    return crossings % 2 == 1 ? -nearest : nearest;
   }
 
 

@@ -31,6 +31,8 @@ namespace palpate
           return "linear solver failure";
         case SolveStatus::stopped:
           return "stopped";
+        case SolveStatus::sphere_through_surface:
+          return "sphere through the surface";
       }
     return "unknown";
   }
@@ -792,12 +794,21 @@ namespace palpate
     const auto          a      = from.active_displacement;
     const double        length = Utilities::distance(a, target);
     unsigned int        n      = s.n_increments;
-    if (s.max_increment_length > 0)
+    // A sphere moves at most its radius per increment. A longer jump can
+    // carry it past a surface node without ever touching it (the contact
+    // is node to sphere): a 2 mm sphere pushed 1 cm into the liver in one
+    // increment ended inside the organ, between its nodes, with no node in
+    // contact and a force of 0 N.
+    double max_length = s.max_increment_length;
+    if (impl->system->has_contact())
+      max_length = max_length > 0 ?
+                     std::min(max_length, impl->system->sphere_radius()) :
+                     impl->system->sphere_radius();
+    if (max_length > 0)
       {
         // A path of more than 1000 increments is not a haptic interaction
         // but a mistake; refuse it rather than work for minutes.
-        const double needed =
-          std::ceil(length / s.max_increment_length - 1e-12);
+        const double needed = std::ceil(length / max_length - 1e-12);
         if (needed > 1000)
           {
             impl->system->to_state(x, state);
@@ -960,6 +971,29 @@ namespace palpate
         failure.message =
           "the force is not finite (are the material constants within "
           "their physical range?)";
+      }
+    if (ok && impl->system->has_contact())
+      {
+        const double R = impl->system->sphere_radius();
+        const double d =
+          impl->system->sphere_center_distance(x, state.active_displacement);
+        if (d < 0.5 * R)
+          {
+            ok             = false;
+            failure.status = SolveStatus::sphere_through_surface;
+            failure.message =
+              "the sphere (radius " + Utilities::to_string(1000 * R, 3) +
+              " mm) went between the surface nodes: its centre is " +
+              Utilities::to_string(1000 * std::abs(d), 3) + " mm " +
+              (d < 0 ? "inside the deformed surface" :
+                       "from the deformed surface, less than half its radius") +
+              ". The contact acts at nodes, and a sphere smaller than the "
+              "surface triangles where it pushes slips past the node it "
+              "pushes, so its force would be the mesh's. Use a larger Tip "
+              "radius, a mesh finer near the probe (Mesh / Source = surface "
+              "with Refinement size about a third of the radius), or "
+              "Polynomial degree = 2";
+          }
       }
     if (!ok)
       {

@@ -381,7 +381,10 @@ namespace palpate
           "the surface from outside, along the outward normal, at the point "
           "of the surface nearest to Point (Selection = nearest surface "
           "node) or at the node (Selection = node id); palpate solve --to X "
-          "moves it by X.");
+          "moves it by X. The contact acts at the surface nodes: a state "
+          "where the sphere went between them (its centre less than half "
+          "its radius from the deformed surface, as a sphere smaller than "
+          "the triangles it pushes does) is a failure point, not a force.");
         prm.declare_entry(
           "Tip radius",
           "0",
@@ -768,7 +771,9 @@ namespace palpate
                           Patterns::Double(0.),
                           "Longest increment of the active node's path (m); "
                           "a longer path gets more increments. 0 means no "
-                          "limit.");
+                          "limit. With Tip = sphere, never more than the "
+                          "sphere's radius (a longer step could carry it "
+                          "past a surface node unseen).");
         prm.declare_entry("Maximum Newton iterations",
                           "25",
                           Patterns::Integer(1),

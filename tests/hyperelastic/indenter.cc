@@ -22,6 +22,11 @@
 // - with the fixed nodes held by multipliers the state is the same (the
 //   contact rows stay apart from the supports'), and a VTU of the pressed
 //   state shows the reactions.
+// - HyperelasticSystem::sphere_center_distance: R at rest exactly, a
+//   little less pressed in (the triangles' sag), negative inside;
+// - and on the liver, a sphere much smaller than its surface triangles
+//   pushed in is a failure point (sphere through the surface), not a
+//   state with 0 N.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -121,6 +126,29 @@ main(int argc, char **argv)
             << std::endl;
   }
 
+  // --- Where the sphere is against the deformed surface: its centre is
+  // one radius above the flat top face at rest, exactly; pressed in, less
+  // by about the sag of a triangle whose corners touch it (rc^2 / 2R for
+  // the circumradius rc = h / sqrt 2 of the beam's right triangles, h =
+  // 2.5 mm; 0.17 mm measured, 0.16 mm the sag, 0.23 mm allowed); moved
+  // 2 cm down without solving, its centre is on the beam's axis, 1 cm
+  // inside from three faces.
+  {
+    const std::vector<double> rest(system.n_equations(), 0.0);
+    const double              R = system.sphere_radius();
+    const double              h = 0.0025, sag = h * h / (4 * R);
+    const double at_rest = system.sphere_center_distance(rest, {{0, 0, 0}});
+    const double pressed = system.sphere_center_distance(system.from_state(s),
+                                                         s.active_displacement);
+    const double inside  = system.sphere_center_distance(rest, {{0, 0, -0.02}});
+    deallog << "sphere centre from the deformed surface: at rest R to 1e-12: "
+            << ok(std::abs(at_rest - R) <= 1e-12 * R)
+            << "; pressed 2 mm within 1.5 rc^2/2R below R: "
+            << ok(pressed <= R * (1 + 1e-12) && pressed >= R - 1.5 * sag)
+            << "; 2 cm down -1 cm (inside) to 1e-12: "
+            << ok(std::abs(inside + 0.01) <= 1e-12) << std::endl;
+  }
+
   // --- Off the surface. From here on the scene's tolerances: at rest the
   // force scale is the floor 1e-12 E L^2, against which a residual of
   // 1e-12 is below round-off.
@@ -168,4 +196,31 @@ main(int argc, char **argv)
           << "the work done: " << ok(std::abs(work) <= 1e-3 * total)
           << "; back to the same state: " << ok(change <= 1e-8 * depth)
           << std::endl;
+
+  // --- A sphere much smaller than the surface triangles: on the shipped
+  // liver (liver-stvk.prm, triangles of about a centimetre), a 2 mm sphere
+  // at a node pushed 1 cm in along the normal. Before, one increment
+  // carried it past every node (0 N, "converged"); with increments no
+  // longer than its radius the node it pushes slips past it after 6-8 mm,
+  // and the state is refused rather than rendered with no force.
+  {
+    palpate::Scene liver = shipped_scene("liver-stvk.prm");
+    liver.parameters.boundary_conditions.active_node.tip =
+      palpate::Parameters::ActiveNode::Tip::sphere;
+    liver.parameters.boundary_conditions.active_node.tip_radius = 0.002;
+    const Body           liver_body(liver);
+    palpate::StateSolver liver_solver(liver_body.mesh,
+                                      liver_body.nodes,
+                                      liver.parameters);
+    const palpate::State pushed =
+      liver_solver.solve(liver_solver.rest_state(),
+                         {{0.00197, -0.00207, -0.00958}});
+    deallog << "a 2 mm sphere pushed 1 cm into the liver: "
+            << (pushed.converged ? "converged" :
+                                   palpate::to_string(pushed.status))
+            << ", no force: "
+            << ok(pushed.force[0] == 0 && pushed.force[1] == 0 &&
+                  pushed.force[2] == 0)
+            << std::endl;
+  }
 }

@@ -71,6 +71,14 @@ namespace palpate
     Point3
     cross(const Point3 &a, const Point3 &b);
 
+    /** The point of triangle (@p a, @p b, @p c) closest to @p p (Ericson,
+     * Real-Time Collision Detection, 5.1.5). */
+    Point3
+    closest_on_triangle(const Point3 &p,
+                        const Point3 &a,
+                        const Point3 &b,
+                        const Point3 &c);
+
     /** s a. */
     Point3
     scaled(const Point3 &a, const double s);

@@ -140,6 +140,21 @@ namespace palpate
     Utilities::Point3
     sphere_center(const Utilities::Point3 &target) const;
 
+    /**
+     * With a sphere: the distance (m) of its centre from the deformed
+     * surface at unknowns @p x with the HIP displaced by @p target,
+     * negative when the centre is inside the body (infinite without a
+     * sphere). A sphere pressed on the surface is about its radius away
+     * (less by the sag of the triangles between the nodes it touches,
+     * h^2 / 8R for edges h). Much less means it went between the surface
+     * nodes: the contact is node to sphere, and a sphere smaller than the
+     * triangles can slip past a node it pushes. Its force is then the
+     * mesh's, not the tissue's.
+     */
+    double
+    sphere_center_distance(const std::vector<double> &x,
+                           const Utilities::Point3   &target) const;
+
     /** One contact candidate of the sphere in a state. */
     struct ContactPoint
     {

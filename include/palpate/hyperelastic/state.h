@@ -28,7 +28,12 @@ namespace palpate
     /** A stop was asked for (StateSolver::set_stop_check()) before the
      * state converged: says nothing about the body, so never a failure
      * point to keep. */
-    stopped
+    stopped,
+    /** Every increment converged, but the sphere went through the surface
+     * between its nodes (HyperelasticSystem::sphere_center_distance()):
+     * the force is the mesh's, not the tissue's. (Last, so that the
+     * numbers of the others in a state store stay as they were.) */
+    sphere_through_surface
   };
 
   /** A short name for @p status, e.g. "max iterations". */
