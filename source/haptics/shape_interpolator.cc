@@ -11,8 +11,8 @@
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
-#include <deal.II/base/data_out_base.h>
 
+#include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -34,6 +34,102 @@
 
 namespace palpate
 {
+  namespace
+  {
+    /**
+     * A PVD index that is whole at every moment. Each frame's entry is
+     * written over the closing tags, with new closing tags after it, in
+     * one write where they began: a run killed between frames (SIGKILL, a
+     * crash, mpirun ending a lost MPI client) leaves every frame indexed
+     * but the one being written. (Rewriting the whole index every 5 s lost
+     * the frames of the last few seconds: 93 of 97 indexed when an MPI
+     * client was killed.) A write that fails (a full disk) puts the
+     * closing tags back where they were, in room the file already has, and
+     * cuts what came after them.
+     */
+    class PvdIndex
+    {
+    public:
+      ~PvdIndex()
+      {
+        if (fd >= 0)
+          ::close(fd);
+      }
+
+      /** Create @p name with no entries; "" or why it could not be. */
+      std::string
+      open(const std::string &name)
+      {
+        file = name;
+        fd =
+          ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0)
+          return failed(errno);
+        const std::string header =
+          "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+          "version=\"0.1\" ByteOrder=\"LittleEndian\">\n  <Collection>\n";
+        if (!write_at(header + closing, 0))
+          return failed(errno);
+        tail = static_cast<off_t>(header.size());
+        return "";
+      }
+
+      /** Add the frame @p name at @p time (s); "" or why it could not be. */
+      std::string
+      append(const double time, const std::string &name)
+      {
+        std::ostringstream entry;
+        entry << std::setprecision(10) << "    <DataSet timestep=\"" << time
+              << "\" group=\"\" part=\"0\" file=\"" << name << "\"/>\n";
+        if (write_at(entry.str() + closing, tail))
+          {
+            tail += static_cast<off_t>(entry.str().size());
+            return "";
+          }
+        const int error = errno;
+        write_at(closing, tail);
+        if (::ftruncate(fd, tail + static_cast<off_t>(closing.size())) != 0)
+          {
+            // The closing tags are in place; a cut entry may follow them,
+            // which readers stop before.
+          }
+        return failed(error);
+      }
+
+    private:
+      bool
+      write_at(const std::string &text, off_t at) const
+      {
+        for (std::size_t done = 0; done < text.size();)
+          {
+            const ssize_t n =
+              ::pwrite(fd, text.data() + done, text.size() - done, at);
+            if (n < 0 && errno == EINTR)
+              continue;
+            if (n <= 0)
+              return false;
+            done += static_cast<std::size_t>(n);
+            at += n;
+          }
+        return true;
+      }
+
+      std::string
+      failed(const int error) const
+      {
+        return "the index '" + file + "' could not be written (" +
+               std::strerror(error) + ")";
+      }
+
+      const std::string closing = "  </Collection>\n</VTKFile>\n";
+      std::string       file;
+      int               fd   = -1;
+      off_t             tail = 0;
+    };
+  } // namespace
+
+
+
   struct ShapeInterpolator::Impl
   {
     Impl(const Interaction             &i,
@@ -59,11 +155,6 @@ namespace palpate
     void
     write_frames();
 
-    /** Write the PVD index of the frames written so far, whole (under a
-     * temporary name first); "" or why it could not be. */
-    std::string
-    write_index() const;
-
     const Interaction            &interaction;
     const double                  rate;
     const std::string             directory, stem;
@@ -80,8 +171,8 @@ namespace palpate
     std::atomic<unsigned int> written{0}, skipped{0}, busy{0}, over{0},
       thinned{0};
     std::string failure; // written by the thread before it ends
-    std::vector<std::pair<double, std::string>> records;
-    std::thread                                 thread;
+    PvdIndex    index;
+    std::thread thread;
   };
 
 
@@ -219,9 +310,12 @@ namespace palpate
     using Clock = std::chrono::steady_clock;
     // Behind the solvers: a frame is for the eye, a state for the hand.
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
-    const auto t0         = Clock::now();
-    auto       last_index = t0;
-    const auto period     = std::chrono::duration_cast<Clock::duration>(
+    const auto t0 = Clock::now();
+    if (const std::string why =
+          index.open(directory + "/" + stem + "-shape.pvd");
+        !why.empty())
+      throw std::runtime_error(why);
+    const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / rate));
     auto              next = t0;
     Utilities::Point3 last{{0, 0, 0}};
@@ -289,16 +383,15 @@ namespace palpate
         const std::string file = stem + name;
         bytes +=
           frames.write(blend.solution, blend.force, directory + "/" + file);
-        records.emplace_back(t, file);
-        ++written;
-        // The index is rewritten every few seconds as frames come, so that
-        // a run that ends without stop() (a kill, a crash) leaves its
-        // frames indexed, not only at the end.
-        if (Utilities::seconds_since(last_index) >= 5)
+        if (const std::string why = index.append(t, file); !why.empty())
           {
-            write_index();
-            last_index = Clock::now();
+            // Counted, on disk and indexed go together: the frame the index
+            // cannot name is removed (which gives back its room).
+            std::error_code ignored;
+            std::filesystem::remove(directory + "/" + file, ignored);
+            throw std::runtime_error(why + ": the shape output stopped there");
           }
+        ++written;
         last = x;
         any  = true;
       }
@@ -396,45 +489,6 @@ namespace palpate
     }
     impl->wake.notify_all();
     impl->thread.join();
-    if (const std::string why = impl->write_index(); !why.empty())
-      impl->failure += (impl->failure.empty() ? "" : "; ") + why;
-  }
-
-
-
-  std::string
-  ShapeInterpolator::Impl::write_index() const
-  {
-    const std::string file = directory + "/" + stem + "-shape.pvd";
-    // The index is built in memory and written whole, under a temporary
-    // name first: on a full disk there is either an index of every frame
-    // written or none, never a cut one. deal.II asserts on a stream that
-    // failed: that is this output's failure, reported with the others.
-    std::ostringstream index;
-    try
-      {
-        dealii::DataOutBase::write_pvd_record(index, records);
-      }
-    catch (const std::exception &)
-      {
-        index.setstate(std::ios::failbit);
-      }
-    const std::string part = file + ".part";
-    std::ofstream     pvd(part);
-    pvd << index.str();
-    pvd.close();
-    const int       error = errno;
-    std::error_code renamed;
-    if (pvd && index)
-      std::filesystem::rename(part, file, renamed);
-    if (pvd && index && !renamed)
-      return "";
-    std::error_code ignored;
-    std::filesystem::remove(part, ignored);
-    return "the index '" + file + "' could not be written (" +
-           (renamed ? renamed.message() : std::string(std::strerror(error))) +
-           "): the " + std::to_string(written.load()) +
-           " frames written are on disk without it";
   }
 
 

@@ -7,7 +7,8 @@
 // closed PVD index whose frame count is the summary's - and the exit status
 // is 128 + the signal. A closed pipe on standard output (what `| head -1`
 // does) and /dev/full are output errors (status 6) that still write the
-// files. `palpate study` stopped by SIGINT, or past --time-limit, prints
+// files. SIGKILL leaves a whole PVD index of the frames on disk.
+// `palpate study` stopped by SIGINT, or past --time-limit, prints
 // and writes (CSV) the rows it measured.
 //
 // The program runs as a child with its standard output in a file; the
@@ -155,6 +156,43 @@ main()
             << ok(force_log(dir + "/paper-stvk-forces.csv").second > 500 &&
                   std::filesystem::exists(dir + "/paper-stvk-summary.json"))
             << std::endl;
+  }
+
+  // SIGKILL (or a crash, or mpirun ending a lost MPI client) cannot be
+  // caught: nothing is written at the end. The PVD index is whole at every
+  // moment and names every frame on disk but the one being written (it was
+  // rewritten every 5 s: the last seconds' frames were on disk unnamed).
+  {
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() != ".txt")
+        std::filesystem::remove(f.path());
+    std::filesystem::remove(out);
+    const pid_t pid     = start_palpate(interaction, out, err);
+    const bool  started = wait_for_text(out, "; motion starts");
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    kill(pid, SIGKILL);
+    const int          status = wait_status(pid);
+    const std::string  pvd    = read_file(dir + "/paper-stvk-shape.pvd");
+    const unsigned int listed = count(pvd, "<DataSet");
+    unsigned int       files  = 0;
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      files +=
+        f.path().filename().string().find("-shape-") != std::string::npos &&
+        f.path().extension() == ".vtu";
+    bool named_exist = true;
+    for (std::size_t at = pvd.find("file=\""); at != std::string::npos;
+         at             = pvd.find("file=\"", at + 1))
+      named_exist =
+        named_exist &&
+        std::filesystem::exists(
+          dir + "/" + pvd.substr(at + 6, pvd.find('"', at + 6) - at - 6));
+    deallog << "SIGKILL: motion started " << ok(started) << ", killed "
+            << ok(status == 1000 + SIGKILL) << ", PVD index closed "
+            << ok(pvd.find("</VTKFile>") != std::string::npos)
+            << ", frames listed: all on disk but at most the one being "
+               "written "
+            << ok(listed > 10 && listed <= files && files <= listed + 1)
+            << ", every listed frame there " << ok(named_exist) << std::endl;
   }
 
   {
