@@ -305,7 +305,16 @@ namespace palpate
           impl->lower[d] = std::min(impl->lower[d], x[d]);
           impl->upper[d] = std::max(impl->upper[d], x[d]);
         }
-    const double diameter = Utilities::distance(impl->lower, impl->upper);
+    Utilities::Point3 file_lower = data.nodes[data.tetrahedra[0][0]],
+                      file_upper = file_lower;
+    for (const auto &t : data.tetrahedra)
+      for (const unsigned int v : t)
+        for (unsigned int d = 0; d < 3; ++d)
+          {
+            file_lower[d] = std::min(file_lower[d], data.nodes[v][d]);
+            file_upper[d] = std::max(file_upper[d], data.nodes[v][d]);
+          }
+    const double file_diameter = Utilities::distance(file_lower, file_upper);
 
     // Every tetrahedron must have four distinct nodes and a positive
     // volume. deal.II would silently re-orient inverted ones; we do not,
@@ -362,16 +371,22 @@ namespace palpate
                         "points)",
                       "the mesh is broken; remove the duplicate or "
                       "regenerate the mesh (TetGen, Gmsh).");
-        const double       v = signed_volume(impl->vertices[t[0]],
-                                       impl->vertices[t[1]],
-                                       impl->vertices[t[2]],
-                                       impl->vertices[t[3]]);
+        // In the file's units: with a wild scale factor (1e-300) the
+        // volumes in metres underflow to 0 and every element would look
+        // flat; the scale factor's own check names the scale instead.
+        const auto        &raw    = data.tetrahedra[c];
+        const double       v_file = signed_volume(data.nodes[raw[0]],
+                                            data.nodes[raw[1]],
+                                            data.nodes[raw[2]],
+                                            data.nodes[raw[3]]);
+        const double       v      = v_file * scale * scale * scale;
         std::ostringstream nodes;
         nodes << data.node_ids[data.tetrahedra[c][0]] << ", "
               << data.node_ids[data.tetrahedra[c][1]] << ", "
               << data.node_ids[data.tetrahedra[c][2]] << ", "
               << data.node_ids[data.tetrahedra[c][3]];
-        if (std::abs(v) <= 1e-14 * diameter * diameter * diameter)
+        if (std::abs(v_file) <=
+            1e-14 * file_diameter * file_diameter * file_diameter)
           throw error(data.tetrahedron_lines[c],
                       element_name(data, c) + " (nodes " + nodes.str() + ")",
                       "the tetrahedron is degenerate: its four nodes are "
@@ -379,7 +394,7 @@ namespace palpate
                         Utilities::to_string(v, 3) + " m^3",
                       "remesh with a quality bound (TetGen -q, Gmsh "
                       "optimisation) so that no element is flat.");
-        if (v < 0)
+        if (v_file < 0)
           throw error(data.tetrahedron_lines[c],
                       element_name(data, c) + " (nodes " + nodes.str() + ")",
                       "the tetrahedron is inverted: its nodes are ordered "
@@ -780,7 +795,11 @@ namespace palpate
   double
   Mesh::diameter() const
   {
-    return Utilities::distance(impl->lower, impl->upper);
+    // Without under- or overflow of the squares, so that a mesh read at a
+    // wild scale factor (1e-300, 1e300) is said to be that size.
+    return std::hypot(impl->upper[0] - impl->lower[0],
+                      impl->upper[1] - impl->lower[1],
+                      impl->upper[2] - impl->lower[2]);
   }
 
 

@@ -79,8 +79,9 @@ namespace palpate
                           "1",
                           Patterns::Double(0.),
                           "Metres per length unit of the mesh file: every "
-                          "coordinate is multiplied by it (m/unit). The "
-                          "generators produce metres and ignore it.");
+                          "coordinate is multiplied by it (m/unit), from "
+                          "1e-9 to 1e6. The generators produce metres and "
+                          "ignore it.");
 
         prm.enter_subsection("Beam");
         {

@@ -1288,6 +1288,17 @@ namespace palpate
                   "the scale factor must be positive",
                   "set it to the number of metres per mesh-file unit, e.g. "
                   "0.001 for a mesh in millimetres.");
+    // No file unit is below a nanometre or above a thousand kilometres;
+    // past that the coordinates in metres under- or overflow, and the
+    // messages that follow would blame the mesh instead of the scale.
+    if (p.mesh.scale_factor < 1e-9 || p.mesh.scale_factor > 1e6)
+      throw error("Mesh/Scale factor",
+                  "a scale factor of " +
+                    Utilities::to_string(p.mesh.scale_factor, 3) +
+                    " m per mesh-file unit is no unit of length a mesh is "
+                    "written in (1e-9, a nanometre, to 1e6)",
+                  "set it to the number of metres per mesh-file unit, e.g. "
+                  "0.001 for a mesh in millimetres, 1 for metres.");
 
     if (p.mesh.source == "beam")
       {

@@ -387,6 +387,16 @@ main(int argc, char **argv)
   scene("a number below the double range (1e-320)",
         "denormal.prm",
         beam + "subsection Mesh\n  set Scale factor = 1e-320\nend\n");
+  scene("a liver at Scale factor 1e-300 (blamed a flat element)",
+        "liver-scale-tiny.prm",
+        "subsection Mesh\n  set Source = file\n"
+        "  set File name = inverted-liver.msh\n"
+        "  set Scale factor = 1e-300\nend\n");
+  scene("a liver at Scale factor 1.7e308 (a body -nan m across)",
+        "liver-scale-huge.prm",
+        "subsection Mesh\n  set Source = file\n"
+        "  set File name = inverted-liver.msh\n"
+        "  set Scale factor = 1.7e308\nend\n");
   scene("an entry name with a different case",
         "case.prm",
         beam + "subsection Mesh\n  set scale factor = 1\nend\n");
