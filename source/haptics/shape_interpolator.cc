@@ -11,7 +11,6 @@
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
-
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
