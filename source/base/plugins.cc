@@ -6,6 +6,8 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <algorithm>
+#include <map>
 #include <sstream>
 
 namespace palpate
@@ -36,6 +38,53 @@ namespace palpate
             Utilities::trim(line.substr(equals + 1));
         }
       return entries;
+    }
+
+
+
+    namespace
+    {
+      std::map<std::string, std::vector<Declaration>> &
+      all_declarations()
+      {
+        // A function-local static, as Registry::storage().
+        static std::map<std::string, std::vector<Declaration>> all;
+        return all;
+      }
+    } // namespace
+
+
+
+    bool
+    add_declaration(const std::string &kind, const Declaration &declaration)
+    {
+      auto &of_kind = all_declarations()[kind];
+      of_kind.push_back(declaration);
+      std::sort(of_kind.begin(),
+                of_kind.end(),
+                [](const Declaration &a, const Declaration &b) {
+                  return a.name < b.name;
+                });
+      return true;
+    }
+
+
+
+    const std::vector<Declaration> &
+    declarations(const std::string &kind)
+    {
+      return all_declarations()[kind];
+    }
+
+
+
+    std::string
+    selection(const std::string &kind)
+    {
+      std::string s;
+      for (const auto &d : declarations(kind))
+        s += (s.empty() ? "" : "|") + d.name;
+      return s;
     }
 
 

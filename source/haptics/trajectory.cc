@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/base/exceptions.h>
+#include <palpate/base/plugins.templates.h>
 #include <palpate/haptics/trajectory.h>
 #include <palpate/scene/scene.h>
 
@@ -364,38 +365,115 @@ namespace palpate
   std::unique_ptr<Trajectory>
   Trajectory::create(const Scene &scene)
   {
-    const auto &t = scene.parameters.haptics.trajectory;
-    if (t.type == "straight line")
-      return std::make_unique<StraightLine>(t.direction, t.speed, t.duration);
-    if (t.type == "circle")
-      return std::make_unique<Circle>(t.direction,
-                                      t.radius,
-                                      t.speed,
-                                      t.duration);
-    if (t.type == "smooth random")
-      return std::make_unique<SmoothRandom>(t.radius,
-                                            t.speed,
-                                            t.duration,
-                                            t.seed);
-    const std::string path = scene.resolve_path(t.file_name);
-    std::error_code   error;
-    const bool        exists = std::filesystem::exists(path, error);
-    // A name the file system refuses (a loop of links, too long) is not a
-    // missing file: say what it said.
-    if (error)
-      throw scene.error("Haptics/Trajectory/File name",
-                        "the recording '" + path +
-                          "' cannot be opened: " + error.message(),
-                        "check the path and the links on the way to the "
-                        "recording's CSV file.");
-    if (!exists)
-      throw scene.error("Haptics/Trajectory/File name",
-                        "the recording '" + t.file_name +
-                          "' was not found: looked for " +
-                          scene.where_looked(t.file_name),
-                        "a relative path is relative to the scene file's "
-                        "directory; give the recording's path from there, "
-                        "or an absolute one.");
-    return std::make_unique<Replay>(path);
+    const auto &t   = scene.parameters.haptics.trajectory;
+    const auto  own = t.own.find(t.type);
+    try
+      {
+        return TrajectoryRegistry::create(
+          t.type, own == t.own.end() ? Plugins::Entries() : own->second, scene);
+      }
+    catch (const Plugins::EntryError &e)
+      {
+        throw scene.error("Haptics/Trajectory/" + t.type + "/" + e.entry,
+                          e.problem,
+                          e.fix);
+      }
   }
+
+
+
+  namespace
+  {
+    /** The built-in trajectories read only the shared entries. */
+    void
+    no_own_entries(dealii::ParameterHandler &)
+    {}
+
+    std::unique_ptr<Trajectory>
+    replay(const dealii::ParameterHandler &, const Scene &scene)
+    {
+      const auto       &t    = scene.parameters.haptics.trajectory;
+      const std::string path = scene.resolve_path(t.file_name);
+      std::error_code   error;
+      const bool        exists = std::filesystem::exists(path, error);
+      // A name the file system refuses (a loop of links, too long) is not
+      // a missing file: say what it said.
+      if (error)
+        throw scene.error("Haptics/Trajectory/File name",
+                          "the recording '" + path +
+                            "' cannot be opened: " + error.message(),
+                          "check the path and the links on the way to the "
+                          "recording's CSV file.");
+      if (!exists)
+        throw scene.error("Haptics/Trajectory/File name",
+                          "the recording '" + t.file_name +
+                            "' was not found: looked for " +
+                            scene.where_looked(t.file_name),
+                          "a relative path is relative to the scene file's "
+                          "directory; give the recording's path from there, "
+                          "or an absolute one.");
+      return std::make_unique<Replay>(path);
+    }
+
+    const auto &
+    shared(const Scene &scene)
+    {
+      return scene.parameters.haptics.trajectory;
+    }
+
+    [[maybe_unused]] const bool built_in_trajectories_registered = [] {
+      const std::vector<TrajectoryRegistry::Plugin> built_in = {
+        {"straight line",
+         "a straight line at constant speed along Direction",
+         &no_own_entries,
+         [](const dealii::ParameterHandler &,
+            const Scene &scene) -> std::unique_ptr<Trajectory> {
+           const auto &t = shared(scene);
+           return std::make_unique<StraightLine>(t.direction,
+                                                 t.speed,
+                                                 t.duration);
+         }},
+        {"circle",
+         "a circle of Radius through the rest position, in the plane normal "
+         "to Direction",
+         &no_own_entries,
+         [](const dealii::ParameterHandler &,
+            const Scene &scene) -> std::unique_ptr<Trajectory> {
+           const auto &t = shared(scene);
+           return std::make_unique<Circle>(t.direction,
+                                           t.radius,
+                                           t.speed,
+                                           t.duration);
+         }},
+        {"smooth random",
+         "a smooth random walk within Radius, of root-mean-square Speed, "
+         "from Seed",
+         &no_own_entries,
+         [](const dealii::ParameterHandler &,
+            const Scene &scene) -> std::unique_ptr<Trajectory> {
+           const auto &t = shared(scene);
+           return std::make_unique<SmoothRandom>(t.radius,
+                                                 t.speed,
+                                                 t.duration,
+                                                 t.seed);
+         }},
+        {"replay",
+         "replay of the timed positions of the CSV file File name",
+         &no_own_entries,
+         &replay}};
+      for (const auto &plugin : built_in)
+        {
+          TrajectoryRegistry::add(plugin);
+          Plugins::add_declaration("trajectory",
+                                   {plugin.name,
+                                    plugin.description,
+                                    plugin.declare_parameters});
+        }
+      return true;
+    }();
+  } // namespace
+
+
+
+  template class Plugins::Registry<Trajectory, Scene>;
 } // namespace palpate

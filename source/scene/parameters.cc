@@ -1111,13 +1111,25 @@ namespace palpate
     {
       prm.enter_subsection("Trajectory");
       {
-        prm.declare_entry(
-          "Type",
-          "straight line",
-          Patterns::Selection("straight line|circle|smooth random|replay"),
-          "Motion of the simulated device's HIP, relative to the active "
-          "node's rest position: a straight line at constant speed, a "
-          "circle, a smooth random walk, or replay of a CSV file.");
+        // The trajectories are plug-ins (haptics/trajectory.h): the
+        // choice and each one's own subsection come from their
+        // declarations, the entries below are shared.
+        std::string doc = "Motion of the simulated device's HIP, relative "
+                          "to the active node's rest position:";
+        for (const auto &plugin : Plugins::declarations("trajectory"))
+          doc += " " + plugin.name + ": " + plugin.description + ";";
+        doc.back() = '.';
+        prm.declare_entry("Type",
+                          "straight line",
+                          Patterns::Selection(Plugins::selection("trajectory")),
+                          doc);
+        for (const auto &plugin : Plugins::declarations("trajectory"))
+          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
+            {
+              prm.enter_subsection(plugin.name);
+              plugin.declare_parameters(prm);
+              prm.leave_subsection();
+            }
         prm.declare_entry("Direction",
                           "0, 0, -1",
                           point_pattern(),
@@ -1188,7 +1200,20 @@ namespace palpate
     {
       prm.enter_subsection("Trajectory");
       {
-        type                     = prm.get("Type");
+        type = prm.get("Type");
+        own.clear();
+        for (const auto &plugin : Plugins::declarations("trajectory"))
+          {
+            const auto declared =
+              Plugins::declared_entries(plugin.declare_parameters);
+            if (declared.empty())
+              continue;
+            auto &entries = own[plugin.name];
+            prm.enter_subsection(plugin.name);
+            for (const auto &entry : declared)
+              entries[entry.first] = prm.get(entry.first);
+            prm.leave_subsection();
+          }
         direction                = get_point(prm, "Direction");
         speed                    = prm.get_double("Speed");
         duration                 = prm.get_double("Duration");

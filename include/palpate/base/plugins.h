@@ -61,6 +61,32 @@ namespace palpate
     using DeclareFunction = void (*)(dealii::ParameterHandler &prm);
 
     /**
+     * What a scene needs of a plug-in to declare it: its name, description
+     * and entries, without its interface. The scene declares the plug-ins
+     * of a kind (e.g. "trajectory") from these, so it does not include the
+     * layer that defines them (tests/check_layering.sh).
+     */
+    struct Declaration
+    {
+      std::string     name;
+      std::string     description;
+      DeclareFunction declare_parameters;
+    };
+
+    /** Add @p declaration to those of @p kind (at static initialisation,
+     * by a registration macro). */
+    bool
+    add_declaration(const std::string &kind, const Declaration &declaration);
+
+    /** The plug-ins of @p kind, sorted by name. */
+    const std::vector<Declaration> &
+    declarations(const std::string &kind);
+
+    /** Their names joined by '|', for a Patterns::Selection. */
+    std::string
+    selection(const std::string &kind);
+
+    /**
      * The names and default values of the entries a declare function
      * declares (it is run on a scratch ParameterHandler).
      */
@@ -81,14 +107,17 @@ namespace palpate
      * name (as scenes spell it), a one-line description, the declarations
      * of its own entries and a factory that builds it from them.
      */
-    template <typename Interface>
+    template <typename Interface, typename... Context>
     class Registry
     {
     public:
       /** Build the plug-in from its entries (the ParameterHandler holds
-       * only them). Throws EntryError for values that make no sense. */
+       * only them) and, for interfaces that have one, the @p Context it
+       * lives in (a trajectory: the scene, for its shared entries and
+       * paths). Throws EntryError for values that make no sense. */
       using CreateFunction =
-        std::unique_ptr<Interface> (*)(const dealii::ParameterHandler &prm);
+        std::unique_ptr<Interface> (*)(const dealii::ParameterHandler &prm,
+                                       const Context &...context);
 
       struct Plugin
       {
@@ -123,7 +152,9 @@ namespace palpate
       /** Build the plug-in called @p name from @p entries (missing entries
        * take their default). Throws EntryError. */
       static std::unique_ptr<Interface>
-      create(const std::string &name, const Entries &entries);
+      create(const std::string &name,
+             const Entries     &entries,
+             const Context &...context);
 
     private:
       static std::vector<Plugin> &

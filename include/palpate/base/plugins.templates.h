@@ -19,9 +19,9 @@ namespace palpate
 {
   namespace Plugins
   {
-    template <typename Interface>
-    std::vector<typename Registry<Interface>::Plugin> &
-    Registry<Interface>::storage()
+    template <typename Interface, typename... Context>
+    std::vector<typename Registry<Interface, Context...>::Plugin> &
+    Registry<Interface, Context...>::storage()
     {
       // A function-local static: registrations run during static
       // initialisation, in an order the language leaves open.
@@ -31,9 +31,9 @@ namespace palpate
 
 
 
-    template <typename Interface>
+    template <typename Interface, typename... Context>
     bool
-    Registry<Interface>::add(const Plugin &plugin)
+    Registry<Interface, Context...>::add(const Plugin &plugin)
     {
       auto &all = storage();
       if (find(plugin.name) != nullptr)
@@ -51,18 +51,18 @@ namespace palpate
 
 
 
-    template <typename Interface>
-    const std::vector<typename Registry<Interface>::Plugin> &
-    Registry<Interface>::plugins()
+    template <typename Interface, typename... Context>
+    const std::vector<typename Registry<Interface, Context...>::Plugin> &
+    Registry<Interface, Context...>::plugins()
     {
       return storage();
     }
 
 
 
-    template <typename Interface>
-    const typename Registry<Interface>::Plugin *
-    Registry<Interface>::find(const std::string &name)
+    template <typename Interface, typename... Context>
+    const typename Registry<Interface, Context...>::Plugin *
+    Registry<Interface, Context...>::find(const std::string &name)
     {
       for (const auto &plugin : storage())
         if (plugin.name == name)
@@ -72,9 +72,9 @@ namespace palpate
 
 
 
-    template <typename Interface>
+    template <typename Interface, typename... Context>
     std::string
-    Registry<Interface>::selection()
+    Registry<Interface, Context...>::selection()
     {
       std::string s;
       for (const auto &plugin : storage())
@@ -84,9 +84,9 @@ namespace palpate
 
 
 
-    template <typename Interface>
+    template <typename Interface, typename... Context>
     std::string
-    Registry<Interface>::names_sentence()
+    Registry<Interface, Context...>::names_sentence()
     {
       const auto &all = storage();
       std::string s;
@@ -97,9 +97,11 @@ namespace palpate
 
 
 
-    template <typename Interface>
+    template <typename Interface, typename... Context>
     std::unique_ptr<Interface>
-    Registry<Interface>::create(const std::string &name, const Entries &entries)
+    Registry<Interface, Context...>::create(const std::string &name,
+                                            const Entries     &entries,
+                                            const Context &...context)
     {
       const Plugin *plugin = find(name);
       if (plugin == nullptr)
@@ -108,7 +110,7 @@ namespace palpate
                          "use " + names_sentence() + ".");
       const auto prm =
         make_parameter_handler(plugin->declare_parameters, entries);
-      return plugin->create(*prm);
+      return plugin->create(*prm, context...);
     }
   } // namespace Plugins
 } // namespace palpate

@@ -4,6 +4,7 @@
 #ifndef palpate_haptics_trajectory_h
 #define palpate_haptics_trajectory_h
 
+#include <palpate/base/plugins.h>
 #include <palpate/base/utilities.h>
 
 #include <memory>
@@ -19,6 +20,18 @@ namespace palpate
    * active node's rest position (m) at time t (s) after the motion starts.
    * Every trajectory starts at the rest position. position() is cheap and
    * allocation-free: the haptic thread calls it every tick.
+   *
+   * Trajectories are plug-ins (doc/extending.md): `Haptics / Trajectory /
+   * Type` chooses one from TrajectoryRegistry. A plug-in reads the shared
+   * entries of `Haptics / Trajectory` (Speed, Duration, Direction, Radius,
+   * Seed, File name) from the scene, and its own from its subsection
+   * `Haptics / Trajectory / <its name>`; its file ends with
+   *
+   *     PALPATE_REGISTER_TRAJECTORY(Lissajous, "lissajous", "one line")
+   *
+   * where the class has `static void declare_parameters(ParameterHandler
+   * &)` and `static std::unique_ptr<Trajectory> create(const
+   * ParameterHandler &own, const Scene &scene)`.
    */
   class Trajectory
   {
@@ -39,11 +52,32 @@ namespace palpate
 
     /**
      * The trajectory of a scene's Haptics / Trajectory subsection. A replay
-     * file that cannot be read is an InputError naming its line.
+     * file that cannot be read is an InputError naming its line; a value a
+     * plug-in refuses is one naming its entry.
      */
     static std::unique_ptr<Trajectory>
     create(const Scene &scene);
   };
+
+  /** The trajectories, by the names scenes give them. */
+  using TrajectoryRegistry = Plugins::Registry<Trajectory, Scene>;
+  extern template class Plugins::Registry<Trajectory, Scene>;
+
+/** Register the trajectory @p classname as @p name (PALPATE_REGISTER_PLUGIN,
+ * plus its declaration for the scene's Haptics / Trajectory subsection). */
+#define PALPATE_REGISTER_TRAJECTORY(classname, name, description)            \
+  namespace                                                                  \
+  {                                                                          \
+    [[maybe_unused]] const bool palpate_trajectory_registered_##classname =  \
+      ::palpate::TrajectoryRegistry::add({name,                              \
+                                          description,                       \
+                                          &classname::declare_parameters,    \
+                                          &classname::create}) &&            \
+      ::palpate::Plugins::add_declaration("trajectory",                      \
+                                          {name,                             \
+                                           description,                      \
+                                           &classname::declare_parameters}); \
+  }
 
   /** A straight line from the rest position at constant speed. */
   class StraightLine : public Trajectory

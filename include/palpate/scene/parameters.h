@@ -4,6 +4,7 @@
 #ifndef palpate_scene_parameters_h
 #define palpate_scene_parameters_h
 
+#include <palpate/base/plugins.h>
 #include <palpate/base/utilities.h>
 
 #include <map>
@@ -386,8 +387,13 @@ namespace palpate
     /** `subsection Haptics / subsection Trajectory`: the simulated device. */
     struct Trajectory
     {
-      /** "straight line", "circle", "smooth random" or "replay". */
-      std::string  type;
+      /** The plug-in's name ("straight line", "circle", "smooth random",
+       * "replay", or one registered elsewhere: TrajectoryRegistry). */
+      std::string type;
+      /** Each trajectory plug-in's own entries (plug-in name -> its
+       * subsection's values), as MaterialModel keeps the models'. */
+      std::map<std::string, Plugins::Entries> own;
+      // The entries every trajectory may read:
       Point3       direction;
       double       speed;
       double       duration;
