@@ -67,6 +67,14 @@ namespace
     bool growth = false;
   };
 
+  /** A solver's name as a RESULT value: spaces become dashes. */
+  std::string
+  dashed(std::string name)
+  {
+    std::replace(name.begin(), name.end(), ' ', '-');
+    return name;
+  }
+
   double
   median(std::vector<double> v)
   {
@@ -656,16 +664,17 @@ main(int argc, char **argv)
         << "Where the time goes: direct solvers and orderings (" << subset
         << " transitions; medians per Newton iteration)\n"
         << "  solver                                     analysis   solve   iteration\n";
-      for (const auto &[name, ordering] :
-           std::vector<std::pair<std::string, std::string>>{
-             {"MUMPS", "METIS"},
-             {"MUMPS", "AMD"},
-             {"MUMPS", "AMF"},
-             {"MUMPS", "PORD"},
-             {"UMFPACK", "METIS"},
-             {"KLU", "METIS"},
-             {"Amesos MUMPS", "METIS"},
-             {"Amesos KLU", "METIS"}})
+      // Every registered solver (LinearSolverRegistry) with METIS, and
+      // MUMPS with its other orderings.
+      std::vector<std::pair<std::string, std::string>> solvers;
+      for (const auto &plugin : LinearSolverRegistry::plugins())
+        {
+          solvers.emplace_back(plugin.name, "METIS");
+          if (plugin.name == "MUMPS")
+            for (const std::string ordering : {"AMD", "AMF", "PORD"})
+              solvers.emplace_back(plugin.name, ordering);
+        }
+      for (const auto &[name, ordering] : solvers)
         {
           auto variant                   = p;
           variant.linear_solver.solver   = name;
@@ -688,10 +697,7 @@ main(int argc, char **argv)
                     << ms(median(s.solve)) << " ms" << std::setw(7)
                     << ms(median(s.total)) << " ms\n";
           std::ostringstream r;
-          r << "RESULT newton study=linear-solver solver="
-            << (name == "Amesos MUMPS" ? "Amesos-MUMPS" :
-                name == "Amesos KLU"   ? "Amesos-KLU" :
-                                         name)
+          r << "RESULT newton study=linear-solver solver=" << dashed(name)
             << " ordering=" << ordering << " analysis_ms=" << ms(analysis)
             << " solve_ms=" << ms(median(s.solve))
             << " iteration_ms=" << ms(median(s.total));

@@ -11,6 +11,7 @@
 
 #include <palpate/base/environment.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/linear_solver.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -181,17 +182,19 @@ touch_beam_with_sphere(palpate::Scene &scene, const double radius)
   p.boundary_conditions.active_node.tip_radius = radius;
 }
 
-/** Every direct solver and ordering palpate offers, for the solver tests. */
+/** Every linear solver registered (LinearSolverRegistry, in name order)
+ * with the METIS ordering, and MUMPS with AMD too, for the solver tests. */
 inline std::vector<std::pair<std::string, std::string>>
 every_linear_solver()
 {
-  return {{"MUMPS", "METIS"},
-          {"MUMPS", "AMD"},
-          {"MUMPS single", "METIS"},
-          {"UMFPACK", "METIS"},
-          {"KLU", "METIS"},
-          {"Amesos MUMPS", "METIS"},
-          {"Amesos KLU", "METIS"}};
+  std::vector<std::pair<std::string, std::string>> solvers;
+  for (const auto &plugin : palpate::LinearSolverRegistry::plugins())
+    {
+      solvers.emplace_back(plugin.name, "METIS");
+      if (plugin.name == "MUMPS")
+        solvers.emplace_back(plugin.name, "AMD");
+    }
+  return solvers;
 }
 
 /** Whether every component of @p f is finite. */

@@ -78,6 +78,23 @@ namespace palpate
 
 
 
+    void
+    check_entries(const std::string &kind,
+                  const std::string &name,
+                  const Entries     &entries)
+    {
+      for (const auto &d : declarations(kind))
+        if (d.name == name)
+          {
+            const auto prm =
+              make_parameter_handler(d.declare_parameters, entries);
+            if (d.check_parameters != nullptr)
+              d.check_parameters(*prm);
+          }
+    }
+
+
+
     std::string
     selection(const std::string &kind)
     {

@@ -2,7 +2,9 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/base/exceptions.h>
+#include <palpate/base/plugins.templates.h>
 #include <palpate/hyperelastic/linear_solver.h>
+#include <palpate/scene/parameters.h>
 
 #include <Amesos.h>
 #include <Amesos_BaseSolver.h>
@@ -727,18 +729,90 @@ namespace palpate
   std::unique_ptr<LinearSolver>
   LinearSolver::create(const std::string &name, const std::string &ordering)
   {
-    if (name == "MUMPS")
-      return std::make_unique<Mumps<Double>>(ordering);
-    if (name == "MUMPS single")
-      return std::make_unique<Mumps<Single>>(ordering);
-    if (name == "UMFPACK")
-      return std::make_unique<Umfpack>();
-    if (name == "KLU")
-      return std::make_unique<Klu>();
-    if (name == "Amesos MUMPS")
-      return std::make_unique<AmesosSolver>("Amesos_Mumps");
-    if (name == "Amesos KLU")
-      return std::make_unique<AmesosSolver>("Amesos_Klu");
-    throw std::invalid_argument("unknown linear solver '" + name + "'");
+    Parameters::LinearSolver p;
+    p.solver   = name;
+    p.ordering = ordering;
+    return create(p, 0);
   }
+
+
+
+  std::unique_ptr<LinearSolver>
+  LinearSolver::create(const Parameters::LinearSolver &p,
+                       const unsigned int              n_equations)
+  {
+    const std::string name = p.solver_for(n_equations);
+    const auto        own  = p.own.find(name);
+    if (LinearSolverRegistry::find(name) == nullptr)
+      throw std::invalid_argument("unknown linear solver '" + name + "'");
+    return LinearSolverRegistry::create(
+      name, own == p.own.end() ? Plugins::Entries() : own->second, p);
+  }
+
+
+
+  namespace
+  {
+    /** The built-in solvers have no entries of their own (MUMPS's ordering
+     * is the shared Linear solver / Ordering). */
+    void
+    no_own_entries(dealii::ParameterHandler &)
+    {}
+
+    [[maybe_unused]] const bool built_in_solvers_registered = [] {
+      using Shared = Parameters::LinearSolver;
+      using Own    = dealii::ParameterHandler;
+      const std::vector<LinearSolverRegistry::Plugin> solvers = {
+        {"MUMPS",
+         "MUMPS's symmetric indefinite LDL^T through its C interface",
+         &no_own_entries,
+         [](const Own &, const Shared &p) -> std::unique_ptr<LinearSolver> {
+           return std::make_unique<Mumps<Double>>(p.ordering);
+         }},
+        {"MUMPS single",
+         "MUMPS in single precision, as the preconditioner of GMRES in "
+         "double (mixed precision)",
+         &no_own_entries,
+         [](const Own &, const Shared &p) -> std::unique_ptr<LinearSolver> {
+           return std::make_unique<Mumps<Single>>(p.ordering);
+         }},
+        {"UMFPACK",
+         "SuiteSparse's UMFPACK (unsymmetric LU)",
+         &no_own_entries,
+         [](const Own &, const Shared &) -> std::unique_ptr<LinearSolver> {
+           return std::make_unique<Umfpack>();
+         }},
+        {"KLU",
+         "SuiteSparse's KLU",
+         &no_own_entries,
+         [](const Own &, const Shared &) -> std::unique_ptr<LinearSolver> {
+           return std::make_unique<Klu>();
+         }},
+        {"Amesos MUMPS",
+         "MUMPS through Trilinos Amesos, for comparison",
+         &no_own_entries,
+         [](const Own &, const Shared &) -> std::unique_ptr<LinearSolver> {
+           return std::make_unique<AmesosSolver>("Amesos_Mumps");
+         }},
+        {"Amesos KLU",
+         "KLU through Trilinos Amesos, for comparison",
+         &no_own_entries,
+         [](const Own &, const Shared &) -> std::unique_ptr<LinearSolver> {
+           return std::make_unique<AmesosSolver>("Amesos_Klu");
+         }}};
+      for (const auto &plugin : solvers)
+        {
+          LinearSolverRegistry::add(plugin);
+          Plugins::add_declaration("linear solver",
+                                   {plugin.name,
+                                    plugin.description,
+                                    plugin.declare_parameters});
+        }
+      return true;
+    }();
+  } // namespace
+
+
+
+  template class Plugins::Registry<LinearSolver, Parameters::LinearSolver>;
 } // namespace palpate

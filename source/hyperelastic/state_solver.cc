@@ -208,9 +208,9 @@ namespace palpate
       // fill of nested dissection grows more slowly with the mesh than
       // AMF's, which is cheaper to compute and as good on small meshes.
       ordering = p.linear_solver.ordering_for(system->n_equations());
-      linear_solver =
-        LinearSolver::create(p.linear_solver.solver_for(system->n_equations()),
-                             ordering);
+      Parameters::LinearSolver chosen = p.linear_solver;
+      chosen.ordering                 = ordering;
+      linear_solver = LinearSolver::create(chosen, system->n_equations());
       linear_solver->analyze(system->sparsity());
       setup_time = seconds_since(start);
     }

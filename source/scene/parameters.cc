@@ -16,10 +16,34 @@ namespace palpate
 {
   namespace Parameters
   {
+
     using namespace dealii;
 
     namespace
     {
+      /** The values of the own entries of each plug-in of @p kind, from
+       * their subsections (declared only by plug-ins that have entries). */
+      std::map<std::string, Plugins::Entries>
+      own_entries(ParameterHandler &prm, const std::string &kind)
+      {
+        std::map<std::string, Plugins::Entries> own;
+        for (const auto &plugin : Plugins::declarations(kind))
+          {
+            const auto declared =
+              Plugins::declared_entries(plugin.declare_parameters);
+            if (declared.empty())
+              continue;
+            auto &entries = own[plugin.name];
+            prm.enter_subsection(plugin.name);
+            for (const auto &entry : declared)
+              entries[entry.first] = prm.get(entry.first);
+            prm.leave_subsection();
+          }
+        return own;
+      }
+
+
+
       /** Pattern of a 3-vector entry "x, y, z". */
       Patterns::List
       point_pattern()
@@ -888,24 +912,31 @@ namespace palpate
     {
       prm.enter_subsection("Linear solver");
       {
-        prm.declare_entry(
-          "Solver",
-          "by size",
-          Patterns::Selection(
-            "by size|MUMPS|MUMPS single|UMFPACK|KLU|Amesos MUMPS|Amesos KLU"),
-          "Sparse direct solver for the linearised systems. MUMPS is "
-          "called through its C interface with the symmetric indefinite "
-          "LDL^T factorisation; 'MUMPS single' factorises in single "
-          "precision and serves as the preconditioner of GMRES in double "
-          "(mixed precision: the same Newton iterates and forces, cheaper "
-          "factorisations and solves on large meshes; if GMRES fails with "
-          "it, the state solver changes to MUMPS for good); 'by size' "
-          "chooses MUMPS below 5,000 equations and MUMPS single from 5,000 "
-          "on (a state 9-13 % faster at 5,358-6,965 equations, 30-43 % at "
-          "16,980, "
-          "doc/benchmarks/organ-speed.md). UMFPACK and KLU through "
-          "SuiteSparse; the Amesos variants through Trilinos Amesos, for "
-          "comparison. All analyse the sparsity pattern once per solver.");
+        // The solvers are plug-ins (hyperelastic/linear_solver.h): the
+        // choice and each one's own subsection come from their
+        // declarations; Ordering is shared.
+        std::string doc =
+          "Sparse direct solver for the linearised systems: by size: MUMPS "
+          "below 5,000 equations and MUMPS single from 5,000 on (a state "
+          "9-13 % faster at 5,358-6,965 equations, 30-43 % at 16,980, "
+          "doc/benchmarks/organ-speed.md);";
+        for (const auto &plugin : Plugins::declarations("linear solver"))
+          doc += " " + plugin.name + ": " + plugin.description + ";";
+        doc += " all analyse the sparsity pattern once per solver. With "
+               "MUMPS single, if GMRES fails, the state solver changes to "
+               "MUMPS for good.";
+        prm.declare_entry("Solver",
+                          "by size",
+                          Patterns::Selection(
+                            "by size|" + Plugins::selection("linear solver")),
+                          doc);
+        for (const auto &plugin : Plugins::declarations("linear solver"))
+          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
+            {
+              prm.enter_subsection(plugin.name);
+              plugin.declare_parameters(prm);
+              prm.leave_subsection();
+            }
         prm.declare_entry(
           "Ordering",
           "by size",
@@ -932,6 +963,7 @@ namespace palpate
       {
         solver   = prm.get("Solver");
         ordering = prm.get("Ordering");
+        own      = own_entries(prm, "linear solver");
       }
       prm.leave_subsection();
     }
@@ -1200,20 +1232,8 @@ namespace palpate
     {
       prm.enter_subsection("Trajectory");
       {
-        type = prm.get("Type");
-        own.clear();
-        for (const auto &plugin : Plugins::declarations("trajectory"))
-          {
-            const auto declared =
-              Plugins::declared_entries(plugin.declare_parameters);
-            if (declared.empty())
-              continue;
-            auto &entries = own[plugin.name];
-            prm.enter_subsection(plugin.name);
-            for (const auto &entry : declared)
-              entries[entry.first] = prm.get(entry.first);
-            prm.leave_subsection();
-          }
+        type                     = prm.get("Type");
+        own                      = own_entries(prm, "trajectory");
         direction                = get_point(prm, "Direction");
         speed                    = prm.get_double("Speed");
         duration                 = prm.get_double("Duration");

@@ -1106,6 +1106,7 @@ namespace palpate
   {
     check_material();
     check_effects();
+    check_plugin_entries();
     check_probe();
     check_mesh();
     check_fixed_nodes();
@@ -1214,6 +1215,40 @@ namespace palpate
       {
         throw error("Effects/" + e.entry, e.problem, e.fix);
       }
+  }
+
+
+
+  void
+  Scene::check_plugin_entries() const
+  {
+    const auto &p     = parameters;
+    const auto  check = [&](const std::string &kind,
+                           const std::string &section,
+                           const std::string &name,
+                           const std::map<std::string, Plugins::Entries> &own) {
+      const auto entries = own.find(name);
+      try
+        {
+          Plugins::check_entries(kind,
+                                 name,
+                                 entries == own.end() ? Plugins::Entries() :
+                                                         entries->second);
+        }
+      catch (const Plugins::EntryError &e)
+        {
+          throw error(section + "/" + name + "/" + e.entry, e.problem, e.fix);
+        }
+    };
+    check("trajectory",
+          "Haptics/Trajectory",
+          p.haptics.trajectory.type,
+          p.haptics.trajectory.own);
+    if (p.linear_solver.solver != "by size")
+      check("linear solver",
+            "Linear solver",
+            p.linear_solver.solver,
+            p.linear_solver.own);
   }
 
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// Two solver workers at once, with every selectable direct solver: two
+// Two solver workers at once, with every registered linear solver: two
 // StateSolvers compute the same liver states (StVK, 1 and 2 cm pushes in
 // four directions) in two threads at the same time, three times over, and
 // every state equals the one computed alone (1e-12 relative).
@@ -32,10 +32,10 @@ main(int argc, char **argv)
                                        {{-0.02, 0, 0}},
                                        {{0, 0.01, 0.01}},
                                        {{0.01, -0.01, 0}}};
-  for (const std::string name :
-       {"MUMPS", "UMFPACK", "KLU", "Amesos MUMPS", "Amesos KLU"})
+  for (const auto &plugin : palpate::LinearSolverRegistry::plugins())
     {
-      palpate::Scene scene                  = shipped_scene("paper-stvk.prm");
+      const std::string &name               = plugin.name;
+      palpate::Scene     scene              = shipped_scene("paper-stvk.prm");
       scene.parameters.linear_solver.solver = name;
       const Body           body(scene);
       palpate::StateSolver a(body.mesh, body.nodes, body.scene.parameters),

@@ -60,6 +60,19 @@ namespace palpate
     /** The declarations of one plug-in's entries, as its own subsection. */
     using DeclareFunction = void (*)(dealii::ParameterHandler &prm);
 
+    template <typename Class>
+    constexpr auto
+    has_check(int) -> decltype(&Class::check_parameters, bool())
+    {
+      return true;
+    }
+    template <typename Class>
+    constexpr bool
+    has_check(long)
+    {
+      return false;
+    }
+
     /**
      * What a scene needs of a plug-in to declare it: its name, description
      * and entries, without its interface. The scene declares the plug-ins
@@ -71,7 +84,30 @@ namespace palpate
       std::string     name;
       std::string     description;
       DeclareFunction declare_parameters;
+      /** Checks the plug-in's own entries when the scene is read (throws
+       * EntryError); nullptr if it has no check_parameters(). */
+      void (*check_parameters)(const dealii::ParameterHandler &own) = nullptr;
     };
+
+    /** A plug-in class's `static void check_parameters(const
+     * ParameterHandler &own)`, or nullptr if it has none: what its values
+     * must satisfy beyond their patterns, checked when the scene is read,
+     * before anything is built. */
+    template <typename Class>
+    constexpr void (*check_function())(const dealii::ParameterHandler &)
+    {
+      if constexpr (has_check<Class>(0))
+        return &Class::check_parameters;
+      else
+        return nullptr;
+    }
+
+    /** Check the own @p entries of the plug-in of @p kind called @p name
+     * (their patterns, then its check_parameters()): throws EntryError. */
+    void
+    check_entries(const std::string &kind,
+                  const std::string &name,
+                  const Entries     &entries);
 
     /** Add @p declaration to those of @p kind (at static initialisation,
      * by a registration macro). */

@@ -4,12 +4,19 @@
 #ifndef palpate_hyperelastic_linear_solver_h
 #define palpate_hyperelastic_linear_solver_h
 
+#include <palpate/base/plugins.h>
+
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace palpate
 {
+  namespace Parameters
+  {
+    struct LinearSolver;
+  }
+
   /**
    * A square sparse matrix pattern in compressed row storage with sorted
    * column indices. palpate's systems are symmetric, so the pattern is
@@ -96,16 +103,61 @@ namespace palpate
     }
 
     /**
-     * A solver by scene name: "MUMPS", "MUMPS single", "UMFPACK", "KLU",
-     * "Amesos MUMPS" or "Amesos KLU"; @p ordering is MUMPS's
-     * fill-reducing ordering.
+     * A solver by scene name, from LinearSolverRegistry ("MUMPS", "MUMPS
+     * single", "UMFPACK", "KLU", "Amesos MUMPS", "Amesos KLU", or one
+     * registered elsewhere) with its own entries at their defaults;
+     * @p ordering is the shared entry Linear solver / Ordering (MUMPS's
+     * fill-reducing ordering; "by size" is AMF here).
      */
     static std::unique_ptr<LinearSolver>
     create(const std::string &name, const std::string &ordering);
 
+    /**
+     * The solver @p p names for a system of @p n_equations (Solver = by
+     * size chooses by it), with its own entries from the scene. A value
+     * the plug-in refuses throws Plugins::EntryError.
+     */
+    static std::unique_ptr<LinearSolver>
+    create(const Parameters::LinearSolver &p, const unsigned int n_equations);
+
   protected:
     std::string message_;
   };
+
+  /**
+   * The linear solvers are plug-ins (doc/extending.md): `Linear solver /
+   * Solver` chooses one by name; its own entries are in `Linear solver /
+   * <its name>`, the shared ones (Ordering) in Parameters::LinearSolver,
+   * the context its factory gets. Its file ends with
+   *
+   *     PALPATE_REGISTER_LINEAR_SOLVER(Pardiso, "Pardiso", "one line")
+   *
+   * where the class has `static void declare_parameters(ParameterHandler
+   * &)` and `static std::unique_ptr<LinearSolver> create(const
+   * ParameterHandler &own, const Parameters::LinearSolver &shared)`.
+   */
+  using LinearSolverRegistry =
+    Plugins::Registry<LinearSolver, Parameters::LinearSolver>;
+  extern template class Plugins::Registry<LinearSolver,
+                                          Parameters::LinearSolver>;
+
+/** Register the linear solver @p classname as @p name (the registry, and
+ * its declaration for the scene's Linear solver subsection). */
+#define PALPATE_REGISTER_LINEAR_SOLVER(classname, name, description)           \
+  namespace                                                                    \
+  {                                                                            \
+    [[maybe_unused]] const bool palpate_linear_solver_registered_##classname = \
+      ::palpate::LinearSolverRegistry::add({name,                              \
+                                            description,                       \
+                                            &classname::declare_parameters,    \
+                                            &classname::create}) &&            \
+      ::palpate::Plugins::add_declaration(                                     \
+        "linear solver",                                                       \
+        {name,                                                                 \
+         description,                                                          \
+         &classname::declare_parameters,                                       \
+         ::palpate::Plugins::check_function<classname>()});                    \
+  }
 } // namespace palpate
 
 #endif

@@ -289,6 +289,9 @@ namespace palpate
        * equations, MUMPS single from there on), "MUMPS", "MUMPS single",
        * "UMFPACK", "KLU", "Amesos MUMPS" or "Amesos KLU". */
       std::string solver;
+      /** Each linear solver plug-in's own entries (plug-in name -> its
+       * subsection's values; LinearSolverRegistry). */
+      std::map<std::string, Plugins::Entries> own;
       /** MUMPS fill-reducing ordering: "by size" (AMF below
        * Parameters::LinearSolver::metis_from equations, METIS from there
        * on), "AMF", "METIS", "AMD", "QAMD", "PORD", "SCOTCH" or "automatic"

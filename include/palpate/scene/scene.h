@@ -144,6 +144,10 @@ namespace palpate
     /** validate(): each enabled effect plug-in's entries. */
     void
     check_effects() const;
+    /** The own entries of the chosen trajectory and linear solver
+     * plug-ins (Plugins::check_entries). */
+    void
+    check_plugin_entries() const;
 
     /** validate(): the probe's tip and its radius. */
     void
