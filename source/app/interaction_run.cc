@@ -4,10 +4,10 @@
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/base/stop_request.h>
+#include <palpate/haptics/device.h>
 #include <palpate/haptics/haptic_loop.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
-#include <palpate/haptics/trajectory.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/scene/scene.h>
@@ -135,7 +135,7 @@ namespace palpate
 
       double                             duration = 0, reach = 0;
       std::unique_ptr<Interaction>       interaction;
-      std::unique_ptr<SimulatedDevice>   device;
+      std::unique_ptr<Device>            device;
       std::unique_ptr<HapticLoop>        loop;
       std::unique_ptr<ShapeInterpolator> shape;
 
@@ -164,36 +164,18 @@ namespace palpate
       if (files)
         check_output_directory(scene);
 
-      auto trajectory = Trajectory::create(scene);
-      duration        = trajectory->duration();
-      // How far the scene's own trajectory takes the probe from rest, along
-      // any axis: beyond the grid's extent the force fades to zero.
-      for (unsigned int k = 0; k <= 1000; ++k)
-        for (const double x : trajectory->position(duration * k / 1000))
-          reach = std::max(reach, std::abs(x));
-      if (duration > Limits::max_motion_duration)
-        throw InputError(
-          scene.resolve_path(p.haptics.trajectory.file_name),
-          0,
-          "trajectory replay (Haptics / Trajectory / File name)",
-          "the recording lasts " + Utilities::to_string(duration, 4) +
-            " s; at most " +
-            Utilities::to_string(Limits::max_motion_duration, 4) +
-            " s (one hour) are allowed: the haptic loop preallocates its "
-            "statistics and force log for every tick of the run",
-          "check the time column (seconds, not milliseconds), or split the "
-          "recording.");
+      device   = Device::create(scene);
+      duration = std::min(device->max_duration(), Limits::max_motion_duration);
+      // How far the device's planned motion takes the probe from rest,
+      // along any axis: beyond the grid's extent the force fades to zero.
+      reach                    = device->planned_reach();
       interaction              = std::make_unique<Interaction>(scene);
       const double max_seconds = wait_limit + duration + 1;
-      device                   = std::make_unique<SimulatedDevice>(
-        std::move(trajectory),
-        p.effects.force_log ?
-                            HapticLoop::max_ticks(p.haptics.loop_rate, max_seconds) :
-                            0);
-      loop = std::make_unique<HapticLoop>(*interaction,
+      loop                     = std::make_unique<HapticLoop>(*interaction,
                                           *device,
                                           p.haptics.loop_rate,
-                                          max_seconds);
+                                          max_seconds,
+                                          p.effects.force_log);
 
       if (p.effects.shape_output)
         shape = std::make_unique<ShapeInterpolator>(
@@ -411,7 +393,7 @@ namespace palpate
         {
           const std::string file =
             p.output.directory + "/" + stem + "-forces.csv";
-          write(file, [&] { device->write_force_log(file); });
+          write(file, [&] { loop->write_force_log(file); });
         }
       // The states as VTU come last: they take longest (seconds on a real
       // organ), and a second Ctrl-C while they are written, which ends the

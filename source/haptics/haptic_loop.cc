@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/haptics/device.h>
 #include <palpate/haptics/haptic_loop.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/run_summary.h>
-#include <palpate/haptics/trajectory.h>
 
 #include <pthread.h>
 #include <sched.h>
@@ -26,123 +26,6 @@
 
 namespace palpate
 {
-  struct SimulatedDevice::Impl
-  {
-    std::unique_ptr<Trajectory>    trajectory;
-    std::size_t                    capacity, n = 0;
-    std::vector<double>            time;
-    std::vector<Utilities::Point3> position, force;
-    double                         last_t = 0;
-    Utilities::Point3              last_position{{0, 0, 0}};
-  };
-
-
-
-  SimulatedDevice::SimulatedDevice(std::unique_ptr<Trajectory> trajectory,
-                                   const std::size_t           log_capacity)
-    : impl(std::make_unique<Impl>())
-  {
-    impl->trajectory = std::move(trajectory);
-    impl->capacity   = log_capacity;
-    // The force log is allocated here, before the loop, or not at all.
-    impl->time.resize(log_capacity);
-    impl->position.resize(log_capacity);
-    impl->force.resize(log_capacity);
-  }
-
-
-
-  SimulatedDevice::~SimulatedDevice() = default;
-
-
-
-  Utilities::Point3
-  SimulatedDevice::position(const double t) noexcept
-  {
-    impl->last_t = t;
-    impl->last_position =
-      t > 0 ? impl->trajectory->position(t) : Utilities::Point3{{0, 0, 0}};
-    return impl->last_position;
-  }
-
-
-
-  void
-  SimulatedDevice::render(const Utilities::Point3 &force) noexcept
-  {
-    Impl &s = *impl;
-    // The force log starts with the motion (the device's clock runs from
-    // 0 then); the wait for the initial cloud is not logged.
-    if (s.last_t > 0 && s.n < s.capacity)
-      {
-        s.time[s.n]     = s.last_t;
-        s.position[s.n] = s.last_position;
-        s.force[s.n]    = force;
-        ++s.n;
-      }
-  }
-
-
-
-  std::string
-  SimulatedDevice::description() const
-  {
-    return "simulated device, " + impl->trajectory->description();
-  }
-
-
-
-  double
-  SimulatedDevice::duration() const
-  {
-    return impl->trajectory->duration();
-  }
-
-
-
-  void
-  SimulatedDevice::write_force_log(const std::string &filename) const
-  {
-    std::ofstream out(filename);
-    if (!out)
-      throw std::runtime_error("cannot write '" + filename + "'");
-    out << "t_s,x_m,y_m,z_m,fx_N,fy_N,fz_N\n" << std::setprecision(9);
-    for (std::size_t k = 0; k < impl->n; ++k)
-      out << impl->time[k] << "," << impl->position[k][0] << ","
-          << impl->position[k][1] << "," << impl->position[k][2] << ","
-          << impl->force[k][0] << "," << impl->force[k][1] << ","
-          << impl->force[k][2] << "\n";
-    // A full disk shows only here: a cut log is an output error. What was
-    // written is cut back to its last whole row, so that no row holds a
-    // cut number, and the message says how many rows it keeps.
-    out.close();
-    if (!out)
-      {
-        const int   error = errno;
-        std::string text;
-        {
-          std::ifstream      in(filename, std::ios::binary);
-          std::ostringstream s;
-          s << in.rdbuf();
-          text = s.str();
-        }
-        const auto        end  = text.rfind('\n');
-        const std::size_t keep = end == std::string::npos ? 0 : end + 1;
-        std::error_code   ignored;
-        std::filesystem::resize_file(filename, keep, ignored);
-        const std::size_t rows =
-          std::count(text.begin(), text.begin() + keep, '\n');
-        throw std::runtime_error(
-          "'" + filename + "' could not be written whole (" +
-          std::strerror(error) + "): it keeps " +
-          (rows > 0 ? "the first " + std::to_string(rows - 1) + " of " +
-                        std::to_string(impl->n) + " rows, cut at a whole row" :
-                      std::string("nothing")));
-      }
-  }
-
-
-
   struct HapticLoop::Impl
   {
     Interaction           &interaction;
@@ -161,8 +44,17 @@ namespace palpate
     std::atomic<bool>      done{false}, stop{false};
     std::thread            thread;
     double                 motion_started_at = 0;
+    // The force log (Effects / Force log), allocated here or not at all:
+    // a row per tick of the motion.
+    std::vector<double>            log_time;
+    std::vector<Utilities::Point3> log_position, log_force;
+    std::size_t                    logged = 0;
 
-    Impl(Interaction &i, Device &d, const double r, const double max_seconds)
+    Impl(Interaction &i,
+         Device      &d,
+         const double r,
+         const double max_seconds,
+         const bool   force_log)
       : interaction(i)
       , device(d)
       , rate(r)
@@ -170,6 +62,9 @@ namespace palpate
       , period(capacity)
       , lateness(capacity)
       , interpolation(capacity)
+      , log_time(force_log ? capacity : 0)
+      , log_position(force_log ? capacity : 0)
+      , log_force(force_log ? capacity : 0)
     {}
 
     void
@@ -274,9 +169,16 @@ namespace palpate
         clock_gettime(CLOCK_MONOTONIC, &b);
         interpolation[n] = 1e-9 * (nanoseconds(b) - nanoseconds(a));
         device.render(f);
+        if (t > 0 && logged < log_time.size())
+          {
+            log_time[logged]     = t;
+            log_position[logged] = x;
+            log_force[logged]    = f;
+            ++logged;
+          }
         ++n;
 
-        if (start >= 0 && t > motion_duration)
+        if (start >= 0 && (device.finished(t) || t > motion_duration))
           {
             motion_over = true;
             break;
@@ -290,8 +192,13 @@ namespace palpate
   HapticLoop::HapticLoop(Interaction &interaction,
                          Device      &device,
                          const double rate,
-                         const double max_seconds)
-    : impl(std::make_unique<Impl>(interaction, device, rate, max_seconds))
+                         const double max_seconds,
+                         const bool   force_log)
+    : impl(std::make_unique<Impl>(interaction,
+                                  device,
+                                  rate,
+                                  max_seconds,
+                                  force_log))
   {}
 
 
@@ -405,5 +312,49 @@ namespace palpate
     r.loop_truncated        = s.truncated;
     r.motion_start    = s.motion_start_ns.load() < 0 ? 0 : s.motion_started_at;
     r.motion_duration = s.motion_elapsed;
+  }
+
+
+
+  void
+  HapticLoop::write_force_log(const std::string &filename) const
+  {
+    std::ofstream out(filename);
+    if (!out)
+      throw std::runtime_error("cannot write '" + filename + "'");
+    out << "t_s,x_m,y_m,z_m,fx_N,fy_N,fz_N\n" << std::setprecision(9);
+    const Impl &s = *impl;
+    for (std::size_t k = 0; k < s.logged; ++k)
+      out << s.log_time[k] << "," << s.log_position[k][0] << ","
+          << s.log_position[k][1] << "," << s.log_position[k][2] << ","
+          << s.log_force[k][0] << "," << s.log_force[k][1] << ","
+          << s.log_force[k][2] << "\n";
+    // A full disk shows only here: a cut log is an output error. What was
+    // written is cut back to its last whole row, so that no row holds a
+    // cut number, and the message says how many rows it keeps.
+    out.close();
+    if (!out)
+      {
+        const int   error = errno;
+        std::string text;
+        {
+          std::ifstream      in(filename, std::ios::binary);
+          std::ostringstream s;
+          s << in.rdbuf();
+          text = s.str();
+        }
+        const auto        end  = text.rfind('\n');
+        const std::size_t keep = end == std::string::npos ? 0 : end + 1;
+        std::error_code   ignored;
+        std::filesystem::resize_file(filename, keep, ignored);
+        const std::size_t rows =
+          std::count(text.begin(), text.begin() + keep, '\n');
+        throw std::runtime_error(
+          "'" + filename + "' could not be written whole (" +
+          std::strerror(error) + "): it keeps " +
+          (rows > 0 ? "the first " + std::to_string(rows - 1) + " of " +
+                        std::to_string(s.logged) + " rows, cut at a whole row" :
+                      std::string("nothing")));
+      }
   }
 } // namespace palpate

@@ -1258,11 +1258,24 @@ namespace palpate
                           Patterns::Double(0.),
                           "Rate of the haptic loop that interpolates and "
                           "sends the force (Hz).");
+        // The devices are plug-ins (haptics/device.h): the choice and
+        // each one's own subsection come from their declarations.
+        std::string doc = "The haptic device, which the haptic loop reads "
+                          "and renders the force to:";
+        for (const auto &plugin : Plugins::declarations("device"))
+          doc += " " + plugin.name + ": " + plugin.description + ";";
+        doc.back() = '.';
         prm.declare_entry("Device",
                           "simulated",
-                          Patterns::Selection("simulated"),
-                          "The haptic device: a simulated one that follows "
-                          "the trajectory below.");
+                          Patterns::Selection(Plugins::selection("device")),
+                          doc);
+        for (const auto &plugin : Plugins::declarations("device"))
+          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
+            {
+              prm.enter_subsection(plugin.name);
+              plugin.declare_parameters(prm);
+              prm.leave_subsection();
+            }
         prm.declare_entry("Force limit",
                           "8",
                           Patterns::Double(0.),
@@ -1286,6 +1299,7 @@ namespace palpate
       {
         loop_rate        = prm.get_double("Loop rate");
         device           = prm.get("Device");
+        own              = own_entries(prm, "device");
         force_limit      = prm.get_double("Force limit");
         max_force_change = prm.get_double("Maximum force change");
         trajectory.parse_parameters(prm);

@@ -1240,6 +1240,7 @@ namespace palpate
           throw error(section + "/" + name + "/" + e.entry, e.problem, e.fix);
         }
     };
+    check("device", "Haptics", p.haptics.device, p.haptics.own);
     check("trajectory",
           "Haptics/Trajectory",
           p.haptics.trajectory.type,

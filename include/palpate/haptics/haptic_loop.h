@@ -11,69 +11,9 @@
 
 namespace palpate
 {
+  class Device;
   class Interaction;
-  class Trajectory;
   struct RunSummary;
-
-  /**
-   * A haptic device as the loop sees it: where the HIP is, and the force
-   * to render there.
-   */
-  class Device
-  {
-  public:
-    virtual ~Device() = default;
-
-    /** The HIP's position (m, relative to the active node's rest
-     * position) at time @p t (s) since its motion started (<= 0: at
-     * rest). Real-time safe. */
-    virtual Utilities::Point3
-    position(const double t) noexcept = 0;
-
-    /** Render @p force (N). Real-time safe. */
-    virtual void
-    render(const Utilities::Point3 &force) noexcept = 0;
-
-    /** One line for reports. */
-    virtual std::string
-    description() const = 0;
-  };
-
-  /**
-   * The paper's simulated device: the HIP follows a trajectory, and the
-   * rendered forces go nowhere, or, with Effects / Force log, into a
-   * preallocated log written as CSV after the run.
-   */
-  class SimulatedDevice : public Device
-  {
-  public:
-    /** @p log_capacity ticks of force log (0: no log, no work). */
-    SimulatedDevice(std::unique_ptr<Trajectory> trajectory,
-                    const std::size_t           log_capacity);
-
-    ~SimulatedDevice() override;
-
-    Utilities::Point3
-    position(const double t) noexcept override;
-
-    void
-    render(const Utilities::Point3 &force) noexcept override;
-
-    std::string
-    description() const override;
-
-    /** The trajectory's length (s). */
-    double
-    duration() const;
-
-    /** Write the force log (t s, position m, force N) as CSV. */
-    void
-    write_force_log(const std::string &filename) const;
-
-  private:
-    struct Impl;
-    std::unique_ptr<Impl> impl;
-  };
 
   /**
    * The built-in haptic thread: at Haptics / Loop rate, with absolute
@@ -84,7 +24,9 @@ namespace palpate
    * before it starts: the loop itself never allocates.
    *
    * The motion starts when start_motion() is called (e.g. once the initial
-   * cloud is computed); the loop ends when the motion is over.
+   * cloud is computed); the loop ends when the device says the interaction
+   * is over (Device::finished()). Every device runs in it alike, with the
+   * same priority, statistics, summary and force log.
    */
   class HapticLoop
   {
@@ -96,7 +38,8 @@ namespace palpate
     HapticLoop(Interaction &interaction,
                Device      &device,
                const double rate,
-               const double max_seconds);
+               const double max_seconds,
+               const bool   force_log = false);
 
     ~HapticLoop();
 
@@ -105,7 +48,8 @@ namespace palpate
     static std::size_t
     max_ticks(const double rate, const double max_seconds);
 
-    /** Start the thread; the HIP rests until start_motion(). */
+    /** Start the thread; the HIP rests until start_motion(). The motion
+     * lasts until the device says so, at most @p motion_duration (s). */
     void
     start(const double motion_duration);
 
@@ -131,6 +75,15 @@ namespace palpate
     /** Add the loop's statistics to @p summary. */
     void
     add_to(RunSummary &summary) const;
+
+    /**
+     * With a force log: write it as CSV (t s, HIP position m, force N, a
+     * row per tick of the motion; the wait before it is not logged). A
+     * full disk cuts it back to its last whole row and throws, saying how
+     * many rows it keeps.
+     */
+    void
+    write_force_log(const std::string &filename) const;
 
   private:
     struct Impl;

@@ -419,11 +419,15 @@ namespace palpate
     /** `subsection Haptics`: the real-time loop and the device. */
     struct Haptics
     {
-      double      loop_rate;
+      double loop_rate;
+      /** The device plug-in's name (DeviceRegistry). */
       std::string device;
-      double      force_limit;
-      double      max_force_change;
-      Trajectory  trajectory;
+      /** Each device plug-in's own entries (plug-in name -> its
+       * subsection's values). */
+      std::map<std::string, Plugins::Entries> own;
+      double                                  force_limit;
+      double                                  max_force_change;
+      Trajectory                              trajectory;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);

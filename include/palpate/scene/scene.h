@@ -144,8 +144,8 @@ namespace palpate
     /** validate(): each enabled effect plug-in's entries. */
     void
     check_effects() const;
-    /** The own entries of the chosen trajectory and linear solver
-     * plug-ins (Plugins::check_entries). */
+    /** The own entries of the chosen device, trajectory and linear
+     * solver plug-ins (Plugins::check_entries). */
     void
     check_plugin_entries() const;
 
