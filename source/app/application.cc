@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -250,11 +251,13 @@ namespace palpate
         }
       // A push longer than the body is across is a typing mistake (mm for
       // m), not a failure point after 1000 increments.
-      if (Utilities::norm(*target) > mesh.diameter())
+      // (hypot: a push of 1e300 m is said to be that, not 'inf').
+      const double length =
+        std::hypot((*target)[0], (*target)[1], (*target)[2]);
+      if (length > mesh.diameter())
         {
           const std::string size = Utilities::to_string(mesh.diameter(), 3);
-          const std::string push =
-            Utilities::to_string(Utilities::norm(*target), 3);
+          const std::string push = Utilities::to_string(length, 3);
           if (target != prescribed)
             throw InputError("command line",
                              0,

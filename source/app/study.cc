@@ -752,6 +752,20 @@ namespace palpate
     };
 
     result.csv_file = options.csv_file;
+    if (!result.csv_file.empty())
+      {
+        // Said before anything runs, not at the first knob's end.
+        std::error_code error;
+        if (std::filesystem::is_directory(result.csv_file, error))
+          throw InputError(
+            "command line",
+            0,
+            "--csv " + result.csv_file,
+            "'" + result.csv_file + "' is a directory, not a file",
+            "give the CSV file's name, e.g. --csv " +
+              (std::filesystem::path(result.csv_file) / "study.csv").string() +
+              ".");
+      }
     if (result.csv_file.empty())
       {
         std::filesystem::create_directories(p0.output.directory);
@@ -785,8 +799,11 @@ namespace palpate
       csv.close();
       if (!csv)
         throw OutputError("the study's CSV '" + result.csv_file +
-                          "' could not be written");
+                          "' could not be written (" + std::strerror(errno) +
+                          ")");
     };
+    // Its header now: a file that cannot be written fails before the work.
+    write_csv();
 
     std::vector<Sample> reference;
     unsigned int        n_reference = 0;

@@ -39,7 +39,8 @@ namespace palpate
     if (!(value > 0))
       throw Plugins::EntryError(entry,
                                 "must be positive",
-                                "set it in Pa, e.g. 15465 for liver.");
+                                "set it in Pa: soft tissue is 1e2 - 1e7 Pa "
+                                "(the scene's default is a liver's).");
   }
 
 

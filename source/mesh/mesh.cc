@@ -553,7 +553,7 @@ namespace palpate
       // forces and a state space of the wrong size.
       const auto check_size = [](const Scene &scene, const Mesh &mesh) {
         const double size = mesh.diameter();
-        if (size >= 0.002 && size <= 2)
+        if (size >= Limits::min_body_size && size <= Limits::max_body_size)
           return;
         const double factor = scene.parameters.mesh.scale_factor;
         throw scene.error(

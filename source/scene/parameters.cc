@@ -1103,7 +1103,7 @@ namespace palpate
           "stay.");
         prm.declare_entry("Server timeout",
                           "5",
-                          Patterns::Double(0.1),
+                          Patterns::Double(0.5),
                           "Type = mpi: a solver server that has sent "
                           "nothing (it sends a heartbeat every 0.1 s) for "
                           "this long is lost: it gets no more work and its "
@@ -1184,7 +1184,7 @@ namespace palpate
                           "random walk (m).");
         prm.declare_entry("Seed",
                           "1",
-                          Patterns::Integer(0),
+                          Patterns::Integer(0, 2147483647),
                           "Seed of the smooth random walk (dimensionless).");
         prm.declare_entry("File name",
                           "",

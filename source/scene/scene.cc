@@ -1185,6 +1185,29 @@ namespace palpate
                     "(liver: E = 15465 Pa, or C10 = 2148, C01 = 430).");
       }
 
+    // A Poisson's ratio a hair below 0.5 passes its own check but makes the
+    // first Lame constant astronomical: nu = 0.49999999999999994 gave a
+    // 1.7e12 N force for a 1 cm push (lambda 4.6e19 Pa). Held against the
+    // same bound as the moduli.
+    if (const double nu = material->poissons_ratio(); nu < 0.5)
+      {
+        const double E      = material->youngs_modulus();
+        const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+        if (!(std::abs(lambda) <= max_modulus))
+          throw error("Material model/" + m.model_name + "/Poisson's ratio",
+                      "nu = " + Utilities::to_string_exact(nu) +
+                        " makes the first Lame constant lambda = E nu / ((1 "
+                        "+ nu)(1 - 2 nu)) = " +
+                        Utilities::to_string(lambda, 3) + " Pa, more than " +
+                        Utilities::to_string(max_modulus, 3) +
+                        " Pa: stiffer than any solid, it only overflows the "
+                        "solver's force scale",
+                      "for a nearly incompressible tissue use nu <= 0.499 "
+                      "(linear elements lock long before 0.5), or "
+                      "Mooney-Rivlin, whose mixed formulation keeps the "
+                      "volume without locking.");
+      }
+
     // An element pair (Taylor-Hood, P1-P1) fixes the displacement degree.
     if (const Formulation f = material->formulation();
         f.displacement_degree > 0 && sets("Discretization/Polynomial degree") &&
@@ -1281,9 +1304,11 @@ namespace palpate
                       " needs a positive Tip radius",
                     "set Tip radius in metres, e.g. 0.01 for a probe of "
                     "1 cm radius.");
-      if (a.tip == Tip::sphere && a.tip_radius > max_sphere_radius)
+      if (a.tip != Tip::point && a.tip_radius > max_sphere_radius)
         throw error("Boundary conditions/Active node/Tip radius",
-                    "a sphere of " + Utilities::to_string(a.tip_radius, 3) +
+                    std::string(a.tip == Tip::sphere ? "a sphere" :
+                                                       "a glued tip") +
+                      " of " + Utilities::to_string(a.tip_radius, 3) +
                       " m radius is no probe (at most " +
                       Utilities::to_string(max_sphere_radius, 3) + " m)",
                     "give the radius in metres (a 1 cm probe: 0.01).");
@@ -1351,6 +1376,19 @@ namespace palpate
                           words[d] + " has no volume",
                         std::string("set it in metres, e.g. ") +
                           (d == 0 ? "0.1." : "0.02."));
+          else if (dims[d] < min_body_size / 2 || dims[d] > max_body_size)
+            // As a mesh file's body (check_size in mesh.cc): past these its
+            // elements' volumes under- or overflow and the messages blame
+            // the generated mesh.
+            throw error(std::string("Mesh/Beam/") + names[d],
+                        std::string("a beam ") +
+                          Utilities::to_string(dims[d], 3) + " m in " +
+                          words[d] + "; a body to palpate is " +
+                          Utilities::to_string(min_body_size / 2, 3) + " to " +
+                          Utilities::to_string(max_body_size, 3) +
+                          " m in each direction",
+                        std::string("set it in metres, e.g. ") +
+                          (d == 0 ? "0.1." : "0.02."));
         const double nodes = (p.mesh.beam_subdivisions_length + 1.) *
                              (p.mesh.beam_subdivisions_width + 1.) *
                              (p.mesh.beam_subdivisions_height + 1.);
@@ -1363,13 +1401,37 @@ namespace palpate
                         "far from haptic rates)",
                       "use fewer subdivisions, e.g. 10, 2, 2.");
       }
+    // As palpate mesh --fine-size: below 10 micrometres Gmsh works until
+    // its time limit and the message blames the limit.
+    if (p.mesh.source == "surface" && p.mesh.surface_fine_size > 0 &&
+        p.mesh.surface_fine_size < 1e-5)
+      throw error("Mesh/Surface/Refinement size",
+                  "an element size of " +
+                    Utilities::to_string(p.mesh.surface_fine_size, 3) +
+                    " m near the probe; at least 1e-5 m (10 micrometres)",
+                  "give the size in metres: a third of the sphere's radius "
+                  "is a good start, e.g. 0.003 for a 1 cm sphere.");
     if (p.mesh.source == "blob")
       for (unsigned int d = 0; d < 3; ++d)
-        if (!(p.mesh.blob_semi_axes[d] > 0))
-          throw error("Mesh/Blob/Semi-axes",
-                      "every semi-axis must be positive: a blob with a zero "
-                      "or negative semi-axis has no volume",
-                      "give three lengths in metres, e.g. 0.125, 0.09, 0.07.");
+        {
+          if (!(p.mesh.blob_semi_axes[d] > 0))
+            throw error(
+              "Mesh/Blob/Semi-axes",
+              "every semi-axis must be positive: a blob with a zero "
+              "or negative semi-axis has no volume",
+              "give three lengths in metres, e.g. 0.125, 0.09, 0.07.");
+          else if (p.mesh.blob_semi_axes[d] < min_body_size / 4 ||
+                   p.mesh.blob_semi_axes[d] > max_body_size / 2)
+            throw error(
+              "Mesh/Blob/Semi-axes",
+              "a semi-axis of " +
+                Utilities::to_string(p.mesh.blob_semi_axes[d], 3) +
+                " m; a body to palpate is " +
+                Utilities::to_string(min_body_size / 2, 3) + " to " +
+                Utilities::to_string(max_body_size, 3) +
+                " m across, a semi-axis half that",
+              "give three lengths in metres, e.g. 0.125, 0.09, 0.07.");
+        }
   }
 
 
@@ -1391,7 +1453,9 @@ namespace palpate
                       "make each coordinate of Box upper corner larger than "
                       "that of Box lower corner.");
     if (f.selection == "half-space" &&
-        Utilities::norm(f.half_space_normal) == 0)
+        std::max({std::abs(f.half_space_normal[0]),
+                  std::abs(f.half_space_normal[1]),
+                  std::abs(f.half_space_normal[2])}) == 0)
       throw error("Boundary conditions/Fixed nodes/Half-space normal",
                   "the normal is the zero vector",
                   "give the direction pointing into the fixed half-space, "

@@ -397,6 +397,27 @@ main(int argc, char **argv)
         "subsection Mesh\n  set Source = file\n"
         "  set File name = inverted-liver.msh\n"
         "  set Scale factor = 1.7e308\nend\n");
+  // The fifth re-run (issue 26): extremes that blamed the wrong thing or
+  // ran with nonsense.
+  scene("a beam 1e-300 m wide (blamed a flat generated element)",
+        "beam-thin.prm",
+        beam + "subsection Mesh\n  subsection Beam\n"
+               "    set Width = 1e-300\n  end\nend\n");
+  scene("a glued tip of 1e300 m radius (glued the whole surface)",
+        "glued-huge.prm",
+        beam + "subsection Boundary conditions\n  subsection Active node\n"
+               "    set Tip = glued nodes\n    set Tip radius = 1e300\n"
+               "  end\nend\n");
+  scene("nu = 0.49999999999999994 (1.7e12 N for 1 cm)",
+        "nu-half.prm",
+        beam + "subsection Material model\n"
+               "  subsection St.Venant-Kirchhoff\n"
+               "    set Poisson's ratio = 0.49999999999999994\n  end\nend\n");
+  scene("Server timeout 0.1 s, the heartbeat period (healthy servers lost)",
+        "server-timeout.prm",
+        beam + "subsection Engine\n  set Server timeout = 0.1\nend\n");
+  run("study --csv naming a directory (found after the first knob)",
+      "study good.prm --quick --csv .");
   scene("an entry name with a different case",
         "case.prm",
         beam + "subsection Mesh\n  set scale factor = 1\nend\n");

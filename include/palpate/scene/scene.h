@@ -36,6 +36,10 @@ namespace palpate
     constexpr double max_generated_nodes = 1e5;
     /** Active node / Tip radius of a sphere (m): a probe, not a wall. */
     constexpr double max_sphere_radius = 0.1;
+    /** A body to palpate is this many metres across, at least and at most
+     * (the diagonal of its bounding box; a mesh in the wrong unit is
+     * outside). */
+    constexpr double min_body_size = 0.002, max_body_size = 2;
   } // namespace Limits
 
   /**
