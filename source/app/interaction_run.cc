@@ -108,6 +108,22 @@ namespace palpate
       RunSummary
       summarise();
 
+      /** A stop signal that came after the motion, while the outputs were
+       * written: they were written whole (the handler only takes note),
+       * and @p summary's exit status still says that the run was stopped. */
+      void
+      note_late_stop(RunSummary &summary) const
+      {
+        if (summary.stop_signal == 0 && stop_request &&
+            stop_request->requested())
+          {
+            summary.stop_signal = stop_request->signal_number();
+            summary.stopped_by  = "by " + stop_request->description() +
+                                 " while the outputs were written (after "
+                                 "the motion)";
+          }
+      }
+
       /** The CSV/JSON summaries, the store's line, the force log, the VTU
        * export and the shape output's line; an OutputError listing what
        * could not be written, after everything else was. */
@@ -502,8 +518,9 @@ namespace palpate
     run.set_up();
     run.report();
     run.move();
-    const RunSummary summary = run.summarise();
+    RunSummary summary = run.summarise();
     run.write_outputs(summary);
+    run.note_late_stop(summary);
     return summary;
   }
 } // namespace palpate

@@ -360,9 +360,16 @@ namespace palpate
     bool held = false;
     // Missing data is an event while in contact; a failure region or the
     // state space's edge also before it (the HIP got there before any cell
-    // was complete: zero force, with nothing to hold, is reported too).
-    const bool event = cause != MissingCause::none &&
-                       (s.in_contact || cause != MissingCause::not_computed);
+    // was complete: zero force, with nothing to hold, is reported too); and
+    // data not computed yet once the HIP has left its rest position, where
+    // the force is no longer zero (Start = immediately: the hand pushed
+    // 7 mm into the liver at 0 N before the first cell was complete, and
+    // no event was counted). At rest the zero force is the right one.
+    const bool moved =
+      finite && Utilities::norm(position) > 1e-3 * s.grid.spacing();
+    const bool event =
+      cause != MissingCause::none &&
+      (s.in_contact || moved || cause != MissingCause::not_computed);
     if (event)
       {
         held = (cause != MissingCause::not_computed || server_trouble) &&

@@ -246,6 +246,49 @@ main()
             << ", no state file cut short " << ok(no_partial) << std::endl;
   }
 
+  // One SIGINT after the motion, while the used states are exported as VTU:
+  // everything is still written whole, and the exit status says the run was
+  // stopped (it was 0, the signal unmentioned).
+  {
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() != ".txt")
+        std::filesystem::remove(f.path());
+    std::filesystem::remove(out);
+    auto with_vtu = interaction;
+    for (auto &argument : with_vtu)
+      if (argument == "Haptics/Trajectory/Duration=30")
+        argument = "Haptics/Trajectory/Duration=1";
+    with_vtu.push_back("--set");
+    with_vtu.push_back("Effects/VTU export=true");
+    const pid_t pid       = start_palpate(with_vtu, out, err);
+    bool        exporting = false;
+    for (unsigned int i = 0; i < 240000 && !exporting; ++i)
+      {
+        for (const auto &f : std::filesystem::directory_iterator(dir))
+          exporting =
+            exporting ||
+            f.path().filename().string().rfind("paper-stvk-state-", 0) == 0;
+        if (!exporting)
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
+      }
+    kill(pid, SIGINT);
+    const int status     = wait_status(pid);
+    bool      no_partial = true;
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() == ".vtu")
+        no_partial =
+          no_partial &&
+          read_file(f.path().string()).find("</VTKFile>") != std::string::npos;
+    deallog << "SIGINT during the VTU export after the motion: export began "
+            << ok(exporting) << ", exit status 130 " << ok(status == 130)
+            << ", stderr says when "
+            << ok(read_file(err).find("while the outputs were written") !=
+                  std::string::npos)
+            << ", summaries written "
+            << ok(std::filesystem::exists(dir + "/paper-stvk-summary.json"))
+            << ", every state file whole " << ok(no_partial) << std::endl;
+  }
+
   // `palpate solve` stopped in the middle of a long path (1000 increments):
   // within a Newton iteration it prints the history and how far it got,
   // writes the shape output and the force log, and exits 128 + 2.
