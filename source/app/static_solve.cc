@@ -12,8 +12,6 @@
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 
-#include <deal.II/base/data_out_base.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -92,23 +90,29 @@ namespace palpate
       scene.file().empty() ?
         "default" :
         std::filesystem::path(scene.file()).stem().string();
-    std::vector<std::pair<double, std::string>> frames;
-    std::unique_ptr<ShapeFrames>                writer;
-    const State                                 rest = solver.rest_state();
-    const auto frame = [&](const State &s, const double t) {
+    // The index names each frame as soon as it is written (PvdIndex), so
+    // that a killed solve leaves its frames indexed.
+    unsigned int                 frames = 0;
+    std::unique_ptr<ShapeFrames> writer;
+    PvdIndex                     index;
+    const std::string            index_file =
+      p.output.directory + "/" + stem + "-shape.pvd";
+    const State rest  = solver.rest_state();
+    const auto  frame = [&](const State &s, const double t) {
       char name[64];
-      std::snprintf(name,
-                    sizeof(name),
-                    "-shape-%05u.vtu",
-                    static_cast<unsigned int>(frames.size()));
+      std::snprintf(name, sizeof(name), "-shape-%05u.vtu", frames);
       const std::string file = stem + name;
       writer->write(s.solution, s.force, p.output.directory + "/" + file);
-      frames.emplace_back(t, file);
+      if (const std::string why = index.append(t, file); !why.empty())
+        throw OutputError(why);
+      ++frames;
     };
     if (p.effects.shape_output)
       {
         std::filesystem::create_directories(p.output.directory);
         writer = std::make_unique<ShapeFrames>(mesh, nodes, system);
+        if (const std::string why = index.open(index_file); !why.empty())
+          throw OutputError(why);
         frame(rest, 0);
       }
     // The last equilibrium on the path, for a report if a stop signal
@@ -219,17 +223,9 @@ namespace palpate
     if (p.effects.vtu_export || p.effects.force_log)
       std::filesystem::create_directories(p.output.directory);
     if (writer)
-      {
-        const std::string file = p.output.directory + "/" + stem + "-shape.pvd";
-        std::ofstream     pvd(file);
-        dealii::DataOutBase::write_pvd_record(pvd, frames);
-        pvd.flush();
-        if (!pvd)
-          throw OutputError("cannot write the file '" + file + "'");
-        out << "  wrote " << file << " (" << frames.size()
-            << " frames: rest, then the end of every increment; time = the "
-               "fraction of the path)\n";
-      }
+      out << "  wrote " << index_file << " (" << frames
+          << " frames: rest, then the end of every increment; time = the "
+             "fraction of the path)\n";
     if (p.effects.vtu_export)
       {
         const std::string file = p.output.directory + "/" + stem + "-state.vtu";

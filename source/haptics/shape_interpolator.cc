@@ -33,99 +33,83 @@
 
 namespace palpate
 {
-  namespace
-  {
-    /**
-     * A PVD index that is whole at every moment. Each frame's entry is
-     * written over the closing tags, with new closing tags after it, in
-     * one write where they began: a run killed between frames (SIGKILL, a
-     * crash, mpirun ending a lost MPI client) leaves every frame indexed
-     * but the one being written. (Rewriting the whole index every 5 s lost
-     * the frames of the last few seconds: 93 of 97 indexed when an MPI
-     * client was killed.) A write that fails (a full disk) puts the
-     * closing tags back where they were, in room the file already has, and
-     * cuts what came after them.
-     */
-    class PvdIndex
-    {
-    public:
-      ~PvdIndex()
-      {
-        if (fd >= 0)
-          ::close(fd);
-      }
 
-      /** Create @p name with no entries; "" or why it could not be. */
-      std::string
-      open(const std::string &name)
+
+
+  PvdIndex::~PvdIndex()
+  {
+    if (fd >= 0)
+      ::close(fd);
+  }
+
+
+
+  std::string
+  PvdIndex::open(const std::string &name)
+  {
+    file = name;
+    fd   = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0)
+      return failed(errno);
+    const std::string header =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+      "version=\"0.1\" ByteOrder=\"LittleEndian\">\n  <Collection>\n";
+    if (!write_at(header + closing, 0))
+      return failed(errno);
+    tail = static_cast<long>(header.size());
+    return "";
+  }
+
+
+
+  std::string
+  PvdIndex::append(const double time, const std::string &name)
+  {
+    std::ostringstream entry;
+    entry << std::setprecision(10) << "    <DataSet timestep=\"" << time
+          << "\" group=\"\" part=\"0\" file=\"" << name << "\"/>\n";
+    if (write_at(entry.str() + closing, tail))
       {
-        file = name;
-        fd =
-          ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-        if (fd < 0)
-          return failed(errno);
-        const std::string header =
-          "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
-          "version=\"0.1\" ByteOrder=\"LittleEndian\">\n  <Collection>\n";
-        if (!write_at(header + closing, 0))
-          return failed(errno);
-        tail = static_cast<off_t>(header.size());
+        tail += static_cast<long>(entry.str().size());
         return "";
       }
-
-      /** Add the frame @p name at @p time (s); "" or why it could not be. */
-      std::string
-      append(const double time, const std::string &name)
+    const int error = errno;
+    write_at(closing, tail);
+    if (::ftruncate(fd, tail + static_cast<long>(closing.size())) != 0)
       {
-        std::ostringstream entry;
-        entry << std::setprecision(10) << "    <DataSet timestep=\"" << time
-              << "\" group=\"\" part=\"0\" file=\"" << name << "\"/>\n";
-        if (write_at(entry.str() + closing, tail))
-          {
-            tail += static_cast<off_t>(entry.str().size());
-            return "";
-          }
-        const int error = errno;
-        write_at(closing, tail);
-        if (::ftruncate(fd, tail + static_cast<off_t>(closing.size())) != 0)
-          {
-            // The closing tags are in place; a cut entry may follow them,
-            // which readers stop before.
-          }
-        return failed(error);
+        // The closing tags are in place; a cut entry may follow them,
+        // which readers stop before.
       }
+    return failed(error);
+  }
 
-    private:
-      bool
-      write_at(const std::string &text, off_t at) const
+
+
+  bool
+  PvdIndex::write_at(const std::string &text, long at) const
+  {
+    for (std::size_t done = 0; done < text.size();)
       {
-        for (std::size_t done = 0; done < text.size();)
-          {
-            const ssize_t n =
-              ::pwrite(fd, text.data() + done, text.size() - done, at);
-            if (n < 0 && errno == EINTR)
-              continue;
-            if (n <= 0)
-              return false;
-            done += static_cast<std::size_t>(n);
-            at += n;
-          }
-        return true;
+        const ssize_t n =
+          ::pwrite(fd, text.data() + done, text.size() - done, at);
+        if (n < 0 && errno == EINTR)
+          continue;
+        if (n <= 0)
+          return false;
+        done += static_cast<std::size_t>(n);
+        at += n;
       }
+    return true;
+  }
 
-      std::string
-      failed(const int error) const
-      {
-        return "the index '" + file + "' could not be written (" +
-               std::strerror(error) + ")";
-      }
 
-      const std::string closing = "  </Collection>\n</VTKFile>\n";
-      std::string       file;
-      int               fd   = -1;
-      off_t             tail = 0;
-    };
-  } // namespace
+
+  std::string
+  PvdIndex::failed(const int error) const
+  {
+    return "the index '" + file + "' could not be written (" +
+           std::strerror(error) + ")";
+  }
 
 
 

@@ -324,14 +324,39 @@ namespace palpate
       }
     else
       {
-        double best = std::numeric_limits<double>::max();
+        // (hypot: a Point at 1e300 m is that far, not 'inf', and its
+        // nearest node is not an arbitrary one.)
+        const auto from_point = [&](const unsigned int v) {
+          return std::hypot(x[v][0] - a.point[0],
+                            x[v][1] - a.point[1],
+                            x[v][2] - a.point[2]);
+        };
+        double best = std::numeric_limits<double>::infinity();
         for (unsigned int v = 0; v < x.size(); ++v)
-          if (surface[v] && Utilities::distance(x[v], a.point) < best)
+          if (surface[v] && from_point(v) < best)
             {
-              best                    = Utilities::distance(x[v], a.point);
+              best                    = from_point(v);
               selection.active_vertex = v;
             }
         selection.active_distance = best;
+        // The probe touches the surface where Point is: a Point a quarter
+        // of the body away from it (-1, 0.11, 0.1 beside a 25 cm liver:
+        // 824 mm) is a mistake, not a place to palpate.
+        if (!(best <= 0.25 * mesh.diameter()))
+          throw scene.error(
+            "Boundary conditions/Active node/Point",
+            "the nearest surface node (node " +
+              std::to_string(mesh.node_id(selection.active_vertex)) + " at " +
+              Utilities::to_string(x[selection.active_vertex], 4) + " m) is " +
+              Utilities::to_string(best, 3) +
+              " m from Point, more than a quarter of the body's size (" +
+              Utilities::to_string(mesh.diameter(), 3) +
+              " m across): Point is not on the organ",
+            "give a point on (or next to) the surface where the probe "
+            "touches, in metres, in the mesh's coordinates after Scale "
+            "factor: the body's bounding box is " +
+              Utilities::to_string(mesh.bounding_box().first, 3) + " to " +
+              Utilities::to_string(mesh.bounding_box().second, 3) + " m.");
       }
     if (fixed.count(selection.active_vertex))
       throw scene.error(

@@ -416,6 +416,16 @@ main(int argc, char **argv)
   scene("Server timeout 0.1 s, the heartbeat period (healthy servers lost)",
         "server-timeout.prm",
         beam + "subsection Engine\n  set Server timeout = 0.1\nend\n");
+  {
+    std::string       far   = beam;
+    const std::string point = "    set Point = 0.1, 0, 0.01\n";
+    far.replace(far.find(point),
+                point.size(),
+                "    set Point = 1e300, 0, 0.01\n");
+    scene("an active node Point 1e300 m away (an arbitrary node, 'inf mm')",
+          "point-far.prm",
+          far);
+  }
   run("study --csv naming a directory (found after the first knob)",
       "study good.prm --quick --csv .");
   scene("an entry name with a different case",

@@ -19,6 +19,49 @@ namespace palpate
   struct NodeSelection;
 
   /**
+   * A PVD index that is whole at every moment. Each frame's entry is
+   * written over the closing tags, with new closing tags after it, in one
+   * write where they began: a run killed between frames (SIGKILL, a crash,
+   * mpirun ending a lost MPI client) leaves every frame indexed but the one
+   * being written. (Rewriting the whole index every 5 s lost the frames of
+   * the last few seconds: 93 of 97 indexed when an MPI client was killed;
+   * palpate solve wrote it only at the end.) A write that fails (a full
+   * disk) puts the closing tags back where they were, in room the file
+   * already has, and cuts what came after them.
+   */
+  class PvdIndex
+  {
+  public:
+    PvdIndex()                 = default;
+    PvdIndex(const PvdIndex &) = delete;
+    PvdIndex &
+    operator=(const PvdIndex &) = delete;
+    ~PvdIndex();
+
+    /** Create @p name with no entries; "" or why it could not be. */
+    std::string
+    open(const std::string &name);
+
+    /** Add the frame @p name at @p time; "" or why it could not be. */
+    std::string
+    append(const double time, const std::string &name);
+
+  private:
+    bool
+    write_at(const std::string &text, long at) const;
+
+    std::string
+    failed(const int error) const;
+
+    const std::string closing = "  </Collection>\n</VTKFile>\n";
+    std::string       file;
+    int               fd   = -1;
+    long              tail = 0;
+  };
+
+
+
+  /**
    * Writes shape frames: the body's displacement as a VTU file for
    * ParaView (warp by 'displacement'), with the fixed and active nodes
    * flagged and the force on the probe as field data. What every frame
