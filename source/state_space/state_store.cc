@@ -340,6 +340,20 @@ namespace palpate
       if (!error)
         where = canonical;
       const std::string lock_file = where.string() + ".lock";
+      // Symbolic links lead to one lock; hard links do not (each name has
+      // its own lock file), and two writers through two names damaged
+      // 196-571 records. A store with more than one name is refused.
+      if (struct stat st; stat(where.c_str(), &st) == 0 &&
+                          S_ISREG(st.st_mode) && st.st_nlink > 1)
+        store_error(store,
+                    "the store has " + std::to_string(st.st_nlink) +
+                      " names (hard links to one file): the lock that keeps "
+                      "a second writer out is taken by name, so two "
+                      "processes could write it through two names at once",
+                    "keep one name: remove the other links (find them with "
+                    "'find / -samefile " +
+                      where.string() +
+                      "'), or copy the store to a file of its own.");
 
       std::lock_guard<std::mutex> registry_lock(lock_registry_mutex());
       auto                       &entry = lock_registry()[lock_file];

@@ -8,6 +8,7 @@
 //   naming the writer (pid, command, lock file) and the fix; in the same
 //   process a StoreLock shares the writer's lock; releasing it lets the
 //   next writer in, and removes the lock file;
+// - a store with two names (a hard link) is refused: the lock is by name;
 // - two processes that open one store at the same moment and append: one
 //   is refused, the other's records are all intact (none damaged; without
 //   the lock both wrote, and records were damaged);
@@ -235,6 +236,42 @@ main(int argc, char **argv)
             << "; released, its lock file is removed: " << ok(lock_file_gone)
             << " and the next writer appends: " << ok(after == 0) << " ("
             << c.states << " states in the store)" << std::endl;
+  }
+
+  // --- A store with two names (a hard link): each name would have its own
+  // lock file, and two writers through the two names damaged hundreds of
+  // records. It is refused, through either name.
+  {
+    std::filesystem::remove("two-names.h5");
+    std::filesystem::create_hard_link("one.h5", "two-names.h5");
+    unsigned int refused = 0;
+    std::string  problem;
+    for (const std::string name : {"one.h5", "two-names.h5"})
+      try
+        {
+          const palpate::StoreLock lock(name);
+        }
+      catch (const palpate::InputError &e)
+        {
+          ++refused;
+          problem = e.problem();
+        }
+    std::filesystem::remove("two-names.h5");
+    bool one_name_again = true;
+    try
+      {
+        const palpate::StoreLock lock("one.h5");
+      }
+    catch (const palpate::InputError &)
+      {
+        one_name_again = false;
+      }
+    deallog << "a store with two names (a hard link) is refused through "
+               "both: "
+            << ok(refused == 2) << ", saying so "
+            << ok(problem.find("2 names (hard links") != std::string::npos)
+            << "; with one name again it is taken: " << ok(one_name_again)
+            << std::endl;
   }
 
   // --- Two processes open one store at the same moment and append.
