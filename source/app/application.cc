@@ -212,6 +212,11 @@ namespace palpate
       if (serves(scene, solve))
         release.emplace();
       print_scene_report(out, scene, mesh, nodes);
+      // Out now, into a file or a pipe too: a stop signal before a run's
+      // own handler is installed still ends the process at once, and lost
+      // the report in the buffer. (Not line buffering: with it a closed
+      // pipe went unseen, since a line-buffered fwrite reports success.)
+      out << std::flush;
       if (!solve && mode == "set-up only")
         return ExitStatus::success;
       if (!solve && mode == "interaction")
@@ -312,7 +317,7 @@ namespace palpate
       const Mesh          mesh  = Mesh::create(scene);
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
       print_scene_report(out, scene, mesh, nodes);
-      out << "\n";
+      out << "\n" << std::flush; // as in the interaction's: kept on a stop
       return scene;
     }
 

@@ -14,6 +14,11 @@
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -69,6 +74,83 @@ namespace palpate
   namespace
   {
     using Clock = std::chrono::steady_clock;
+
+    /**
+     * Two interactions of one scene into one Output / Directory would write
+     * the same files: two runs started 0.3 s apart both said "wrote", and
+     * the second's force log, summary and index were the first's. The run
+     * that writes them holds an flock on DIRECTORY/STEM.lock (the kernel's
+     * lock goes with the process, however it ends); a second one is refused
+     * before it computes anything, naming the first.
+     */
+    class OutputLock
+    {
+    public:
+      OutputLock(const Scene &scene, const std::string &stem)
+        : file(scene.parameters.output.directory + "/" + stem + ".lock")
+      {
+        // A few rounds: the holder may remove its lock file just as this
+        // run locks it (then the lock is on a file nobody else sees).
+        for (unsigned int round = 0; round < 5; ++round)
+          {
+            fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+            if (fd < 0)
+              return; // no lock to be had: check_output_directory() speaks
+            if (flock(fd, LOCK_EX | LOCK_NB) != 0)
+              {
+                char       text[64] = {};
+                const auto n        = ::pread(fd, text, sizeof(text) - 1, 0);
+                ::close(fd);
+                fd = -1;
+                throw scene.error(
+                  "Output/Directory",
+                  "another palpate (process " +
+                    std::string(n > 0 ? text : "?") +
+                    ") is running this scene with its outputs in '" +
+                    scene.parameters.output.directory +
+                    "': both would write the same force log, summaries and "
+                    "shape frames (its lock file '" +
+                    file + "')",
+                  "wait until it ends, or give this run a directory of its "
+                  "own (--set 'Output/Directory=run2').");
+              }
+            struct stat locked, named;
+            if (fstat(fd, &locked) == 0 && stat(file.c_str(), &named) == 0 &&
+                locked.st_ino == named.st_ino && locked.st_dev == named.st_dev)
+              {
+                const std::string pid = std::to_string(getpid());
+                if (ftruncate(fd, 0) != 0 ||
+                    ::pwrite(fd, pid.data(), pid.size(), 0) < 0)
+                  {
+                    // The lock holds without the pid in it.
+                  }
+                return;
+              }
+            ::close(fd);
+            fd = -1;
+          }
+      }
+
+      OutputLock(const OutputLock &) = delete;
+      OutputLock &
+      operator=(const OutputLock &) = delete;
+
+      ~OutputLock()
+      {
+        if (fd >= 0)
+          {
+            // Removed while still locked: whoever opens the name next
+            // makes a new file, and the check above catches one that
+            // locked this one as it went.
+            ::unlink(file.c_str());
+            ::close(fd);
+          }
+      }
+
+    private:
+      const std::string file;
+      int               fd = -1;
+    };
 
     /**
      * One interaction, in the steps run_interaction() takes: set up the
@@ -150,6 +232,7 @@ namespace palpate
       const std::string stem;
 
       double                             duration = 0, reach = 0;
+      std::unique_ptr<OutputLock>        output_lock;
       std::unique_ptr<Interaction>       interaction;
       std::unique_ptr<Device>            device;
       std::unique_ptr<HapticLoop>        loop;
@@ -178,7 +261,10 @@ namespace palpate
                          !p.output.summary_formats.empty() ||
                          p.effects.shape_output;
       if (files)
-        check_output_directory(scene);
+        {
+          check_output_directory(scene);
+          output_lock = std::make_unique<OutputLock>(scene, stem);
+        }
 
       device   = Device::create(scene);
       duration = std::min(device->max_duration(), Limits::max_motion_duration);

@@ -158,6 +158,33 @@ main()
             << std::endl;
   }
 
+  // Two runs of one scene into one output directory would write the same
+  // files (both said "wrote", the second's were the first's): the second
+  // is refused before it computes anything, naming the first; the first
+  // goes on and removes its lock file when it ends.
+  {
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() != ".txt")
+        std::filesystem::remove(f.path());
+    std::filesystem::remove(out);
+    const pid_t       first      = start_palpate(interaction, out, err);
+    const bool        started    = wait_for_text(out, "; motion starts");
+    const std::string second_out = dir + "/second.txt";
+    const pid_t second = start_palpate(interaction, second_out, second_out);
+    const int   second_status = wait_status(second);
+    const std::string message = read_file(second_out);
+    kill(first, SIGTERM);
+    const int first_status = wait_status(first);
+    deallog << "a second run into the same directory: refused (exit 2) "
+            << ok(started && second_status == 2) << ", naming the first "
+            << ok(message.find("another palpate (process " +
+                               std::to_string(first)) != std::string::npos)
+            << "; the first goes on (stopped by SIGTERM: 143) "
+            << ok(first_status == 143) << ", its lock file removed "
+            << ok(!std::filesystem::exists(dir + "/paper-stvk.lock"))
+            << std::endl;
+  }
+
   // SIGKILL (or a crash, or mpirun ending a lost MPI client) cannot be
   // caught: nothing is written at the end. The PVD index is whole at every
   // moment and names every frame on disk but the one being written (it was
