@@ -574,6 +574,36 @@ namespace palpate
                          " m across (the diagonal of its bounding box); an "
                          "organ is 0.02 to 1 m across",
                        advice + ".");
+    // A refinement centred far from the organ refines nothing, silently
+    // (--refine 100,0,0 beside a 25 cm liver gave the uniform mesh):
+    // the centre must lie within its radius of the bounding box.
+    if (grading.fine_size > 0)
+      {
+        double outside = 0;
+        for (unsigned int d = 0; d < 3; ++d)
+          outside = std::hypot(outside,
+                               std::max({report.box[0][d] - grading.center[d],
+                                         grading.center[d] - report.box[1][d],
+                                         0.0}));
+        if (!(outside <= grading.radius))
+          throw InputError(
+            scale_entry.rfind("--", 0) == 0 ? "command line" : surface_file,
+            0,
+            scale_entry.rfind("--", 0) == 0 ?
+              "--refine " + Utilities::to_string(grading.center, 6) :
+              "Boundary conditions / Active node / Point = " +
+                Utilities::to_string(grading.center, 6) +
+                " (the centre of Mesh / Surface / Refinement)",
+            "the refinement's centre is " + Utilities::to_string(outside, 3) +
+              " m outside the surface's bounding box (" +
+              Utilities::to_string(report.box[0], 3) + " to " +
+              Utilities::to_string(report.box[1], 3) +
+              " m), farther than its radius (" +
+              Utilities::to_string(grading.radius, 3) +
+              " m): it would refine nothing",
+            "give the point where the probe touches, in metres (after "
+            "--scale), e.g. a vertex of the surface.");
+      }
     report.repairs = repair_surface(s, surface_file);
     report.volume  = s.volume();
     report.self_intersections =

@@ -426,6 +426,10 @@ main(int argc, char **argv)
           "point-far.prm",
           far);
   }
+  run("mesh --refine 100 m from the organ (refined nothing, silently)",
+      "mesh " + palpate_source_dir +
+        "/meshes/liver-tetgen/liver501-surface.obj far.msh --scale 0.039146 "
+        "--refine 100,0,0 --fine-size 0.002");
   run("study --csv naming a directory (found after the first knob)",
       "study good.prm --quick --csv .");
   scene("an entry name with a different case",
