@@ -221,4 +221,47 @@ write_file(const std::string &name, const std::string &text)
   std::ofstream(name) << text;
 }
 
+/** The rows of numbers of the CSV file @p name after its header line (a
+ * force log: t, x, y, z, fx, fy, fz). */
+inline std::vector<std::vector<double>>
+read_csv_rows(const std::string &name)
+{
+  std::vector<std::vector<double>> rows;
+  std::ifstream                    in(name);
+  std::string                      line;
+  std::getline(in, line); // the header
+  while (std::getline(in, line))
+    {
+      std::istringstream  fields(line);
+      std::string         field;
+      std::vector<double> values;
+      while (std::getline(fields, field, ','))
+        values.push_back(std::stod(field));
+      rows.push_back(values);
+    }
+  return rows;
+}
+
+/**
+ * The shipped beam set up for a short interaction with a force log (a
+ * 2 mm grid of +-1 cm, a 4 mm initial cloud), followed by @p more (the
+ * subsections a test adds: its device, trajectory, output directory).
+ */
+inline std::string
+beam_interaction(const std::string &more)
+{
+  return read_file(palpate_source_dir + "/parameters/beam.prm") + R"(
+subsection Effects
+  set Force log = true
+end
+subsection State space
+  set Grid spacing = 0.002
+  set Extent       = 0.01
+end
+subsection Scheduler
+  set Cloud radius = 0.004
+end
+)" + more;
+}
+
 #endif

@@ -117,27 +117,15 @@ main(int argc, char **argv)
   initlog();
 
   // The shipped beam with the figure eight as its device's motion.
-  const std::string beam =
-    read_file(palpate_source_dir + "/parameters/beam.prm");
   const auto scene_text = [&](const std::string &width) {
-    return beam + R"(
-subsection Effects
-  set Force log = true
-end
-subsection State space
-  set Grid spacing = 0.002
-  set Extent       = 0.01
-end
-subsection Scheduler
-  set Cloud radius = 0.004
-end
+    return beam_interaction(R"(
 subsection Haptics
   subsection Trajectory
     set Type     = figure eight
     set Duration = 1
     subsection figure eight
-      set Width  = )" +
-           width + R"(
+      set Width  = )" + width +
+                            R"(
       set Period = 0.8
     end
   end
@@ -145,7 +133,7 @@ end
 subsection Output
   set Directory = figure-eight-output
 end
-)";
+)");
   };
   write_file("figure-eight.prm", scene_text("0.006"));
   const palpate::Scene scene = palpate::Scene::read("figure-eight.prm");
@@ -170,18 +158,11 @@ end
   std::filesystem::remove_all("figure-eight-output");
   std::ostringstream report;
   palpate::run_interaction(report, scene);
-  std::ifstream log("figure-eight-output/figure-eight-forces.csv");
-  std::string   line;
-  std::getline(log, line); // the header
   unsigned int rows = 0;
   double       off  = 0;
-  while (std::getline(log, line))
+  for (const auto &values :
+       read_csv_rows("figure-eight-output/figure-eight-forces.csv"))
     {
-      std::istringstream  fields(line);
-      std::string         field;
-      std::vector<double> values;
-      while (std::getline(fields, field, ','))
-        values.push_back(std::stod(field));
       if (values.size() < 4 || values[0] < 0)
         continue;
       ++rows;
