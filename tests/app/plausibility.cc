@@ -3,7 +3,8 @@
 
 // Plausibility checks that name the likely mistake (issue 14), through the
 // palpate program as a user meets them:
-// - an active-node point 0.5 m from a 10 cm beam: a warning;
+// - an active-node point 2 cm from a 10 cm beam: a warning; 0.5 m from it:
+//   an input error (more than a quarter of the body's size: not on it);
 // - a push whose force is far beyond the device's limit (E = 1e7 Pa, 5 cm
 //   push): palpate solve warns and names the likely slips;
 // - a File name while Source = beam: an input error;
@@ -51,7 +52,7 @@ main()
   write_file("far.prm",
              replaced(replaced(replaced(beam,
                                         "set Point     = 0.1, 0, 0.01",
-                                        "set Point     = 0.6, 0, 0.01"),
+                                        "set Point     = 0.12, 0, 0.01"),
                                "set Prescribed displacement = 0, 0, -0.01",
                                "set Prescribed displacement = 0, 0, -0.05"),
                       "set Young's modulus = 1e5",
@@ -60,6 +61,13 @@ main()
   deallog << "far point, stiff push: exit status " << r.exit_status << std::endl
           << line_with(r.output, "the Point is") << std::endl
           << line_with(r.output, "times the device's force limit") << std::endl;
+  write_file("farther.prm",
+             replaced(beam,
+                      "set Point     = 0.1, 0, 0.01",
+                      "set Point     = 0.6, 0, 0.01"));
+  r = run_palpate("solve farther.prm");
+  deallog << "a point 0.5 m away: exit status " << r.exit_status << std::endl
+          << line_with(r.output, "problem:") << std::endl;
 
   write_file("named.prm",
              beam + "\nsubsection Mesh\n  set File name = liver.stl\nend\n");
