@@ -42,6 +42,41 @@ namespace palpate
         return own;
       }
 
+      /**
+       * The entry @p entry that chooses a plug-in of @p kind (its choices
+       * @p other_choices and the plug-ins' names, its documentation
+       * @p intro, each plug-in's description, then @p outro), and the
+       * subsection of each plug-in that has entries of its own.
+       */
+      void
+      declare_plugin_choice(ParameterHandler  &prm,
+                            const std::string &kind,
+                            const std::string &entry,
+                            const std::string &default_value,
+                            std::string        doc,
+                            const std::string &outro,
+                            const std::string &other_choices = "")
+      {
+        for (const auto &plugin : Plugins::declarations(kind))
+          doc += " " + plugin.name + ": " + plugin.description + ";";
+        if (outro.empty())
+          doc.back() = '.';
+        else
+          doc += outro;
+        prm.declare_entry(entry,
+                          default_value,
+                          Patterns::Selection(other_choices +
+                                              Plugins::selection(kind)),
+                          doc);
+        for (const auto &plugin : Plugins::declarations(kind))
+          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
+            {
+              prm.enter_subsection(plugin.name);
+              plugin.declare_parameters(prm);
+              prm.leave_subsection();
+            }
+      }
+
 
 
       /** Pattern of a 3-vector entry "x, y, z". */
@@ -915,28 +950,19 @@ namespace palpate
         // The solvers are plug-ins (hyperelastic/linear_solver.h): the
         // choice and each one's own subsection come from their
         // declarations; Ordering is shared.
-        std::string doc =
+        declare_plugin_choice(
+          prm,
+          "linear solver",
+          "Solver",
+          "by size",
           "Sparse direct solver for the linearised systems: by size: MUMPS "
           "below 5,000 equations and MUMPS single from 5,000 on (a state "
           "9-13 % faster at 5,358-6,965 equations, 30-43 % at 16,980, "
-          "doc/benchmarks/organ-speed.md);";
-        for (const auto &plugin : Plugins::declarations("linear solver"))
-          doc += " " + plugin.name + ": " + plugin.description + ";";
-        doc += " all analyse the sparsity pattern once per solver. With "
-               "MUMPS single, if GMRES fails, the state solver changes to "
-               "MUMPS for good.";
-        prm.declare_entry("Solver",
-                          "by size",
-                          Patterns::Selection(
-                            "by size|" + Plugins::selection("linear solver")),
-                          doc);
-        for (const auto &plugin : Plugins::declarations("linear solver"))
-          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
-            {
-              prm.enter_subsection(plugin.name);
-              plugin.declare_parameters(prm);
-              prm.leave_subsection();
-            }
+          "doc/benchmarks/organ-speed.md);",
+          " all analyse the sparsity pattern once per solver. With MUMPS "
+          "single, if GMRES fails, the state solver changes to MUMPS for "
+          "good.",
+          "by size|");
         prm.declare_entry(
           "Ordering",
           "by size",
@@ -1146,22 +1172,13 @@ namespace palpate
         // The trajectories are plug-ins (haptics/trajectory.h): the
         // choice and each one's own subsection come from their
         // declarations, the entries below are shared.
-        std::string doc = "Motion of the simulated device's HIP, relative "
-                          "to the active node's rest position:";
-        for (const auto &plugin : Plugins::declarations("trajectory"))
-          doc += " " + plugin.name + ": " + plugin.description + ";";
-        doc.back() = '.';
-        prm.declare_entry("Type",
-                          "straight line",
-                          Patterns::Selection(Plugins::selection("trajectory")),
-                          doc);
-        for (const auto &plugin : Plugins::declarations("trajectory"))
-          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
-            {
-              prm.enter_subsection(plugin.name);
-              plugin.declare_parameters(prm);
-              prm.leave_subsection();
-            }
+        declare_plugin_choice(prm,
+                              "trajectory",
+                              "Type",
+                              "straight line",
+                              "Motion of the simulated device's HIP, "
+                              "relative to the active node's rest position:",
+                              "");
         prm.declare_entry("Direction",
                           "0, 0, -1",
                           point_pattern(),
@@ -1260,22 +1277,13 @@ namespace palpate
                           "sends the force (Hz).");
         // The devices are plug-ins (haptics/device.h): the choice and
         // each one's own subsection come from their declarations.
-        std::string doc = "The haptic device, which the haptic loop reads "
-                          "and renders the force to:";
-        for (const auto &plugin : Plugins::declarations("device"))
-          doc += " " + plugin.name + ": " + plugin.description + ";";
-        doc.back() = '.';
-        prm.declare_entry("Device",
-                          "simulated",
-                          Patterns::Selection(Plugins::selection("device")),
-                          doc);
-        for (const auto &plugin : Plugins::declarations("device"))
-          if (!Plugins::declared_entries(plugin.declare_parameters).empty())
-            {
-              prm.enter_subsection(plugin.name);
-              plugin.declare_parameters(prm);
-              prm.leave_subsection();
-            }
+        declare_plugin_choice(prm,
+                              "device",
+                              "Device",
+                              "simulated",
+                              "The haptic device, which the haptic loop reads "
+                              "and renders the force to:",
+                              "");
         prm.declare_entry("Force limit",
                           "8",
                           Patterns::Double(0.),

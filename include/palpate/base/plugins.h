@@ -216,4 +216,29 @@ namespace palpate
          &classname::create});                                           \
   }
 
+/**
+ * Register the plug-in @p classname in @p Registry (a Registry<Interface,
+ * Context...>) under @p name, and its Declaration as one of @p kind, so that
+ * the scene declares and checks its entries without including its interface
+ * (devices, trajectories, linear solvers). The class also provides an
+ * optional `static void check_parameters(const dealii::ParameterHandler &)`.
+ */
+#define PALPATE_REGISTER_DECLARED_PLUGIN(                     \
+  Registry, kind, classname, name, description)               \
+  namespace                                                   \
+  {                                                           \
+    [[maybe_unused]] const bool                               \
+      palpate_declared_plugin_registered_##classname =        \
+        Registry::add({name,                                  \
+                       description,                           \
+                       &classname::declare_parameters,        \
+                       &classname::create}) &&                \
+        ::palpate::Plugins::add_declaration(                  \
+          kind,                                               \
+          {name,                                              \
+           description,                                       \
+           &classname::declare_parameters,                    \
+           ::palpate::Plugins::check_function<classname>()}); \
+  }
+
 #endif

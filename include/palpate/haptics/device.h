@@ -87,20 +87,8 @@ namespace palpate
 
 /** Register the device @p classname as @p name (the registry, and its
  * declaration for the scene's Haptics subsection). */
-#define PALPATE_REGISTER_DEVICE(classname, name, description)           \
-  namespace                                                             \
-  {                                                                     \
-    [[maybe_unused]] const bool palpate_device_registered_##classname = \
-      ::palpate::DeviceRegistry::add({name,                             \
-                                      description,                      \
-                                      &classname::declare_parameters,   \
-                                      &classname::create}) &&           \
-      ::palpate::Plugins::add_declaration(                              \
-        "device",                                                       \
-        {name,                                                          \
-         description,                                                   \
-         &classname::declare_parameters,                                \
-         ::palpate::Plugins::check_function<classname>()});             \
-  }
+#define PALPATE_REGISTER_DEVICE(classname, name, description) \
+  PALPATE_REGISTER_DECLARED_PLUGIN(                           \
+    ::palpate::DeviceRegistry, "device", classname, name, description)
 
 #endif

@@ -65,21 +65,9 @@ namespace palpate
 
 /** Register the trajectory @p classname as @p name (PALPATE_REGISTER_PLUGIN,
  * plus its declaration for the scene's Haptics / Trajectory subsection). */
-#define PALPATE_REGISTER_TRAJECTORY(classname, name, description)           \
-  namespace                                                                 \
-  {                                                                         \
-    [[maybe_unused]] const bool palpate_trajectory_registered_##classname = \
-      ::palpate::TrajectoryRegistry::add({name,                             \
-                                          description,                      \
-                                          &classname::declare_parameters,   \
-                                          &classname::create}) &&           \
-      ::palpate::Plugins::add_declaration(                                  \
-        "trajectory",                                                       \
-        {name,                                                              \
-         description,                                                       \
-         &classname::declare_parameters,                                    \
-         ::palpate::Plugins::check_function<classname>()});                 \
-  }
+#define PALPATE_REGISTER_TRAJECTORY(classname, name, description) \
+  PALPATE_REGISTER_DECLARED_PLUGIN(                               \
+    ::palpate::TrajectoryRegistry, "trajectory", classname, name, description)
 
   /** A straight line from the rest position at constant speed. */
   class StraightLine : public Trajectory

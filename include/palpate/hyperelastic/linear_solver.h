@@ -143,21 +143,12 @@ namespace palpate
 
 /** Register the linear solver @p classname as @p name (the registry, and
  * its declaration for the scene's Linear solver subsection). */
-#define PALPATE_REGISTER_LINEAR_SOLVER(classname, name, description)           \
-  namespace                                                                    \
-  {                                                                            \
-    [[maybe_unused]] const bool palpate_linear_solver_registered_##classname = \
-      ::palpate::LinearSolverRegistry::add({name,                              \
-                                            description,                       \
-                                            &classname::declare_parameters,    \
-                                            &classname::create}) &&            \
-      ::palpate::Plugins::add_declaration(                                     \
-        "linear solver",                                                       \
-        {name,                                                                 \
-         description,                                                          \
-         &classname::declare_parameters,                                       \
-         ::palpate::Plugins::check_function<classname>()});                    \
-  }
+#define PALPATE_REGISTER_LINEAR_SOLVER(classname, name, description) \
+  PALPATE_REGISTER_DECLARED_PLUGIN(::palpate::LinearSolverRegistry,  \
+                                   "linear solver",                  \
+                                   classname,                        \
+                                   name,                             \
+                                   description)
 } // namespace palpate
 
 #endif
