@@ -462,13 +462,7 @@ namespace palpate
          &no_own_entries,
          &replay}};
       for (const auto &plugin : built_in)
-        {
-          TrajectoryRegistry::add(plugin);
-          Plugins::add_declaration("trajectory",
-                                   {plugin.name,
-                                    plugin.description,
-                                    plugin.declare_parameters});
-        }
+        TrajectoryRegistry::add_declared("trajectory", plugin);
       return true;
     }();
   } // namespace

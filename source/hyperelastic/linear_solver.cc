@@ -801,13 +801,7 @@ namespace palpate
            return std::make_unique<AmesosSolver>("Amesos_Klu");
          }}};
       for (const auto &plugin : solvers)
-        {
-          LinearSolverRegistry::add(plugin);
-          Plugins::add_declaration("linear solver",
-                                   {plugin.name,
-                                    plugin.description,
-                                    plugin.declare_parameters});
-        }
+        LinearSolverRegistry::add_declared("linear solver", plugin);
       return true;
     }();
   } // namespace

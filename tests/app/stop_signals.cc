@@ -79,14 +79,19 @@ main()
     "--set",
     "Output/Directory=" + dir};
   const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+  // Before each run: no file of the last one (its outputs, its stdout's
+  // "motion starts"); the .txt of other runs' stderr stay.
+  const auto start_afresh = [&] {
+    for (const auto &f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() != ".txt")
+        std::filesystem::remove(f.path());
+    std::filesystem::remove(out);
+  };
 
   for (const auto &[signal, name] : std::vector<std::pair<int, std::string>>{
          {SIGINT, "SIGINT"}, {SIGTERM, "SIGTERM"}, {SIGHUP, "SIGHUP"}})
     {
-      for (const auto &f : std::filesystem::directory_iterator(dir))
-        if (f.path().extension() != ".txt")
-          std::filesystem::remove(f.path());
-      std::filesystem::remove(out); // not the last run's "motion starts"
+      start_afresh();
       const pid_t pid     = start_palpate(interaction, out, err);
       const bool  started = wait_for_text(out, "; motion starts");
       std::this_thread::sleep_for(std::chrono::milliseconds(1500));
@@ -138,10 +143,7 @@ main()
   // process manager may, to the process and to its group): the same stop,
   // not "a second Ctrl-C, end at once" - everything is written.
   {
-    for (const auto &f : std::filesystem::directory_iterator(dir))
-      if (f.path().extension() != ".txt")
-        std::filesystem::remove(f.path());
-    std::filesystem::remove(out);
+    start_afresh();
     const pid_t pid     = start_palpate(interaction, out, err);
     const bool  started = wait_for_text(out, "; motion starts");
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));
@@ -163,10 +165,7 @@ main()
   // is refused before it computes anything, naming the first; the first
   // goes on and removes its lock file when it ends.
   {
-    for (const auto &f : std::filesystem::directory_iterator(dir))
-      if (f.path().extension() != ".txt")
-        std::filesystem::remove(f.path());
-    std::filesystem::remove(out);
+    start_afresh();
     const pid_t       first      = start_palpate(interaction, out, err);
     const bool        started    = wait_for_text(out, "; motion starts");
     const std::string second_out = dir + "/second.txt";
@@ -190,10 +189,7 @@ main()
   // moment and names every frame on disk but the one being written (it was
   // rewritten every 5 s: the last seconds' frames were on disk unnamed).
   {
-    for (const auto &f : std::filesystem::directory_iterator(dir))
-      if (f.path().extension() != ".txt")
-        std::filesystem::remove(f.path());
-    std::filesystem::remove(out);
+    start_afresh();
     const pid_t pid     = start_palpate(interaction, out, err);
     const bool  started = wait_for_text(out, "; motion starts");
     std::this_thread::sleep_for(std::chrono::milliseconds(2500));
@@ -223,10 +219,7 @@ main()
   }
 
   {
-    for (const auto &f : std::filesystem::directory_iterator(dir))
-      if (f.path().extension() != ".txt")
-        std::filesystem::remove(f.path());
-    std::filesystem::remove(out);
+    start_afresh();
     auto with_vtu = interaction;
     with_vtu.push_back("--set");
     with_vtu.push_back("Effects/VTU export=true");
@@ -277,10 +270,7 @@ main()
   // everything is still written whole, and the exit status says the run was
   // stopped (it was 0, the signal unmentioned).
   {
-    for (const auto &f : std::filesystem::directory_iterator(dir))
-      if (f.path().extension() != ".txt")
-        std::filesystem::remove(f.path());
-    std::filesystem::remove(out);
+    start_afresh();
     auto with_vtu = interaction;
     for (auto &argument : with_vtu)
       if (argument == "Haptics/Trajectory/Duration=30")

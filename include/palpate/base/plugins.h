@@ -169,6 +169,12 @@ namespace palpate
       static bool
       add(const Plugin &plugin);
 
+      /** add(), and the plug-in's Declaration as one of @p kind (for the
+       * built-in plug-ins of a kind the scene declares through
+       * Plugins::declarations(); they have no check_parameters()). */
+      static bool
+      add_declared(const std::string &kind, const Plugin &plugin);
+
       /** Every registered plug-in, sorted by name. */
       static const std::vector<Plugin> &
       plugins();

@@ -52,6 +52,19 @@ namespace palpate
 
 
     template <typename Interface, typename... Context>
+    bool
+    Registry<Interface, Context...>::add_declared(const std::string &kind,
+                                                  const Plugin      &plugin)
+    {
+      return add(plugin) && add_declaration(kind,
+                                            {plugin.name,
+                                             plugin.description,
+                                             plugin.declare_parameters});
+    }
+
+
+
+    template <typename Interface, typename... Context>
     const std::vector<typename Registry<Interface, Context...>::Plugin> &
     Registry<Interface, Context...>::plugins()
     {
