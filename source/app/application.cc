@@ -240,9 +240,8 @@ namespace palpate
           std::cerr << "\npalpate: " << summary.lost_servers.size()
                     << " MPI solver server(s) lost during the run (LOST in the "
                        "summary above); the interaction went on with the "
-                       "servers left, if any (with none, no state was "
-                       "computed after the last was lost, and the force "
-                       "faded or was held there). Exit status "
+                       "servers left, and ended when none was left. Exit "
+                       "status "
                     << ExitStatus::server_lost << ".\n";
           return ExitStatus::server_lost;
         }

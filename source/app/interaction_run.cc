@@ -371,13 +371,20 @@ namespace palpate
           // A stop signal, or nobody left to read the output (a closed pipe,
           // a full disk: SIGPIPE is ignored, so the write fails instead):
           // end the motion here and write what the run has.
-          if (stop.requested() || !out)
+          // Every solver server lost: no state will come any more, so
+          // neither waiting for the initial cloud nor moving on can give
+          // a force; end here, through the same path.
+          if (stop.requested() || !out || interaction->engine_lost())
             {
               const double motion = loop->motion_time();
               stopped_by =
                 (stop.requested() ? "by " + stop.description() :
-                                    std::string("because standard output "
-                                                "could not be written")) +
+                 !out             ? std::string("because standard output "
+                                                "could not be written") :
+                                    std::string(
+                          "because every solver server was lost "
+                                      "(the LOST lines): none was left to compute "
+                                      "a state")) +
                 (motion >= 0 ?
                    " after " + Utilities::to_string(motion, 3) + " s of the " +
                      Utilities::to_string(duration, 3) + " s motion" :

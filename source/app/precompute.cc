@@ -62,8 +62,9 @@ namespace palpate
     const auto        stopping = [&] {
       return stop.requested() || !lock.failure().empty();
     };
-    StoreFingerprint fingerprint;
-    unsigned int     before_run = 0; // records the store held before
+    StoreFingerprint         fingerprint;
+    unsigned int             before_run = 0; // records the store held before
+    std::vector<std::string> lost_servers;   // MPI solver servers lost
     {
       Interaction interaction(scene);
       fingerprint              = StoreFingerprint::of(interaction.scene(),
@@ -83,7 +84,9 @@ namespace palpate
 
       interaction.attach();
       unsigned int shown = ~0u;
-      while (!interaction.initial_cloud_complete() && !stopping())
+      // Every solver server lost: nothing more will come (issue 26).
+      while (!interaction.initial_cloud_complete() && !stopping() &&
+             !interaction.engine_lost())
         {
           std::this_thread::sleep_for(std::chrono::milliseconds(250));
           const auto   c    = interaction.cache().counts();
@@ -129,21 +132,29 @@ namespace palpate
           std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
       interaction.detach(); // appends what was finished last
+      lost_servers = interaction.summary().lost_servers;
+      for (const std::string &lost : lost_servers)
+        out << "\n  LOST:          " << lost;
       const auto   c = interaction.cache().counts();
       const double t =
         std::chrono::duration<double>(Clock::now() - start).count();
       out << "\n  "
-          << (stop.requested()       ? "stopped by " + stop.description() :
-              lock.failure().empty() ? std::string("done") :
-                                       std::string("stopped: the store "
-                                                   "could not be written,"))
+          << (stop.requested()          ? "stopped by " + stop.description() :
+              !lock.failure().empty()   ? std::string("stopped: the store "
+                                                      "could not be written,") :
+              interaction.engine_lost() ? std::string(
+                                            "stopped: every solver server was "
+                                            "lost, none is left to compute a "
+                                            "state,") :
+                                          std::string("done"))
           << " after " << Utilities::to_string(t, 3) << " s: " << c.first
           << " states and " << c.second << " failure points in the cache; "
           << interaction.store_report() << "\n";
       // Points of the region no state reached: every path to them from
       // rest passes a failure point (the engine computes a state only from
       // a converged neighbour), so they are not computed, and said so.
-      if (!stop.requested() && lock.failure().empty())
+      if (!stop.requested() && lock.failure().empty() &&
+          !interaction.engine_lost())
         {
           const auto  &grid        = interaction.grid();
           unsigned int unreachable = 0;
@@ -209,13 +220,19 @@ namespace palpate
                                        export_failure + ")"));
     if (!export_failure.empty())
       throw OutputError(export_failure);
-    if (stop.requested())
+    if (!lost_servers.empty())
+      out << "  " << lost_servers.size()
+          << " MPI solver server(s) lost (LOST above): exit status "
+          << ExitStatus::server_lost << ".\n";
+    if (stop.requested() || !lost_servers.empty())
       out << "  run the same command again to go on: the states stored are "
              "not computed again.\n";
     else
       out << "  use it:        palpate " << scene.file()
           << " (with the same State space / Store) starts without waiting "
              "for these states.\n";
-    return stop.requested() ? stop.exit_status() : ExitStatus::success;
+    return stop.requested()     ? stop.exit_status() :
+           lost_servers.empty() ? ExitStatus::success :
+                                  ExitStatus::server_lost;
   }
 } // namespace palpate

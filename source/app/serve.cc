@@ -2022,20 +2022,25 @@ namespace palpate
       }
     out << std::flush;
     // The view runs until a stop signal (Ctrl-C, SIGTERM, SIGHUP: its
-    // normal end, status 0) or until nobody can read what it prints.
+    // normal end, status 0), until nobody can read what it prints, or
+    // until every MPI solver server is lost (nothing could compute a state
+    // any more; status 5, as for an interaction).
     std::string stopped_by;
     int         stop_signal = 0;
     {
       const StopRequest stop;
-      while (!stop.requested() && out)
+      while (!stop.requested() && out && !server.interaction().engine_lost())
         {
           std::this_thread::sleep_for(std::chrono::milliseconds(100));
           if (log.is_open() && log)
             log_rows += server.write_force_log(log);
         }
-      stopped_by  = stop.requested() ?
-                      "by " + stop.description() + " (the live view's end)" :
-                      "because standard output could not be written";
+      stopped_by =
+        stop.requested() ?
+          "by " + stop.description() + " (the live view's end)" :
+        !out ? std::string("because standard output could not be written") :
+               std::string("because every solver server was lost (the LOST "
+                           "lines): none was left to compute a state");
       stop_signal = stop.signal_number();
     }
     server.stop();
@@ -2101,6 +2106,7 @@ namespace palpate
                           std::to_string(failures.size()) +
                           " output(s) could not be written:" + what);
       }
-    return ExitStatus::success;
+    return summary.lost_servers.empty() ? ExitStatus::success :
+                                          ExitStatus::server_lost;
   }
 } // namespace palpate

@@ -244,6 +244,8 @@ namespace palpate
     /** A server silent past its heartbeats, or one lost within the last
      * 3 s (degraded()); and when the last one was lost. */
     std::atomic<bool> trouble{false};
+    /** Every server lost (lost_every_worker()). */
+    std::atomic<bool> all_lost{false};
     Clock::time_point last_loss{};
     unsigned int      busy            = 0;
     bool              nothing_to_plan = false, replan = false;
@@ -352,7 +354,11 @@ namespace palpate
       what << "; " << orphans
            << " states only it held are recomputed when needed";
     stats.lost_servers.push_back(what.str());
-    replan = true;
+    replan        = true;
+    bool any_left = false;
+    for (unsigned int r = 1; r < servers.size(); ++r)
+      any_left = any_left || !servers[r].lost;
+    all_lost.store(!any_left, std::memory_order_relaxed);
     // It is told to go at once: a server that was only stopped (SIGSTOP,
     // a machine that froze) and comes back reads this first and exits,
     // instead of waiting for a client that no longer talks to it, which
@@ -821,7 +827,9 @@ namespace palpate
                 lose(r,
                      "its task ran longer than Engine / Task timeout (" +
                        Utilities::to_string(parameters.engine.task_timeout, 3) +
-                       " s)");
+                       " s): it hung, or a state on this mesh takes longer "
+                       "than that (then raise Task timeout above the longest "
+                       "state time)");
             }
 
           trouble.store(
@@ -1006,6 +1014,14 @@ namespace palpate
   MpiEngine::degraded() const noexcept
   {
     return impl->trouble.load(std::memory_order_relaxed);
+  }
+
+
+
+  bool
+  MpiEngine::lost_every_worker() const noexcept
+  {
+    return impl->all_lost.load(std::memory_order_relaxed);
   }
 
 

@@ -21,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdlib>
 #include <deque>
 #include <mutex>
 #include <set>
@@ -658,8 +659,14 @@ namespace palpate
             scene.file(),
             scene.line_of("Engine/Type"),
             "Engine / Type = mpi",
-            "the MPI engine needs solver servers, and this palpate runs "
-            "alone",
+            // Under mpirun -np 1 it is not "alone" by choice: say what
+            // mpirun did (Open MPI sets OMPI_COMM_WORLD_SIZE).
+            std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr ?
+              std::string("mpirun started only 1 process (-np 1), the haptic "
+                          "client; the MPI engine needs at least one more, "
+                          "a solver server") :
+              std::string("the MPI engine needs solver servers, and this "
+                          "palpate was not started by mpirun"),
             "start it with mpirun: `mpirun -np 3 palpate " +
               (scene.file().empty() ? std::string("SCENE.prm") : scene.file()) +
               "` runs the haptic client and 2 solver servers (add "

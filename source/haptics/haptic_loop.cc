@@ -310,7 +310,7 @@ namespace palpate
     r.interpolation_p999_us = 1e6 * percentile(interpolation, 0.999);
     r.memory_locked         = s.locked;
     r.loop_truncated        = s.truncated;
-    r.motion_start    = s.motion_start_ns.load() < 0 ? 0 : s.motion_started_at;
+    r.motion_start    = s.motion_start_ns.load() < 0 ? -1 : s.motion_started_at;
     r.motion_duration = s.motion_elapsed;
   }
 

@@ -467,6 +467,14 @@ namespace palpate
 
 
   bool
+  Interaction::engine_lost() const noexcept
+  {
+    return impl->engine->lost_every_worker();
+  }
+
+
+
+  bool
   Interaction::initial_cloud_complete() const
   {
     Impl &s = *impl;

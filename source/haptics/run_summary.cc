@@ -225,27 +225,35 @@ namespace palpate
         << " solves threw (counted as failure points); the last: "
         << last_solver_error << "\n";
     if (loop_ran)
-      s << "  haptic loop:       " << ticks << " ticks at " << loop_rate
-        << " Hz, "
-        << (realtime_priority ?
-              "real-time priority (SCHED_FIFO)" :
-              "normal priority (no real-time scheduling permitted)")
-        << (memory_locked ? ", memory locked" :
-                            ", memory not locked (page faults possible)")
-        << "\n"
-        << "  loop period:       p50 " << period_p50_ms << " ms, p99 "
-        << period_p99_ms << " ms, p99.9 " << period_p999_ms << " ms, max "
-        << period_max_ms << " ms\n"
-        << "  deadline misses:   " << deadline_misses
-        << " (ticks more than 0.5 ms late)\n"
-        << "  interpolation:     p50 " << interpolation_p50_us << " us, p99.9 "
-        << interpolation_p999_us << " us\n"
-        << "  motion:            started " << motion_start
-        << " s after attach, lasted " << motion_duration << " s"
-        << (loop_truncated ?
-              "  <-- cut short: the loop reached its time bound" :
-              "")
-        << "\n";
+      {
+        s << "  haptic loop:       " << ticks << " ticks at " << loop_rate
+          << " Hz, "
+          << (realtime_priority ?
+                "real-time priority (SCHED_FIFO)" :
+                "normal priority (no real-time scheduling permitted)")
+          << (memory_locked ? ", memory locked" :
+                              ", memory not locked (page faults possible)")
+          << "\n"
+          << "  loop period:       p50 " << period_p50_ms << " ms, p99 "
+          << period_p99_ms << " ms, p99.9 " << period_p999_ms << " ms, max "
+          << period_max_ms << " ms\n"
+          << "  deadline misses:   " << deadline_misses
+          << " (ticks more than 0.5 ms late)\n"
+          << "  interpolation:     p50 " << interpolation_p50_us
+          << " us, p99.9 " << interpolation_p999_us << " us\n"
+          << "  motion:            ";
+        // A run stopped during the initial cloud never moved: not "started 0 s
+        // after attach".
+        if (motion_start < 0)
+          s << "never started\n";
+        else
+          s << "started " << motion_start << " s after attach, lasted "
+            << motion_duration << " s"
+            << (loop_truncated ?
+                  "  <-- cut short: the loop reached its time bound" :
+                  "")
+            << "\n";
+      }
     if (shape_frames > 0)
       s << "  shape output:      " << shape_frames << " frames\n";
     if (!stopped_by.empty())

@@ -152,6 +152,21 @@ namespace palpate
       return false;
     }
 
+    /**
+     * Whether every worker is gone: all solver servers were lost, so no
+     * state the HIP needs will ever come. The interaction then ends
+     * through its normal path (summary, outputs, exit status 5) instead of
+     * moving on an empty or frozen cloud (issue 26: a 0.1 s Task timeout
+     * lost both servers during the initial cloud and the motion started
+     * anyway). Real-time safe. The threaded engine's workers cannot
+     * vanish: false.
+     */
+    virtual bool
+    lost_every_worker() const noexcept
+    {
+      return false;
+    }
+
     /** A description, e.g. "2 solver threads". */
     virtual std::string
     description() const = 0;

@@ -79,6 +79,9 @@ namespace palpate
     bool
     degraded() const noexcept override;
 
+    bool
+    lost_every_worker() const noexcept override;
+
     std::string
     description() const override;
 

@@ -170,6 +170,11 @@ namespace palpate
     EngineLoad
     engine_load() const;
 
+    /** Whether the engine has no worker left (every solver server lost):
+     * no state will come any more. Real-time safe. */
+    bool
+    engine_lost() const noexcept;
+
     /** What happened so far (engine and haptic side; no loop timing). */
     RunSummary
     summary() const;

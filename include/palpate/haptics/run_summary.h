@@ -63,8 +63,11 @@ namespace palpate
     /** Whether the loop's memory could be locked (no page faults). */
     bool memory_locked = false;
     /** Whether the loop hit its time bound before the motion ended. */
-    bool          loop_truncated = false;
-    double        loop_rate = 0, motion_start = 0, motion_duration = 0;
+    bool   loop_truncated = false;
+    double loop_rate      = 0;
+    /** Seconds from attach to the motion's start (-1: it never started,
+     * stopped during the initial cloud), and how long it lasted. */
+    double        motion_start = 0, motion_duration = 0;
     std::uint64_t ticks = 0, deadline_misses = 0;
     double        period_p50_ms = 0, period_p99_ms = 0, period_p999_ms = 0,
            period_max_ms        = 0;
