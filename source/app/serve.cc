@@ -7,8 +7,11 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/base/stop_request.h>
 #include <palpate/engine/engine.h>
+#include <palpate/haptics/haptic_loop.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/haptics/run_summary.h>
 #include <palpate/haptics/shape_interpolator.h>
+#include <palpate/haptics/target_follower.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/material.h>
 #include <palpate/mesh/mesh.h>
@@ -819,22 +822,13 @@ namespace palpate
       : interaction(scene)
       , max_speed(max_speed)
       , rate(scene.parameters.haptics.loop_rate)
+      , device(rate, max_speed)
       , token(make_token())
       , log(log)
       , scene_material(material_description())
       , scene_active(active_description())
     {
-      for (auto &a : {&target, &hip, &force})
-        for (auto &x : *a)
-          x.store(0);
       force_log = scene.parameters.effects.force_log;
-      if (force_log)
-        {
-          std::size_t n = 1;
-          while (n < 4 * rate)
-            n *= 2;
-          log_ring.resize(n);
-        }
       // The surface: its vertices (rest positions), triangles, and the
       // DoFs of each vertex's displacement.
       const Mesh              &mesh = interaction.mesh();
@@ -946,100 +940,11 @@ namespace palpate
       active_json = a.str();
     }
 
-    /** The device: at the loop rate, move the HIP toward the target as a
-     * hand moves a device, at most at max_speed and speeding up and
-     * slowing down at most at max_acceleration (the mouse's jumps
-     * smoothed: the velocity the scheduler looks ahead with has no jumps),
-     * stopping on the target; and ask the interaction for the force. */
-    void
-    run_device()
-    {
-      const auto period = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(1.0 / rate));
-      const double dt = 1.0 / rate, dv_max = max_acceleration * dt;
-      auto         next = Clock::now();
-      while (running.load())
-        {
-          // After a stall (a parameter change holds the device), on from
-          // now: no burst of steps that would outrun the speed limit.
-          next = std::max(next + period, Clock::now());
-          std::this_thread::sleep_until(next);
-          // Held while the parameters change (the interaction is detached
-          // and its scene replaced then, and another active node starts
-          // at rest).
-          std::lock_guard<std::mutex> lock(device_mutex);
-          auto                       &x = device_position, &v = device_velocity;
-          Utilities::Point3           d;
-          for (unsigned int k = 0; k < 3; ++k)
-            d[k] = target[k].load() - x[k];
-          const double n = Utilities::norm(d);
-          // Toward the target at the speed from which it can still stop
-          // there (at most max_speed); the velocity changes by at most
-          // dv_max per tick.
-          const double reach =
-            std::min(max_speed, std::sqrt(2 * max_acceleration * n));
-          Utilities::Point3 dv;
-          for (unsigned int k = 0; k < 3; ++k)
-            dv[k] = (n > 0 ? reach * d[k] / n : 0.0) - v[k];
-          const double change = Utilities::norm(dv);
-          for (unsigned int k = 0; k < 3; ++k)
-            v[k] += change > dv_max ? dv[k] * dv_max / change : dv[k];
-          // Within this tick's step, slow (as the approach leaves it: at
-          // most 2 mm/s at 1 kHz) and heading for it: on the target, at
-          // rest. Moving away or fast, as when the target came back toward
-          // the probe, it brakes at max_acceleration instead.
-          const double speed   = Utilities::norm(v);
-          double       heading = 0;
-          for (unsigned int k = 0; k < 3; ++k)
-            heading += v[k] * d[k];
-          if (speed * dt >= n && speed <= 2 * dv_max * (1 + 1e-9) &&
-              (n == 0 || heading > 0))
-            {
-              for (unsigned int k = 0; k < 3; ++k)
-                {
-                  x[k] += d[k];
-                  v[k] = 0;
-                }
-            }
-          else
-            for (unsigned int k = 0; k < 3; ++k)
-              x[k] += v[k] * dt;
-          const Utilities::Point3 f = interaction.force(x);
-          for (unsigned int k = 0; k < 3; ++k)
-            {
-              hip[k].store(x[k]);
-              force[k].store(f[k]);
-            }
-          if (force_log)
-            {
-              const std::size_t h = log_head.load(std::memory_order_relaxed);
-              if (h - log_tail.load(std::memory_order_acquire) <
-                  log_ring.size())
-                {
-                  log_ring[h & (log_ring.size() - 1)] = {
-                    std::chrono::duration<double>(Clock::now() - log_start)
-                      .count(),
-                    x,
-                    f};
-                  log_head.store(h + 1, std::memory_order_release);
-                }
-              else
-                log_dropped.fetch_add(1, std::memory_order_relaxed);
-            }
-          cause.store(static_cast<std::uint8_t>(interaction.missing_cause()));
-        }
-    }
-
     std::string
     frame()
     {
-      Utilities::Point3 x, f, t;
-      for (unsigned int k = 0; k < 3; ++k)
-        {
-          x[k] = hip[k].load();
-          f[k] = force[k].load();
-          t[k] = target[k].load();
-        }
+      const Utilities::Point3 x = device.hip(), f = device.force(),
+                              t = device.target();
       // The lock first: the parameters (and the nodes) may be changing.
       std::lock_guard<std::mutex> lock(mutex);
       State                       blend;
@@ -1102,7 +1007,7 @@ namespace palpate
       s << "{\"hip\":" << json_point(x) << ",\"target\":" << json_point(t)
         << ",\"force\":" << json_point(f)
         << ",\"shape\":" << (complete ? "true" : "false") << ",\"missing\":\""
-        << cause_name(static_cast<MissingCause>(cause.load()))
+        << cause_name(interaction.missing_cause())
         << "\",\"available\":" << counts.first
         << ",\"failed\":" << counts.second << ",\"cloud_complete\":"
         << (interaction.initial_cloud_complete() ? "true" : "false")
@@ -1118,31 +1023,18 @@ namespace palpate
 
     Interaction  interaction;
     const double max_speed, rate;
-    /** How fast the device speeds up and slows down (m/s^2): from rest to
-     * 5 cm/s in 50 ms, a stop from it within 1.25 mm. */
-    static constexpr double                  max_acceleration = 1.0;
+    /** The browser's mouse: the HIP follows the target the page sends, in
+     * the common haptic loop (started by LiveServer's constructor). */
+    TargetFollower                           device;
+    std::unique_ptr<HapticLoop>              loop;
     std::vector<unsigned int>                surface;
     std::vector<std::array<unsigned int, 3>> triangles, dofs;
     // /mesh without the active node, and the active node (mutex).
     std::string         mesh_json, active_json;
     std::vector<double> displacement;
-    std::atomic<double> target[3], hip[3], force[3];
-    // The device's HIP and velocity (device_mutex).
-    Utilities::Point3 device_position{{0, 0, 0}}, device_velocity{{0, 0, 0}};
-    std::atomic<std::uint8_t> cause{0};
-
-    /** Effects / Force log: a ring the device thread fills (never waiting
-     * or allocating) and write_force_log() empties. */
-    struct LogRow
-    {
-      double            t;
-      Utilities::Point3 x, f;
-    };
-    bool                       force_log = false;
-    std::vector<LogRow>        log_ring; // a power of two long
-    std::atomic<std::size_t>   log_head{0}, log_tail{0};
-    std::atomic<std::uint64_t> log_dropped{0};
-    Clock::time_point          log_start = Clock::now();
+    /** Effects / Force log: the loop's ring, emptied by
+     * write_force_log(). */
+    bool force_log = false;
     // The engine's counters at the last load sample (frame()).
     struct
     {
@@ -1152,8 +1044,8 @@ namespace palpate
     } load_sample{Clock::now(), 0, 0.0};
     double            states_per_second = 0, utilisation = 0;
     std::atomic<bool> running{true};
-    // Locked in this order: control_mutex, device_mutex, mutex.
-    std::mutex control_mutex, mutex, device_mutex;
+    // Locked in this order: control_mutex, (the loop held), mutex.
+    std::mutex control_mutex, mutex;
     // Mesh vertex -> its index among the surface's vertices.
     std::map<unsigned int, unsigned int> surface_index;
 
@@ -1369,18 +1261,16 @@ namespace palpate
       std::string refused;
       try
         {
-          std::lock_guard<std::mutex> lock(device_mutex), frame_lock(mutex);
+          // The device held (the loop asks the interaction for nothing)
+          // while its scene is replaced.
+          const HeldDevice            held(*loop);
+          std::lock_guard<std::mutex> frame_lock(mutex);
           interaction.change_parameters(p);
           describe_active();
           // Another active node: the device at rest on it (a target sent
           // meanwhile was for the old one).
           if (rest)
-            {
-              for (auto &t : target)
-                t.store(0);
-              device_position = {{0, 0, 0}};
-              device_velocity = {{0, 0, 0}};
-            }
+            device.reset();
         }
       catch (const InputError &e)
         {
@@ -1400,7 +1290,7 @@ namespace palpate
      * or of the last answer (keep-alive waits 1 s for its first byte). */
     static constexpr double request_limit = 3;
     GuardedServer           server{request_limit};
-    std::thread             http, device;
+    std::thread             http;
   };
 
 
@@ -1486,8 +1376,7 @@ namespace palpate
             for (const double c : x)
               if (!std::isfinite(c) || std::abs(c) > limit)
                 throw std::invalid_argument("out of range");
-            for (unsigned int k = 0; k < 3; ++k)
-              s.target[k].store(x[k]);
+            s.device.set_target(x);
             res.set_content("ok", "text/plain");
           }
         catch (const std::exception &)
@@ -1696,8 +1585,7 @@ namespace palpate
                 });
     server.Post("/reset",
                 [&s](const httplib::Request &, httplib::Response &res) {
-                  for (auto &t : s.target)
-                    t.store(0);
+                  s.device.set_target({{0, 0, 0}});
                   s.record("the probe sent back to rest");
                   res.set_content("ok", "text/plain");
                 });
@@ -1772,8 +1660,14 @@ namespace palpate
       }
     s.address = "http://" + here + ":" + std::to_string(s.bound) + "/";
     s.interaction.attach();
-    s.device = std::thread([&s] { s.run_device(); });
-    s.http   = std::thread([&s] { s.server.listen_after_bind(); });
+    // The browser's mouse runs in the common haptic loop, as every device
+    // does (real-time priority, statistics, force log), until the view
+    // stops.
+    s.loop = std::make_unique<HapticLoop>(
+      s.interaction, s.device, s.rate, HapticLoop::continuous, s.force_log);
+    s.loop->start(HapticLoop::continuous);
+    s.loop->start_motion();
+    s.http = std::thread([&s] { s.server.listen_after_bind(); });
   }
 
 
@@ -1794,8 +1688,8 @@ namespace palpate
     s.server.stop();
     if (s.http.joinable())
       s.http.join();
-    if (s.device.joinable())
-      s.device.join();
+    if (s.loop)
+      s.loop->join();
     s.interaction.detach();
   }
 
@@ -1922,26 +1816,7 @@ namespace palpate
   std::size_t
   LiveServer::write_force_log(std::ostream &csv)
   {
-    Impl             &s    = *impl;
-    const std::size_t head = s.log_head.load(std::memory_order_acquire);
-    std::size_t       tail = s.log_tail.load(std::memory_order_relaxed);
-    const std::size_t n    = head - tail;
-    // The rows in one write, then flushed: a process killed meanwhile
-    // leaves whole rows (a row cut in two by the stream's buffer was what
-    // a SIGKILL left before).
-    std::ostringstream rows;
-    rows << std::setprecision(9);
-    for (; tail != head; ++tail)
-      {
-        const auto &r = s.log_ring[tail & (s.log_ring.size() - 1)];
-        rows << r.t << "," << r.x[0] << "," << r.x[1] << "," << r.x[2] << ","
-             << r.f[0] << "," << r.f[1] << "," << r.f[2] << "\n";
-      }
-    s.log_tail.store(tail, std::memory_order_release);
-    const std::string text = rows.str();
-    csv.write(text.data(), static_cast<std::streamsize>(text.size()));
-    csv.flush();
-    return n;
+    return impl->loop->drain_force_log(csv);
   }
 
 
@@ -1949,7 +1824,7 @@ namespace palpate
   std::uint64_t
   LiveServer::force_log_dropped() const
   {
-    return impl->log_dropped.load();
+    return impl->loop->force_log_dropped();
   }
 
 
@@ -1957,11 +1832,17 @@ namespace palpate
   void
   LiveServer::last(Utilities::Point3 &hip, Utilities::Point3 &force) const
   {
-    for (unsigned int k = 0; k < 3; ++k)
-      {
-        hip[k]   = impl->hip[k].load();
-        force[k] = impl->force[k].load();
-      }
+    hip   = impl->device.hip();
+    force = impl->device.force();
+  }
+
+
+
+  void
+  LiveServer::add_to(RunSummary &summary) const
+  {
+    impl->loop->add_to(summary);
+    summary.trajectory = impl->device.description();
   }
 
 
@@ -2006,7 +1887,7 @@ namespace palpate
           << (scene.file().empty() ? "SCENE.prm" : scene.file())
           << ", records its frames for ParaView).\n";
     // The force log is written as the view runs, a few times a second
-    // (the device thread only fills a ring): a run that ends however it
+    // (the haptic loop only fills a ring): a run that ends however it
     // ends keeps it.
     const std::string log_file =
       p.output.directory + "/" + stem + "-serve-forces.csv";
@@ -2050,8 +1931,8 @@ namespace palpate
         log.close();
       }
     out << "Live view ended.\n";
-    RunSummary summary  = server.interaction().summary();
-    summary.trajectory  = "the browser's mouse (palpate serve)";
+    RunSummary summary = server.interaction().summary();
+    server.add_to(summary);
     summary.stopped_by  = stopped_by;
     summary.stop_signal = stop_signal;
     summary.print(out);

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -28,27 +29,39 @@ namespace palpate
 {
   struct HapticLoop::Impl
   {
-    Interaction           &interaction;
-    Device                &device;
-    const double           rate;
-    const std::size_t      capacity;
-    std::vector<double>    period, lateness, interpolation; // seconds
-    std::size_t            n        = 0;
-    std::uint64_t          misses   = 0;
-    bool                   realtime = false, locked = false, truncated = false;
-    double                 motion_duration = 0, motion_elapsed = 0;
-    std::atomic<bool>      motion_requested{false};
+    Interaction        &interaction;
+    Device             &device;
+    const double        rate;
+    const bool          continuous;
+    const std::size_t   capacity; // statistics samples (a window if continuous)
+    std::vector<double> period, lateness, interpolation; // seconds
+    std::uint64_t       n        = 0; // ticks sampled (held ticks are not)
+    std::uint64_t       misses   = 0;
+    bool                realtime = false, locked = false, truncated = false;
+    double              motion_duration = 0, motion_elapsed = 0;
+    std::atomic<bool>   motion_requested{false};
     std::atomic<long long> motion_start_ns{
       -1};                            // since the loop started; -1: not yet
     std::atomic<long long> t0_ns{-1}; // the loop's start (CLOCK_MONOTONIC)
     std::atomic<bool>      done{false}, stop{false};
-    std::thread            thread;
-    double                 motion_started_at = 0;
-    // The force log (Effects / Force log), allocated here or not at all:
-    // a row per tick of the motion.
-    std::vector<double>            log_time;
-    std::vector<Utilities::Point3> log_position, log_force;
-    std::size_t                    logged = 0;
+    // hold(): asked for, and the loop's word that it is outside the device
+    // and force path (sequentially consistent: see hold()).
+    std::atomic<bool> hold_requested{false}, holding{false};
+    std::thread       thread;
+    double            motion_started_at = 0;
+    // The force log (Effects / Force log), allocated here or not at all: a
+    // ring of rows of the motion, filled by the loop (never waiting: a
+    // full ring drops the row and counts it) and emptied by
+    // drain_force_log(). A bounded loop's holds every tick of its run.
+    struct LogRow
+    {
+      double            t;
+      Utilities::Point3 x, f;
+    };
+    std::vector<LogRow>              log;
+    std::atomic<std::size_t>         log_head{0};
+    mutable std::atomic<std::size_t> log_tail{0};
+    std::atomic<std::uint64_t>       log_dropped{0};
 
     Impl(Interaction &i,
          Device      &d,
@@ -58,17 +71,33 @@ namespace palpate
       : interaction(i)
       , device(d)
       , rate(r)
-      , capacity(HapticLoop::max_ticks(r, max_seconds))
+      , continuous(max_seconds >= HapticLoop::continuous)
+      , capacity(HapticLoop::max_ticks(r,
+                                       continuous ?
+                                         HapticLoop::continuous_window :
+                                         max_seconds))
       , period(capacity)
       , lateness(capacity)
       , interpolation(capacity)
-      , log_time(force_log ? capacity : 0)
-      , log_position(force_log ? capacity : 0)
-      , log_force(force_log ? capacity : 0)
+      // A continuous loop's log: 4 s of ticks, drained a few times a
+      // second.
+      , log(force_log ? (continuous ? HapticLoop::max_ticks(r, 4) : capacity) :
+                        0)
     {}
 
     void
     run();
+
+    /** Whether the loop is to hold (see HapticLoop::hold()); says so. */
+    bool
+    held() noexcept
+    {
+      holding.store(false);
+      if (!hold_requested.load())
+        return false;
+      holding.store(true);
+      return true;
+    }
   };
 
 
@@ -111,7 +140,8 @@ namespace palpate
       for (std::size_t i = 0; i < sizeof(stack); i += 4096)
         stack[i] = 0;
     }
-    interaction.force(device.position(0));
+    if (!held())
+      interaction.force(device.position(0));
 
     const long long period_ns =
       static_cast<long long>(std::llround(1e9 / rate));
@@ -123,7 +153,9 @@ namespace palpate
     bool      motion_over = false;
     while (!stop.load(std::memory_order_relaxed))
       {
-        if (n == capacity)
+        // A bounded loop's arrays hold its whole run; a continuous loop's
+        // statistics wrap (the last continuous_window seconds).
+        if (!continuous && n == capacity)
           {
             truncated = !motion_over;
             break;
@@ -136,10 +168,8 @@ namespace palpate
           {} // a signal: sleep on until the deadline
         clock_gettime(CLOCK_MONOTONIC, &now);
         const long long wake = nanoseconds(now);
-        lateness[n]          = 1e-9 * (wake - deadline);
-        period[n]            = 1e-9 * (wake - previous_wake);
-        previous_wake        = wake;
-        if (lateness[n] > 0.5e-3)
+        const double    late = 1e-9 * (wake - deadline);
+        if (late > 0.5e-3)
           ++misses;
         // After a stall, no burst of catch-up ticks (each would be allowed
         // the maximum force change): the deadlines that passed are missed.
@@ -149,6 +179,17 @@ namespace palpate
             deadline += passed * period_ns;
             misses += passed;
           }
+        // Held (another thread changes the interaction): keep time only.
+        // The tick is not sampled (it did no work).
+        if (held())
+          {
+            previous_wake = wake;
+            continue;
+          }
+        const std::size_t i = n % capacity;
+        lateness[i]         = late;
+        period[i]           = 1e-9 * (wake - previous_wake);
+        previous_wake       = wake;
 
         // The device's clock: the motion starts at the first tick after
         // start_motion().
@@ -167,14 +208,18 @@ namespace palpate
         clock_gettime(CLOCK_MONOTONIC, &a);
         const Utilities::Point3 f = interaction.force(x);
         clock_gettime(CLOCK_MONOTONIC, &b);
-        interpolation[n] = 1e-9 * (nanoseconds(b) - nanoseconds(a));
+        interpolation[i] = 1e-9 * (nanoseconds(b) - nanoseconds(a));
         device.render(f);
-        if (t > 0 && logged < log_time.size())
+        if (t > 0 && !log.empty())
           {
-            log_time[logged]     = t;
-            log_position[logged] = x;
-            log_force[logged]    = f;
-            ++logged;
+            const std::size_t h = log_head.load(std::memory_order_relaxed);
+            if (h - log_tail.load(std::memory_order_acquire) < log.size())
+              {
+                log[h % log.size()] = {t, x, f};
+                log_head.store(h + 1, std::memory_order_release);
+              }
+            else
+              log_dropped.fetch_add(1, std::memory_order_relaxed);
           }
         ++n;
 
@@ -252,6 +297,29 @@ namespace palpate
 
 
 
+  void
+  HapticLoop::hold()
+  {
+    Impl &s = *impl;
+    s.hold_requested.store(true);
+    // The loop says it holds at its next tick; before its first, or after
+    // its last, it cannot be in the force path. Sequentially consistent:
+    // the loop clears `holding` before it reads the request, so a loop
+    // that read no request cannot leave `holding` true behind.
+    while (s.thread.joinable() && !s.done.load() && !s.holding.load())
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+
+
+
+  void
+  HapticLoop::release() noexcept
+  {
+    impl->hold_requested.store(false);
+  }
+
+
+
   bool
   HapticLoop::finished() const noexcept
   {
@@ -290,15 +358,20 @@ namespace palpate
   HapticLoop::add_to(RunSummary &r) const
   {
     const Impl &s = *impl;
-    // The first sample has no previous tick.
-    std::vector<double> period(s.period.begin() + std::min<std::size_t>(1, s.n),
-                               s.period.begin() + s.n);
+    // The ticks sampled (a continuous loop's last window); the first of a
+    // run has no previous tick.
+    const std::size_t stored = std::min<std::uint64_t>(s.n, s.capacity);
+    const std::size_t first =
+      s.n <= s.capacity ? std::min<std::size_t>(1, stored) : 0;
+    std::vector<double> period(s.period.begin() + first,
+                               s.period.begin() + stored);
     std::vector<double> interpolation(s.interpolation.begin(),
-                                      s.interpolation.begin() + s.n);
+                                      s.interpolation.begin() + stored);
     r.loop_ran              = true;
     r.realtime_priority     = s.realtime;
     r.loop_rate             = s.rate;
     r.ticks                 = s.n;
+    r.statistics_window     = s.n > s.capacity ? s.capacity / s.rate : 0;
     r.deadline_misses       = s.misses;
     r.period_p50_ms         = 1000 * percentile(period, 0.5);
     r.period_p99_ms         = 1000 * percentile(period, 0.99);
@@ -316,19 +389,52 @@ namespace palpate
 
 
 
+  std::size_t
+  HapticLoop::drain_force_log(std::ostream &csv) const
+  {
+    const Impl       &s    = *impl;
+    const std::size_t head = s.log_head.load(std::memory_order_acquire);
+    std::size_t       tail = s.log_tail.load(std::memory_order_relaxed);
+    const std::size_t n    = head - tail;
+    // The rows in writes of whole rows, each flushed: a process killed
+    // meanwhile leaves whole rows (a row cut in two by the stream's buffer
+    // was what a SIGKILL left before).
+    while (tail != head)
+      {
+        std::ostringstream rows;
+        rows << std::setprecision(9);
+        for (unsigned int k = 0; k < 4096 && tail != head; ++k, ++tail)
+          {
+            const auto &r = s.log[tail % s.log.size()];
+            rows << r.t << "," << r.x[0] << "," << r.x[1] << "," << r.x[2]
+                 << "," << r.f[0] << "," << r.f[1] << "," << r.f[2] << "\n";
+          }
+        s.log_tail.store(tail, std::memory_order_release);
+        const std::string text = rows.str();
+        csv.write(text.data(), static_cast<std::streamsize>(text.size()));
+        csv.flush();
+      }
+    return n;
+  }
+
+
+
+  std::uint64_t
+  HapticLoop::force_log_dropped() const noexcept
+  {
+    return impl->log_dropped.load();
+  }
+
+
+
   void
   HapticLoop::write_force_log(const std::string &filename) const
   {
     std::ofstream out(filename);
     if (!out)
       throw std::runtime_error("cannot write '" + filename + "'");
-    out << "t_s,x_m,y_m,z_m,fx_N,fy_N,fz_N\n" << std::setprecision(9);
-    const Impl &s = *impl;
-    for (std::size_t k = 0; k < s.logged; ++k)
-      out << s.log_time[k] << "," << s.log_position[k][0] << ","
-          << s.log_position[k][1] << "," << s.log_position[k][2] << ","
-          << s.log_force[k][0] << "," << s.log_force[k][1] << ","
-          << s.log_force[k][2] << "\n";
+    out << "t_s,x_m,y_m,z_m,fx_N,fy_N,fz_N\n";
+    const std::size_t logged = drain_force_log(out);
     // A full disk shows only here: a cut log is an output error. What was
     // written is cut back to its last whole row, so that no row holds a
     // cut number, and the message says how many rows it keeps.
@@ -353,7 +459,7 @@ namespace palpate
           "'" + filename + "' could not be written whole (" +
           std::strerror(error) + "): it keeps " +
           (rows > 0 ? "the first " + std::to_string(rows - 1) + " of " +
-                        std::to_string(s.logged) + " rows, cut at a whole row" :
+                        std::to_string(logged) + " rows, cut at a whole row" :
                       std::string("nothing")));
       }
   }

@@ -236,7 +236,12 @@ namespace palpate
           << "\n"
           << "  loop period:       p50 " << period_p50_ms << " ms, p99 "
           << period_p99_ms << " ms, p99.9 " << period_p999_ms << " ms, max "
-          << period_max_ms << " ms\n"
+          << period_max_ms << " ms"
+          << (statistics_window > 0 ?
+                " (the last " + Utilities::to_string(statistics_window, 4) +
+                  " s)" :
+                std::string())
+          << "\n"
           << "  deadline misses:   " << deadline_misses
           << " (ticks more than 0.5 ms late)\n"
           << "  interpolation:     p50 " << interpolation_p50_us

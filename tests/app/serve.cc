@@ -42,6 +42,7 @@
 #include <palpate/app/scene_report.h>
 #include <palpate/app/serve.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/haptics/run_summary.h>
 #include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -52,10 +53,12 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -446,6 +449,27 @@ main(int argc, char **argv)
           << ok(second.find("cannot listen on 127.0.0.1:") != std::string::npos)
           << std::endl;
   server.stop();
+  // Issue 28: the browser's mouse runs in the common haptic loop, and the
+  // summary says so: its ticks, priority and periods, and the device. The
+  // material and active-node changes above held it (HapticLoop::hold())
+  // while the scene changed, and it went on after them.
+  {
+    palpate::RunSummary summary;
+    server.add_to(summary);
+    std::ostringstream printed;
+    summary.print(printed);
+    deallog << "the summary has the haptic loop: "
+            << ok(summary.loop_ran && summary.ticks > 100 &&
+                  printed.str().find("haptic loop:") != std::string::npos &&
+                  printed.str().find("loop period:") != std::string::npos)
+            << ", names the device: "
+            << ok(summary.trajectory.find("target follower") !=
+                  std::string::npos)
+            << ", finite periods: "
+            << ok(std::isfinite(summary.period_p50_ms) &&
+                  summary.period_p50_ms > 0)
+            << std::endl;
+  }
 
   // The same beam from a Gmsh file that numbers its nodes 1000 + 7 (n - 1
   // - i): backwards, from 1000, in steps of 7, so that the file's number

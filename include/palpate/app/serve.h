@@ -17,6 +17,7 @@
 namespace palpate
 {
   class Interaction;
+  struct RunSummary;
   class Scene;
 
   /**
@@ -24,11 +25,12 @@ namespace palpate
    * and a small HTTP server (cpp-httplib) serves a page that draws the
    * organ deforming, the HIP and the force (three.js), and takes the
    * mouse as a 3-DOF device. The page polls the state at about 30 Hz; its
-   * mouse positions are targets: a device thread at the scene's loop rate
-   * moves the HIP toward the target as a hand moves a device, at most at
-   * @p max_speed and with at most 1 m/s^2 of acceleration (smooth: the
-   * mouse's jumps become bounded accelerations), and calls
-   * Interaction::force() like a real device.
+   * mouse positions are targets: a TargetFollower device, run by the
+   * common HapticLoop at the scene's loop rate, moves the HIP toward the
+   * target as a hand moves a device, at most at @p max_speed and with at
+   * most 1 m/s^2 of acceleration (smooth: the mouse's jumps become bounded
+   * accelerations), and the loop calls Interaction::force() as for every
+   * device.
    *
    * Endpoints: GET / (the page), GET /three.module.js, /three.core.js and
    * /OrbitControls.js (three.js and its camera controls from npm, built in:
@@ -140,19 +142,24 @@ namespace palpate
     const Interaction &
     interaction() const;
 
-    /** The force the device thread rendered last (N) and its HIP (m). */
+    /** The force the haptic loop rendered last (N) and its HIP (m). */
     void
     last(Utilities::Point3 &hip, Utilities::Point3 &force) const;
 
-    /** Stop serving and the device thread; detach. */
+    /** Add the haptic loop's statistics (the browser's mouse runs in the
+     * common HapticLoop) and the device to @p summary; after stop(). */
+    void
+    add_to(RunSummary &summary) const;
+
+    /** Stop serving and the haptic loop; detach. */
     void
     stop();
 
     /**
-     * With Effects / Force log: write the rows the device thread logged
+     * With Effects / Force log: write the rows the haptic loop logged
      * since the last call to @p csv (t in s since the view started, the
      * HIP in m, the force in N, as an interaction's force log), and return
-     * how many. The device thread puts its rows in a ring of 4 s of ticks
+     * how many. The loop puts its rows in a ring of 4 s of ticks
      * and never waits: call this from one thread, a few times a second;
      * rows that found the ring full are counted (force_log_dropped()).
      */

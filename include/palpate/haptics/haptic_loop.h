@@ -6,6 +6,8 @@
 
 #include <palpate/base/utilities.h>
 
+#include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <string>
 
@@ -20,20 +22,33 @@ namespace palpate
    * deadlines on the steady clock, it reads the device's position, asks the
    * Interaction for the force and renders it. It asks for real-time
    * priority (SCHED_FIFO) and reports whether it got it. Its statistics
-   * (periods, lateness, interpolation times) live in arrays allocated
-   * before it starts: the loop itself never allocates.
+   * (periods, lateness, interpolation times) and its force log live in
+   * arrays allocated before it starts: the loop itself never allocates.
    *
    * The motion starts when start_motion() is called (e.g. once the initial
    * cloud is computed); the loop ends when the device says the interaction
-   * is over (Device::finished()). Every device runs in it alike, with the
-   * same priority, statistics, summary and force log.
+   * is over (Device::finished()), or when it is stopped (join()). Every
+   * device runs in it alike, with the same priority, statistics, summary
+   * and force log: a simulated trajectory for the run's time, and the live
+   * view's mouse (TargetFollower) for as long as the view runs.
    */
   class HapticLoop
   {
   public:
     /**
+     * For @p max_seconds: a loop that runs until it is stopped (the live
+     * view). Its statistics cover the last continuous_window seconds
+     * (they wrap), and its force log is a ring that drain_force_log()
+     * empties while it runs.
+     */
+    static constexpr double continuous = 1e300;
+    /** A continuous loop's statistics window (s). */
+    static constexpr double continuous_window = 600;
+
+    /**
      * @p rate in Hz; @p max_seconds bounds the whole run (waiting plus
-     * motion) and sizes the statistics arrays.
+     * motion) and sizes the statistics arrays and the force log, or is
+     * continuous.
      */
     HapticLoop(Interaction &interaction,
                Device      &device,
@@ -57,6 +72,20 @@ namespace palpate
     void
     start_motion() noexcept;
 
+    /**
+     * Hold the device: from the return of this call until release(), the
+     * loop neither reads the device nor asks the interaction for a force
+     * (it keeps time, and renders nothing new), so that another thread
+     * may change the interaction's parameters or reset the device. Blocks
+     * at most a tick. Not for the loop's own thread.
+     */
+    void
+    hold();
+
+    /** Let the held device go on (a no-op if it was not held). */
+    void
+    release() noexcept;
+
     /** Whether the motion is over (or the time bound reached). */
     bool
     finished() const noexcept;
@@ -72,7 +101,7 @@ namespace palpate
     void
     join();
 
-    /** Add the loop's statistics to @p summary. */
+    /** Add the loop's statistics to @p summary (after join()). */
     void
     add_to(RunSummary &summary) const;
 
@@ -85,9 +114,48 @@ namespace palpate
     void
     write_force_log(const std::string &filename) const;
 
+    /**
+     * With a force log: write the rows logged since the last call to @p csv
+     * (no header) in one write, then flush; returns how many. For a
+     * continuous loop, while it runs (a thread other than the loop's): a
+     * run that ends however it ends keeps what was drained.
+     */
+    std::size_t
+    drain_force_log(std::ostream &csv) const;
+
+    /** Ticks not logged because the force log's ring was full (a
+     * continuous loop whose drain fell behind). */
+    std::uint64_t
+    force_log_dropped() const noexcept;
+
   private:
     struct Impl;
     std::unique_ptr<Impl> impl;
+  };
+
+
+
+  /** HapticLoop::hold() for a scope: released however the scope ends. */
+  class HeldDevice
+  {
+  public:
+    explicit HeldDevice(HapticLoop &loop)
+      : loop(loop)
+    {
+      loop.hold();
+    }
+
+    ~HeldDevice()
+    {
+      loop.release();
+    }
+
+    HeldDevice(const HeldDevice &) = delete;
+    HeldDevice &
+    operator=(const HeldDevice &) = delete;
+
+  private:
+    HapticLoop &loop;
   };
 } // namespace palpate
 

@@ -65,6 +65,9 @@ namespace palpate
     /** Whether the loop hit its time bound before the motion ended. */
     bool   loop_truncated = false;
     double loop_rate      = 0;
+    /** A continuous loop's (the live view's) statistics cover only its last
+     * this many seconds; 0: the whole run. */
+    double statistics_window = 0;
     /** Seconds from attach to the motion's start (-1: it never started,
      * stopped during the initial cloud), and how long it lasted. */
     double        motion_start = 0, motion_duration = 0;

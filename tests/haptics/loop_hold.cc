@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The common haptic loop runs the live view's device (issue 28): a
+// continuous loop with a TargetFollower, as palpate serve runs it.
+// - While held (HapticLoop::hold(), what the live view does while it
+//   changes the scene), the loop reads no position and asks for no force;
+//   after release() it goes on.
+// - The follower reaches its target at rest, never faster than its
+//   maximum speed.
+// - The force log is a ring drained while the loop runs: rows whose times
+//   increase by one period, none dropped.
+// - The summary counts the ticks and names the device.
+
+#include <palpate/haptics/haptic_loop.h>
+#include <palpate/haptics/interaction.h>
+#include <palpate/haptics/run_summary.h>
+#include <palpate/haptics/target_follower.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <thread>
+
+#include "../tests.h"
+
+namespace
+{
+  /** The follower, counting the loop's calls. */
+  class Counted : public palpate::TargetFollower
+  {
+  public:
+    using TargetFollower::TargetFollower;
+
+    palpate::Utilities::Point3
+    position(const double t) noexcept override
+    {
+      calls.fetch_add(1);
+      const auto x = TargetFollower::position(t);
+      const auto d = palpate::Utilities::distance(x, last);
+      fastest      = std::max(fastest.load(), d * 1000); // m/s at 1 kHz
+      last         = x;
+      return x;
+    }
+
+    std::atomic<unsigned long> calls{0};
+    std::atomic<double>        fastest{0};
+    palpate::Utilities::Point3 last{{0, 0, 0}};
+  };
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  palpate::Environment env(argc, argv);
+  initlog();
+  using namespace std::chrono_literals;
+
+  palpate::Scene scene = small_beam_scene();
+  scene.parameters.material_model.set("St.Venant-Kirchhoff",
+                                      "Young's modulus",
+                                      1e6);
+  palpate::Interaction interaction(scene);
+  interaction.attach();
+  Counted             device(1000, 0.05);
+  palpate::HapticLoop loop(
+    interaction, device, 1000, palpate::HapticLoop::continuous, true);
+  loop.start(palpate::HapticLoop::continuous);
+  loop.start_motion();
+  std::this_thread::sleep_for(100ms);
+
+  loop.hold();
+  const unsigned long held_at = device.calls.load();
+  std::this_thread::sleep_for(100ms);
+  const unsigned long while_held = device.calls.load() - held_at;
+  loop.release();
+  std::this_thread::sleep_for(100ms);
+  const unsigned long after = device.calls.load() - held_at - while_held;
+  deallog << "positions read while held: " << while_held
+          << "; after the release, the loop goes on: " << ok(after > 50)
+          << std::endl;
+
+  // 2 mm away at 5 cm/s: about 0.1 s with the acceleration limit.
+  device.set_target({{0.002, 0, -0.001}});
+  std::ostringstream csv;
+  std::size_t        rows = 0;
+  for (unsigned int k = 0; k < 10; ++k)
+    {
+      std::this_thread::sleep_for(100ms);
+      rows += loop.drain_force_log(csv);
+    }
+  const auto x = device.hip();
+  deallog << "target reached: "
+          << ok(palpate::Utilities::distance(x, device.target()) < 1e-12)
+          << ", never faster than 5 cm/s: "
+          << ok(device.fastest.load() <= 0.05 * (1 + 1e-9)) << std::endl;
+  loop.join();
+  rows += loop.drain_force_log(csv);
+
+  // The rows: times one period apart (a held tick is not logged: one gap
+  // of about 0.1 s), finite, as many as drained.
+  std::istringstream in(csv.str());
+  std::string        line;
+  double             previous = -1, largest_gap = 0;
+  unsigned int       read = 0, finite = 0, one_period = 0;
+  while (std::getline(in, line))
+    {
+      double             t = 0, v[6];
+      char               comma;
+      std::istringstream r(line);
+      r >> t;
+      bool good = std::isfinite(t);
+      for (double &c : v)
+        good = (r >> comma >> c) && good && std::isfinite(c);
+      finite += good;
+      if (previous >= 0)
+        {
+          const double gap = t - previous;
+          largest_gap      = std::max(largest_gap, gap);
+          one_period += std::abs(gap - 1e-3) < 0.5e-3;
+        }
+      previous = t;
+      ++read;
+    }
+  deallog << "force log: rows drained = rows read: " << ok(rows == read)
+          << ", all finite: " << ok(finite == read)
+          << ", most one period apart: " << ok(one_period > 0.9 * read)
+          << ", the hold's gap (0.1 s): "
+          << ok(largest_gap > 0.08 && largest_gap < 0.2)
+          << ", none dropped: " << ok(loop.force_log_dropped() == 0)
+          << std::endl;
+
+  palpate::RunSummary summary;
+  loop.add_to(summary);
+  summary.trajectory = device.description();
+  deallog << "summary: ticks = logged rows + the rest before the motion: "
+          << ok(summary.ticks >= read && summary.ticks <= read + 5)
+          << ", names the device: "
+          << ok(summary.trajectory.find("target follower") != std::string::npos)
+          << std::endl;
+}
