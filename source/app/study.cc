@@ -552,396 +552,492 @@ namespace palpate
   } // namespace
 
 
-
-  StudyResult
-  run_study(std::ostream &out, const Scene &scene, const StudyOptions &options)
+  namespace
   {
-    const auto         study_start = Clock::now();
-    const auto        &p0          = scene.parameters;
-    const bool         quick       = options.quick;
-    const unsigned int workers =
-      std::max(1u,
-               std::min(p0.engine.workers,
-                        std::max(1u, std::thread::hardware_concurrency())));
-    StudyResult result;
-    result.material = material_key(p0.material_model);
-
-    // --- The HIP positions: smooth random trajectories in a ball of
-    // 12 mm around rest (cells of up to 20 mm around them stay within the
-    // range where the liver scenes' states exist), or of half the state
-    // space's extent if that is smaller.
-    const unsigned int n_samples =
-      options.samples > 0 ? options.samples : (quick ? 80 : 240);
-    const unsigned int  per_path = 20;
-    const unsigned int  n_paths  = (n_samples + per_path - 1) / per_path;
-    const double        radius   = std::min(0.012, 0.5 * p0.state_space.extent);
-    const auto          paths = trajectories(n_paths, per_path, radius, 2026);
-    std::vector<Point3> positions;
-    for (const auto &path : paths)
-      for (const Point3 &x : path)
-        if (positions.size() < n_samples)
-          positions.push_back(x);
-
-    // --- The knobs and their values, one at a time from the scene's.
-    const double        h0 = p0.state_space.grid_spacing;
-    std::vector<double> spacings =
-      quick ? std::vector<double>{0.005, 0.01, 0.02} :
-              std::vector<double>{0.0025, 0.005, 0.01, 0.02};
-    // A spacing beyond half the extent leaves the positions' cells outside
-    // the grid.
-    spacings.erase(std::remove_if(spacings.begin(),
-                                  spacings.end(),
-                                  [&](const double h) {
-                                    return h > 0.5 * p0.state_space.extent;
-                                  }),
-                   spacings.end());
-    if (std::find(spacings.begin(), spacings.end(), h0) == spacings.end())
-      spacings.push_back(h0);
-    std::sort(spacings.begin(), spacings.end());
-    std::vector<double> tolerances =
-      quick ? std::vector<double>{1e-4} : std::vector<double>{1e-3, 1e-4, 1e-6};
-    std::vector<double> increments =
-      quick ? std::vector<double>{0.0025} : std::vector<double>{0.001, 0.0025};
-    tolerances.erase(std::remove(tolerances.begin(),
-                                 tolerances.end(),
-                                 p0.nonlinear_solver.residual_tolerance),
-                     tolerances.end());
-    increments.erase(std::remove(increments.begin(),
-                                 increments.end(),
-                                 p0.nonlinear_solver.max_increment_length),
-                     increments.end());
-
-    // The finer mesh for the mesh knob.
-    std::optional<Scene> finer;
-    std::string          coarse_name = "scene mesh", finer_name;
+    /**
+     * The study's steps and what they share (step-44's layout): run() reads
+     * like the algorithm. A stop signal or the time budget cuts it short
+     * at the next state or solve (StudyCut); what was measured until then
+     * is reported and written.
+     */
+    class Study
     {
-      Scene       f = scene;
-      auto       &m = f.parameters.mesh;
-      std::string why_not;
-      if (!options.finer_mesh.empty())
-        {
-          m.source    = "file";
-          m.file_name = std::filesystem::absolute(options.finer_mesh).string();
-          finer_name  = std::filesystem::path(options.finer_mesh).stem();
-          finer       = f;
-          // Read it and select its nodes now: a file that is not a mesh
-          // of this organ is an input error before the reference solves,
-          // not after them.
-          try
-            {
-              const Body check(f);
-              // Not finer than the scene's: the mesh knob would measure
-              // no refinement (0 % differences), which looks like a result.
-              const Mesh scene_mesh = Mesh::create(scene);
-              if (check.mesh.n_vertices() <= scene_mesh.n_vertices())
-                out << "warning: --finer-mesh " << options.finer_mesh << " has "
-                    << check.mesh.n_vertices()
-                    << " nodes, not more than the scene's mesh ("
-                    << scene_mesh.n_vertices()
-                    << "): the mesh knob then measures no refinement. Give a "
-                       "finer mesh of the same organ.\n";
-            }
-          catch (const InputError &e)
-            {
-              // The file's own problem, but named as what it is here.
-              throw InputError(e.file(),
-                               e.line(),
-                               "--finer-mesh (" + e.entry() + ")",
-                               e.problem(),
-                               "give a finer mesh of the same organ, in the "
-                               "scene's file unit (its Scale factor applies): "
-                               "the study solves the scene on it to measure "
-                               "the mesh's error.");
-            }
-        }
-      else if (m.source == "file")
-        {
-          std::filesystem::path file(m.file_name);
-          if (file.is_relative() && !scene.file().empty())
-            file = std::filesystem::path(scene.file()).parent_path() / file;
-          const auto sibling = file.parent_path() / "liver2k.msh";
-          if (file.filename() == "liver501.msh" &&
-              std::filesystem::exists(sibling))
-            {
-              m.file_name = std::filesystem::absolute(sibling).string();
-              finer_name  = "liver2k";
-              coarse_name = "liver501";
-              finer       = f;
-            }
-        }
-      else if (m.source == "surface")
-        {
-          // The same surface, finer: the refinement around the probe
-          // halved (the indenter's region), or twice the nodes.
-          if (m.surface_fine_size > 0)
-            {
-              coarse_name = "refinement " + mm(m.surface_fine_size);
-              m.surface_fine_size /= 2;
-              finer_name = "refinement " + mm(m.surface_fine_size);
-            }
-          else
-            {
-              coarse_name = std::to_string(m.surface_target_nodes) + " nodes";
-              m.surface_target_nodes *= 2;
-              finer_name = std::to_string(m.surface_target_nodes) + " nodes";
-            }
-          finer = f;
-        }
-      else if (m.source == "blob")
-        {
-          ++m.blob_refinements;
-          finer_name =
-            "blob, " + std::to_string(m.blob_refinements) + " refinements";
-          finer = f;
-        }
-      else if (m.source == "beam")
-        {
-          m.beam_subdivisions_length *= 2;
-          m.beam_subdivisions_width *= 2;
-          m.beam_subdivisions_height *= 2;
-          finer_name = "beam, twice the subdivisions";
-          finer      = f;
-        }
-    }
-    // The probe: the scene's, and a rigid tip of 25 mm (or the scene's
-    // tip) for the discretisation knobs, where a point probe has no
-    // mesh-converged force.
-    const double       tip = p0.boundary_conditions.active_node.tip_radius > 0 ?
-                               p0.boundary_conditions.active_node.tip_radius :
-                               0.025;
-    const unsigned int n_disc = quick ? 8 : 40;
-    const bool         p2_knob =
-      !quick || p0.material_model.model_name != "Mooney-Rivlin";
-
-    // --- Work, for the progress bar: states to compute (estimated from
-    // the cells and their neighbours) and direct solves, weighted by
-    // their relative cost.
-    const Body base(scene);
-    out << "Study: what accuracy costs in time, for '" << scene.file() << "'\n"
-        << "  " << positions.size() << " HIP positions on " << n_paths
-        << " smooth random trajectories within " << mm(radius)
-        << " of rest; one knob at a time from the scene's settings; " << workers
-        << " worker(s)"
-        << (quick ? "; --quick: fewer knob values and positions" : "") << "\n";
-    double total = positions.size();
-    for (const double h : spacings)
-      total += with_neighbours(StateGrid(h, p0.state_space.extent),
-                               cell_corners(StateGrid(h, p0.state_space.extent),
-                                            positions))
-                 .size();
-    const double h0_states =
-      with_neighbours(StateGrid(h0, p0.state_space.extent),
-                      cell_corners(StateGrid(h0, p0.state_space.extent),
-                                   positions))
-        .size();
-    total += (tolerances.size() + increments.size()) * h0_states;
-    const double finer_cost = 12, p2_cost = 20;
-    if (finer)
-      total += 2 * n_disc * (1 + finer_cost);
-    if (p2_knob)
-      total += 2 * n_disc * p2_cost;
-    // A stop signal or the time budget cuts the study short at the next
-    // state or solve; what was measured until then is reported and written
-    // (the CSV also after every knob setting, so that even a killed study
-    // leaves its finished rows).
-    const StopRequest stop;
-    Progress   progress(out, options.progress, total, stop, options.time_limit);
-    const auto skipped = [&](const std::string &knob) {
-      return std::find(options.skip.begin(), options.skip.end(), knob) !=
-             options.skip.end();
-    };
-
-    result.csv_file = options.csv_file;
-    if (!result.csv_file.empty())
+    public:
+      Study(std::ostream &out, const Scene &scene, const StudyOptions &options)
+        : out(out)
+        , scene(scene)
+        , options(options)
+        , p0(scene.parameters)
+        , quick(options.quick)
+        , workers(std::max(
+            1u,
+            std::min(p0.engine.workers,
+                     std::max(1u, std::thread::hardware_concurrency()))))
       {
-        // Said before anything runs, not at the first knob's end.
-        std::error_code error;
-        if (std::filesystem::is_directory(result.csv_file, error))
-          throw InputError(
-            "command line",
-            0,
-            "--csv " + result.csv_file,
-            "'" + result.csv_file + "' is a directory, not a file",
-            "give the CSV file's name, e.g. --csv " +
-              (std::filesystem::path(result.csv_file) / "study.csv").string() +
-              ".");
+        result.material = material_key(p0.material_model);
       }
-    if (result.csv_file.empty())
+
+      StudyResult
+      run()
       {
-        std::filesystem::create_directories(p0.output.directory);
-        result.csv_file =
-          (std::filesystem::path(p0.output.directory) /
-           ("study-" + std::filesystem::path(scene.file()).stem().string() +
-            ".csv"))
-            .string();
+        choose_positions();
+        choose_knob_values();
+        choose_finer_mesh();
+        choose_probe();
+        announce_and_estimate_work();
+        check_csv_file();
+        // Its header now: a file that cannot be written fails before the
+        // work.
+        write_csv();
+        try
+          {
+            solve_references();
+            measure_grid_knobs();
+            measure_discretisation_knobs();
+          }
+        catch (const StudyCut &cut)
+          {
+            result.stopped     = cut.why;
+            result.stop_signal = stop->signal_number();
+          }
+        progress->finish();
+        say_if_cut_short();
+        if (result.rows.empty())
+          return nothing_measured();
+        bound_discretisation_error();
+        recommend();
+        print_tables();
+        print_discretisation_error_and_recommendation();
+        write_csv_and_plot();
+        result.seconds = seconds_since(study_start);
+        out << "Study time " << fixed(result.seconds, 0) << " s; "
+            << reference_line();
+        return result;
       }
-    const auto write_csv = [&] {
-      std::ofstream csv(result.csv_file);
-      csv << "material,knob,value,interpolation,probe,h_mm,samples,covered,"
+
+    private:
+      /** The HIP positions: smooth random trajectories in a ball. */
+      void
+      choose_positions()
+      {
+        // --- The HIP positions: smooth random trajectories in a ball of
+        // 12 mm around rest (cells of up to 20 mm around them stay within the
+        // range where the liver scenes' states exist), or of half the state
+        // space's extent if that is smaller.
+        const unsigned int n_samples =
+          options.samples > 0 ? options.samples : (quick ? 80 : 240);
+        const unsigned int per_path = 20;
+        n_paths                     = (n_samples + per_path - 1) / per_path;
+        radius = std::min(0.012, 0.5 * p0.state_space.extent);
+        paths  = trajectories(n_paths, per_path, radius, 2026);
+        for (const auto &path : paths)
+          for (const Point3 &x : path)
+            if (positions.size() < n_samples)
+              positions.push_back(x);
+      }
+
+      /** The knobs' values, one knob at a time from the scene's. */
+      void
+      choose_knob_values()
+      {
+        // --- The knobs and their values, one at a time from the scene's.
+        h0       = p0.state_space.grid_spacing;
+        spacings = quick ? std::vector<double>{0.005, 0.01, 0.02} :
+                           std::vector<double>{0.0025, 0.005, 0.01, 0.02};
+        // A spacing beyond half the extent leaves the positions' cells outside
+        // the grid.
+        spacings.erase(std::remove_if(spacings.begin(),
+                                      spacings.end(),
+                                      [&](const double h) {
+                                        return h > 0.5 * p0.state_space.extent;
+                                      }),
+                       spacings.end());
+        if (std::find(spacings.begin(), spacings.end(), h0) == spacings.end())
+          spacings.push_back(h0);
+        std::sort(spacings.begin(), spacings.end());
+        tolerances = quick ? std::vector<double>{1e-4} :
+                             std::vector<double>{1e-3, 1e-4, 1e-6};
+        increments = quick ? std::vector<double>{0.0025} :
+                             std::vector<double>{0.001, 0.0025};
+        tolerances.erase(std::remove(tolerances.begin(),
+                                     tolerances.end(),
+                                     p0.nonlinear_solver.residual_tolerance),
+                         tolerances.end());
+        increments.erase(std::remove(increments.begin(),
+                                     increments.end(),
+                                     p0.nonlinear_solver.max_increment_length),
+                         increments.end());
+      }
+
+      /** The finer mesh for the mesh knob: --finer-mesh, liver2k beside
+       * liver501, or the generator's next refinement. */
+      void
+      choose_finer_mesh()
+      {
+        // The finer mesh for the mesh knob.
+        {
+          Scene       f = scene;
+          auto       &m = f.parameters.mesh;
+          std::string why_not;
+          if (!options.finer_mesh.empty())
+            {
+              m.source = "file";
+              m.file_name =
+                std::filesystem::absolute(options.finer_mesh).string();
+              finer_name = std::filesystem::path(options.finer_mesh).stem();
+              finer      = f;
+              // Read it and select its nodes now: a file that is not a mesh
+              // of this organ is an input error before the reference solves,
+              // not after them.
+              try
+                {
+                  const Body check(f);
+                  // Not finer than the scene's: the mesh knob would measure
+                  // no refinement (0 % differences), which looks like a result.
+                  const Mesh scene_mesh = Mesh::create(scene);
+                  if (check.mesh.n_vertices() <= scene_mesh.n_vertices())
+                    out
+                      << "warning: --finer-mesh " << options.finer_mesh
+                      << " has " << check.mesh.n_vertices()
+                      << " nodes, not more than the scene's mesh ("
+                      << scene_mesh.n_vertices()
+                      << "): the mesh knob then measures no refinement. Give a "
+                         "finer mesh of the same organ.\n";
+                }
+              catch (const InputError &e)
+                {
+                  // The file's own problem, but named as what it is here.
+                  throw InputError(
+                    e.file(),
+                    e.line(),
+                    "--finer-mesh (" + e.entry() + ")",
+                    e.problem(),
+                    "give a finer mesh of the same organ, in the "
+                    "scene's file unit (its Scale factor applies): "
+                    "the study solves the scene on it to measure "
+                    "the mesh's error.");
+                }
+            }
+          else if (m.source == "file")
+            {
+              std::filesystem::path file(m.file_name);
+              if (file.is_relative() && !scene.file().empty())
+                file = std::filesystem::path(scene.file()).parent_path() / file;
+              const auto sibling = file.parent_path() / "liver2k.msh";
+              if (file.filename() == "liver501.msh" &&
+                  std::filesystem::exists(sibling))
+                {
+                  m.file_name = std::filesystem::absolute(sibling).string();
+                  finer_name  = "liver2k";
+                  coarse_name = "liver501";
+                  finer       = f;
+                }
+            }
+          else if (m.source == "surface")
+            {
+              // The same surface, finer: the refinement around the probe
+              // halved (the indenter's region), or twice the nodes.
+              if (m.surface_fine_size > 0)
+                {
+                  coarse_name = "refinement " + mm(m.surface_fine_size);
+                  m.surface_fine_size /= 2;
+                  finer_name = "refinement " + mm(m.surface_fine_size);
+                }
+              else
+                {
+                  coarse_name =
+                    std::to_string(m.surface_target_nodes) + " nodes";
+                  m.surface_target_nodes *= 2;
+                  finer_name =
+                    std::to_string(m.surface_target_nodes) + " nodes";
+                }
+              finer = f;
+            }
+          else if (m.source == "blob")
+            {
+              ++m.blob_refinements;
+              finer_name =
+                "blob, " + std::to_string(m.blob_refinements) + " refinements";
+              finer = f;
+            }
+          else if (m.source == "beam")
+            {
+              m.beam_subdivisions_length *= 2;
+              m.beam_subdivisions_width *= 2;
+              m.beam_subdivisions_height *= 2;
+              finer_name = "beam, twice the subdivisions";
+              finer      = f;
+            }
+        }
+      }
+
+      void
+      choose_probe()
+      {
+        // The probe: the scene's, and a rigid tip of 25 mm (or the scene's
+        // tip) for the discretisation knobs, where a point probe has no
+        // mesh-converged force.
+        tip     = p0.boundary_conditions.active_node.tip_radius > 0 ?
+                    p0.boundary_conditions.active_node.tip_radius :
+                    0.025;
+        n_disc  = quick ? 8 : 40;
+        p2_knob = !quick || p0.material_model.model_name != "Mooney-Rivlin";
+      }
+
+      /** What the study does, and its work for the progress bar. */
+      void
+      announce_and_estimate_work()
+      {
+        // --- Work, for the progress bar: states to compute (estimated from
+        // the cells and their neighbours) and direct solves, weighted by
+        // their relative cost.
+        base.emplace(scene);
+        out << "Study: what accuracy costs in time, for '" << scene.file()
+            << "'\n"
+            << "  " << positions.size() << " HIP positions on " << n_paths
+            << " smooth random trajectories within " << mm(radius)
+            << " of rest; one knob at a time from the scene's settings; "
+            << workers << " worker(s)"
+            << (quick ? "; --quick: fewer knob values and positions" : "")
+            << "\n";
+        total = positions.size();
+        for (const double h : spacings)
+          total +=
+            with_neighbours(StateGrid(h, p0.state_space.extent),
+                            cell_corners(StateGrid(h, p0.state_space.extent),
+                                         positions))
+              .size();
+        const double h0_states =
+          with_neighbours(StateGrid(h0, p0.state_space.extent),
+                          cell_corners(StateGrid(h0, p0.state_space.extent),
+                                       positions))
+            .size();
+        total += (tolerances.size() + increments.size()) * h0_states;
+        if (finer)
+          total += 2 * n_disc * (1 + finer_cost);
+        if (p2_knob)
+          total += 2 * n_disc * p2_cost;
+        // A stop signal or the time budget cuts the study short at the next
+        // state or solve; what was measured until then is reported and written
+        // (the CSV also after every knob setting, so that even a killed study
+        // leaves its finished rows).
+        stop.emplace();
+        progress.emplace(
+          out, options.progress, total, *stop, options.time_limit);
+      }
+
+      bool
+      skipped(const std::string &knob) const
+      {
+        return std::find(options.skip.begin(), options.skip.end(), knob) !=
+               options.skip.end();
+      }
+
+      /** The CSV's name: a directory is refused before anything runs. */
+      void
+      check_csv_file()
+      {
+        result.csv_file = options.csv_file;
+        if (!result.csv_file.empty())
+          {
+            // Said before anything runs, not at the first knob's end.
+            std::error_code error;
+            if (std::filesystem::is_directory(result.csv_file, error))
+              throw InputError(
+                "command line",
+                0,
+                "--csv " + result.csv_file,
+                "'" + result.csv_file + "' is a directory, not a file",
+                "give the CSV file's name, e.g. --csv " +
+                  (std::filesystem::path(result.csv_file) / "study.csv")
+                    .string() +
+                  ".");
+          }
+        if (result.csv_file.empty())
+          {
+            std::filesystem::create_directories(p0.output.directory);
+            result.csv_file =
+              (std::filesystem::path(p0.output.directory) /
+               ("study-" + std::filesystem::path(scene.file()).stem().string() +
+                ".csv"))
+                .string();
+          }
+      }
+
+      /** The rows so far (after every knob setting: even a killed study
+       * leaves its finished rows). */
+      void
+      write_csv() const
+      {
+        std::ofstream csv(result.csv_file);
+        csv
+          << "material,knob,value,interpolation,probe,h_mm,samples,covered,"
              "err_mean_N,err_p95_N,err_max_N,err_mean_pct,err_p95_pct,"
              "err_max_pct,shape_err_mm,state_ms,states,failures,states_per_cm,"
              "region_states,precompute_s,memory_MiB,speed_mm_s,recommended\n";
-      for (unsigned int r = 0; r < result.rows.size(); ++r)
-        {
-          const auto &row = result.rows[r];
-          csv << result.material << "," << row.knob << ",\"" << row.value
-              << "\"," << row.interpolation << "," << row.probe << ","
-              << row.h_mm << "," << row.samples << "," << row.covered << ","
-              << row.err_mean_N << "," << row.err_p95_N << "," << row.err_max_N
-              << "," << row.err_mean_pct << "," << row.err_p95_pct << ","
-              << row.err_max_pct << "," << row.shape_err_mm << ","
-              << row.state_ms << "," << row.states << "," << row.failures << ","
-              << row.states_per_cm << "," << row.region_states << ","
-              << row.precompute_s << "," << row.memory_MiB << ","
-              << row.speed_mm_s << ","
-              << (int(r) == result.recommended ? "yes" : "no") << "\n";
-        }
-      csv.close();
-      if (!csv)
-        throw OutputError("the study's CSV '" + result.csv_file +
-                          "' could not be written (" + std::strerror(errno) +
-                          ")");
-    };
-    // Its header now: a file that cannot be written fails before the work.
-    write_csv();
+        for (unsigned int r = 0; r < result.rows.size(); ++r)
+          {
+            const auto &row = result.rows[r];
+            csv << result.material << "," << row.knob << ",\"" << row.value
+                << "\"," << row.interpolation << "," << row.probe << ","
+                << row.h_mm << "," << row.samples << "," << row.covered << ","
+                << row.err_mean_N << "," << row.err_p95_N << ","
+                << row.err_max_N << "," << row.err_mean_pct << ","
+                << row.err_p95_pct << "," << row.err_max_pct << ","
+                << row.shape_err_mm << "," << row.state_ms << "," << row.states
+                << "," << row.failures << "," << row.states_per_cm << ","
+                << row.region_states << "," << row.precompute_s << ","
+                << row.memory_MiB << "," << row.speed_mm_s << ","
+                << (int(r) == result.recommended ? "yes" : "no") << "\n";
+          }
+        csv.close();
+        if (!csv)
+          throw OutputError("the study's CSV '" + result.csv_file +
+                            "' could not be written (" + std::strerror(errno) +
+                            ")");
+      }
 
-    std::vector<Sample> reference;
-    unsigned int        n_reference = 0;
-    try
+      /** Reference: direct solves at every position, tolerance 1e-10. */
+      void
+      solve_references()
       {
         // --- Reference: direct solves at every position, tolerance 1e-10.
-        reference = direct_solves(base,
+        reference = direct_solves(*base,
                                   paths,
                                   positions.size(),
                                   1e-10,
                                   nullptr,
-                                  progress,
+                                  *progress,
                                   1,
                                   "reference solves");
         for (const auto &s : reference)
           n_reference += s.ok;
-        const std::vector<int> node_of_dof =
-          nodes_of_dofs(StateSolver(base.mesh, base.nodes, p0).system());
+        node_of_dof =
+          nodes_of_dofs(StateSolver(base->mesh, base->nodes, p0).system());
+      }
 
-        // --- One setting of the grid knobs: compute its states, interpolate
-        // with both schemes, compare.
-        const auto grid_setting = [&](const std::string              &knob,
-                                      const std::string              &value,
-                                      const Parameters::AllParameters p) {
-          const StateGrid grid(p.state_space.grid_spacing,
-                               p.state_space.extent);
-          const auto      corners     = cell_corners(grid, positions);
-          const auto      needed      = with_neighbours(grid, corners);
-          auto            q           = p;
-          q.state_space.interpolation = "tricubic Hermite"; // stiffness too
-          const GridStates g          = compute_grid(
-            base, q, grid, needed, progress, 1, knob + " " + value);
-          StateCache cache(grid, std::size_t(1) << 40);
-          for (const auto &[point, state] : g.states)
-            cache.publish(point, state, cache.generation());
-          for (const unsigned int point : g.failed)
-            cache.publish_failure(point, cache.generation());
+      /** One setting of the grid knobs: compute its states, interpolate
+       * with both schemes, compare. */
+      void
+      grid_setting(const std::string              &knob,
+                   const std::string              &value,
+                   const Parameters::AllParameters p)
+      {
+        const StateGrid grid(p.state_space.grid_spacing, p.state_space.extent);
+        const auto      corners     = cell_corners(grid, positions);
+        const auto      needed      = with_neighbours(grid, corners);
+        auto            q           = p;
+        q.state_space.interpolation = "tricubic Hermite"; // stiffness too
+        const GridStates g          = compute_grid(
+          *base, q, grid, needed, *progress, 1, knob + " " + value);
+        StateCache cache(grid, std::size_t(1) << 40);
+        for (const auto &[point, state] : g.states)
+          cache.publish(point, state, cache.generation());
+        for (const unsigned int point : g.failed)
+          cache.publish_failure(point, cache.generation());
 
-          // Cost: state time with and without the stiffness.
-          std::vector<double> plain, with;
-          for (std::size_t i = 0; i < g.times.size(); ++i)
+        // Cost: state time with and without the stiffness.
+        std::vector<double> plain, with;
+        for (std::size_t i = 0; i < g.times.size(); ++i)
+          {
+            with.push_back(g.times[i]);
+            plain.push_back(g.times[i] - g.stiffness_times[i]);
+          }
+        unsigned int region = 0;
+        double       bytes  = 0;
+        for (const unsigned int c : corners)
+          if (const auto i = g.states.find(c); i != g.states.end())
             {
-              with.push_back(g.times[i]);
-              plain.push_back(g.times[i] - g.stiffness_times[i]);
-            }
-          unsigned int region = 0;
-          double       bytes  = 0;
-          for (const unsigned int c : corners)
-            if (const auto i = g.states.find(c); i != g.states.end())
-              {
-                ++region;
-                bytes += state_bytes(*i->second);
-              }
-            else
               ++region;
-          const double per_cm = states_per_cm(grid.spacing());
-
-          // Shape: trilinear blend of the corners' displacement fields.
-          std::vector<double> shape;
-          for (std::size_t k = 0; k < positions.size(); ++k)
-            {
-              if (!reference[k].ok)
-                continue;
-              GridIndex             lower;
-              std::array<double, 3> local;
-              if (!grid.locate(positions[k], lower, local))
-                continue;
-              const auto          c = grid.corners(lower);
-              const auto          w = trilinear_weights(local);
-              std::vector<double> u(reference[k].solution.size(), 0.0);
-              bool                complete = true;
-              for (unsigned int j = 0; j < 8 && complete; ++j)
-                {
-                  const auto i = g.states.find(c[j]);
-                  complete     = i != g.states.end();
-                  if (complete)
-                    for (std::size_t d = 0; d < u.size(); ++d)
-                      u[d] += w[j] * i->second->solution[d];
-                }
-              if (complete)
-                shape.push_back(
-                  shape_difference(node_of_dof, u, reference[k].solution));
+              bytes += state_bytes(*i->second);
             }
+          else
+            ++region;
+        const double per_cm = states_per_cm(grid.spacing());
 
-          for (const auto scheme :
-               {Interpolation::trilinear, Interpolation::hermite})
-            {
-              StudyRow row;
-              row.knob  = knob;
-              row.value = value;
-              row.interpolation =
-                scheme == Interpolation::hermite ? "Hermite" : "trilinear";
-              row.h_mm               = grid.spacing() * 1000;
-              row.residual_tolerance = p.nonlinear_solver.residual_tolerance;
-              row.max_increment      = p.nonlinear_solver.max_increment_length;
-              std::vector<double> absolute, relative;
-              for (std::size_t k = 0; k < positions.size(); ++k)
-                {
-                  if (!reference[k].ok)
-                    continue;
-                  ++row.samples;
-                  const ForceSample s =
-                    interpolate_force(grid, cache, positions[k], scheme);
-                  if (!s.complete)
-                    continue;
-                  ++row.covered;
-                  absolute.push_back(
-                    Utilities::distance(s.force, reference[k].force));
-                  relative.push_back(
-                    relative_error(s.force, reference[k].force));
-                }
-              errors(row, absolute, relative);
-              if (!shape.empty())
-                row.shape_err_mm =
-                  1000 * *std::max_element(shape.begin(), shape.end());
-              row.state_ms =
-                1000 *
-                percentile(scheme == Interpolation::hermite ? with : plain,
-                           0.5);
-              row.states            = g.times.size();
-              row.failures          = g.failed.size();
-              row.states_per_cm     = per_cm;
-              row.region_states     = region;
-              const double slowdown = workers > 1 ? two_solver_slowdown : 1.0;
-              row.precompute_s =
-                region * row.state_ms / 1000 * slowdown / workers;
-              row.memory_MiB = bytes / 1048576.0;
-              // The engine keeps up while it computes the corners ahead as
-              // fast as the HIP reaches them: workers / (state time) states
-              // per second, per_cm states per cm (doc/accuracy-vs-time.md
-              // compares it with benchmarks/run max-speed).
-              row.speed_mm_s =
-                workers / (row.state_ms / 1000 * slowdown) / per_cm * 10;
-              result.rows.push_back(row);
-            }
-          write_csv();
-        };
+        // Shape: trilinear blend of the corners' displacement fields.
+        std::vector<double> shape;
+        for (std::size_t k = 0; k < positions.size(); ++k)
+          {
+            if (!reference[k].ok)
+              continue;
+            GridIndex             lower;
+            std::array<double, 3> local;
+            if (!grid.locate(positions[k], lower, local))
+              continue;
+            const auto          c = grid.corners(lower);
+            const auto          w = trilinear_weights(local);
+            std::vector<double> u(reference[k].solution.size(), 0.0);
+            bool                complete = true;
+            for (unsigned int j = 0; j < 8 && complete; ++j)
+              {
+                const auto i = g.states.find(c[j]);
+                complete     = i != g.states.end();
+                if (complete)
+                  for (std::size_t d = 0; d < u.size(); ++d)
+                    u[d] += w[j] * i->second->solution[d];
+              }
+            if (complete)
+              shape.push_back(
+                shape_difference(node_of_dof, u, reference[k].solution));
+          }
 
+        for (const auto scheme :
+             {Interpolation::trilinear, Interpolation::hermite})
+          {
+            StudyRow row;
+            row.knob  = knob;
+            row.value = value;
+            row.interpolation =
+              scheme == Interpolation::hermite ? "Hermite" : "trilinear";
+            row.h_mm               = grid.spacing() * 1000;
+            row.residual_tolerance = p.nonlinear_solver.residual_tolerance;
+            row.max_increment      = p.nonlinear_solver.max_increment_length;
+            std::vector<double> absolute, relative;
+            for (std::size_t k = 0; k < positions.size(); ++k)
+              {
+                if (!reference[k].ok)
+                  continue;
+                ++row.samples;
+                const ForceSample s =
+                  interpolate_force(grid, cache, positions[k], scheme);
+                if (!s.complete)
+                  continue;
+                ++row.covered;
+                absolute.push_back(
+                  Utilities::distance(s.force, reference[k].force));
+                relative.push_back(relative_error(s.force, reference[k].force));
+              }
+            errors(row, absolute, relative);
+            if (!shape.empty())
+              row.shape_err_mm =
+                1000 * *std::max_element(shape.begin(), shape.end());
+            row.state_ms =
+              1000 *
+              percentile(scheme == Interpolation::hermite ? with : plain, 0.5);
+            row.states            = g.times.size();
+            row.failures          = g.failed.size();
+            row.states_per_cm     = per_cm;
+            row.region_states     = region;
+            const double slowdown = workers > 1 ? two_solver_slowdown : 1.0;
+            row.precompute_s =
+              region * row.state_ms / 1000 * slowdown / workers;
+            row.memory_MiB = bytes / 1048576.0;
+            // The engine keeps up while it computes the corners ahead as
+            // fast as the HIP reaches them: workers / (state time) states
+            // per second, per_cm states per cm (doc/accuracy-vs-time.md
+            // compares it with benchmarks/run max-speed).
+            row.speed_mm_s =
+              workers / (row.state_ms / 1000 * slowdown) / per_cm * 10;
+            result.rows.push_back(row);
+          }
+        write_csv();
+      }
+
+      /** Grid spacing, tolerance, increment, and the best of them together. */
+      void
+      measure_grid_knobs()
+      {
         if (!skipped("grid"))
           for (const double h : spacings)
             {
@@ -993,75 +1089,82 @@ namespace palpate
               grid_setting("combined", value, p);
             }
         }
+      }
 
-        // --- Discretisation knobs: direct solves at the first n_disc
-        // positions, against the finest setting of the knob, with the point
-        // probe and with a rigid tip.
-        const auto discretisation = [&](const std::string        &knob,
-                                        const std::vector<Scene> &variants,
-                                        const std::vector<std::string> &names,
-                                        const std::vector<double>      &cost) {
-          for (const double radius : {0.0, tip})
-            {
-              std::vector<std::vector<Sample>> forces;
-              std::vector<std::vector<double>> times(variants.size());
-              for (unsigned int v = 0; v < variants.size(); ++v)
-                {
-                  Scene s      = variants[v];
-                  auto &active = s.parameters.boundary_conditions.active_node;
-                  active.tip_radius = radius;
-                  // The scene's sphere stays a sphere; otherwise a finite
-                  // radius is a glued tip.
-                  if (active.tip != Parameters::ActiveNode::Tip::sphere)
-                    active.tip = radius > 0 ?
-                                   Parameters::ActiveNode::Tip::glued_nodes :
-                                   Parameters::ActiveNode::Tip::point;
-                  else if (!(radius > 0))
-                    active.tip = Parameters::ActiveNode::Tip::point;
-                  const Body body(s);
-                  forces.push_back(direct_solves(
-                    body,
-                    paths,
-                    std::min<unsigned>(n_disc, positions.size()),
-                    p0.nonlinear_solver.residual_tolerance,
-                    &times[v],
-                    progress,
-                    cost[v],
-                    knob + " " + names[v] +
-                      (radius > 0 ? ", tip " + mm(radius) : ", point probe")));
-                }
-              const auto &finest = forces.back();
-              for (unsigned int v = 0; v < variants.size(); ++v)
-                {
-                  StudyRow row;
-                  row.knob          = knob;
-                  row.value         = names[v];
-                  row.interpolation = "direct";
-                  row.probe = radius > 0 ? "tip " + mm(radius) : "point";
-                  row.h_mm  = 0;
-                  std::vector<double> absolute, relative;
-                  for (std::size_t k = 0; k < finest.size(); ++k)
-                    {
-                      ++row.samples;
-                      if (!finest[k].ok || !forces[v][k].ok)
-                        {
-                          row.failures += !forces[v][k].ok;
-                          continue;
-                        }
-                      ++row.covered;
-                      absolute.push_back(Utilities::distance(forces[v][k].force,
-                                                             finest[k].force));
-                      relative.push_back(
-                        relative_error(forces[v][k].force, finest[k].force));
-                    }
-                  errors(row, absolute, relative);
-                  row.state_ms = 1000 * percentile(times[v], 0.5);
-                  row.states   = times[v].size();
-                  result.rows.push_back(row);
-                }
-              write_csv();
-            }
-        };
+      /** Discretisation knobs: direct solves at the first n_disc positions,
+       * against the finest setting of the knob, with the point probe and
+       * with a rigid tip. */
+      void
+      discretisation(const std::string              &knob,
+                     const std::vector<Scene>       &variants,
+                     const std::vector<std::string> &names,
+                     const std::vector<double>      &cost)
+      {
+        for (const double radius : {0.0, tip})
+          {
+            std::vector<std::vector<Sample>> forces;
+            std::vector<std::vector<double>> times(variants.size());
+            for (unsigned int v = 0; v < variants.size(); ++v)
+              {
+                Scene s      = variants[v];
+                auto &active = s.parameters.boundary_conditions.active_node;
+                active.tip_radius = radius;
+                // The scene's sphere stays a sphere; otherwise a finite
+                // radius is a glued tip.
+                if (active.tip != Parameters::ActiveNode::Tip::sphere)
+                  active.tip = radius > 0 ?
+                                 Parameters::ActiveNode::Tip::glued_nodes :
+                                 Parameters::ActiveNode::Tip::point;
+                else if (!(radius > 0))
+                  active.tip = Parameters::ActiveNode::Tip::point;
+                const Body body(s);
+                forces.push_back(direct_solves(
+                  body,
+                  paths,
+                  std::min<unsigned>(n_disc, positions.size()),
+                  p0.nonlinear_solver.residual_tolerance,
+                  &times[v],
+                  *progress,
+                  cost[v],
+                  knob + " " + names[v] +
+                    (radius > 0 ? ", tip " + mm(radius) : ", point probe")));
+              }
+            const auto &finest = forces.back();
+            for (unsigned int v = 0; v < variants.size(); ++v)
+              {
+                StudyRow row;
+                row.knob          = knob;
+                row.value         = names[v];
+                row.interpolation = "direct";
+                row.probe         = radius > 0 ? "tip " + mm(radius) : "point";
+                row.h_mm          = 0;
+                std::vector<double> absolute, relative;
+                for (std::size_t k = 0; k < finest.size(); ++k)
+                  {
+                    ++row.samples;
+                    if (!finest[k].ok || !forces[v][k].ok)
+                      {
+                        row.failures += !forces[v][k].ok;
+                        continue;
+                      }
+                    ++row.covered;
+                    absolute.push_back(
+                      Utilities::distance(forces[v][k].force, finest[k].force));
+                    relative.push_back(
+                      relative_error(forces[v][k].force, finest[k].force));
+                  }
+                errors(row, absolute, relative);
+                row.state_ms = 1000 * percentile(times[v], 0.5);
+                row.states   = times[v].size();
+                result.rows.push_back(row);
+              }
+            write_csv();
+          }
+      }
+
+      void
+      measure_discretisation_knobs()
+      {
         if (finer && !skipped("mesh"))
           discretisation("mesh",
                          {scene, *finer},
@@ -1088,32 +1191,36 @@ namespace palpate
               discretisation("element", {scene, p2}, {low, high}, {1, p2_cost});
           }
       }
-    catch (const StudyCut &cut)
+
+      void
+      say_if_cut_short()
       {
-        result.stopped     = cut.why;
-        result.stop_signal = stop.signal_number();
+        if (!result.stopped.empty())
+          out << "\nThe study ended early: " << result.stopped << " after "
+              << fixed(seconds_since(study_start), 0) << " s."
+              << (result.rows.empty() ?
+                    std::string() :
+                    " What it measured until then follows (" +
+                      std::to_string(result.rows.size()) +
+                      " rows); the knobs and values not reached are not in it, "
+                      "and the recommendation is among the rows measured.")
+              << "\n";
       }
-    progress.finish();
-    if (!result.stopped.empty())
-      out << "\nThe study ended early: " << result.stopped << " after "
-          << fixed(seconds_since(study_start), 0) << " s."
-          << (result.rows.empty() ?
-                std::string() :
-                " What it measured until then follows (" +
-                  std::to_string(result.rows.size()) +
-                  " rows); the knobs and values not reached are not in it, "
-                  "and the recommendation is among the rows measured.")
-          << "\n";
-    const auto reference_line = [&] {
-      return reference.empty() ? "the " + std::to_string(positions.size()) +
-                                   " reference solves did not finish.\n" :
-                                 std::to_string(n_reference) + " of " +
-                                   std::to_string(positions.size()) +
-                                   " reference solves converged.\n";
-    };
-    // Nothing measured (cut short during the reference solves, or every
-    // knob skipped): no table, and no recommendation made of no rows.
-    if (result.rows.empty())
+
+      std::string
+      reference_line() const
+      {
+        return reference.empty() ? "the " + std::to_string(positions.size()) +
+                                     " reference solves did not finish.\n" :
+                                   std::to_string(n_reference) + " of " +
+                                     std::to_string(positions.size()) +
+                                     " reference solves converged.\n";
+      }
+
+      /** Nothing measured (cut short during the reference solves, or every
+       * knob skipped): no table, and no recommendation made of no rows. */
+      StudyResult
+      nothing_measured()
       {
         out << "\nNothing was measured, so there is no table and no "
                "recommendation"
@@ -1134,212 +1241,284 @@ namespace palpate
         return result;
       }
 
-    // --- The discretisation error of the scene's own mesh and element,
-    // for the scene's own probe: the largest p95 difference to the finer
-    // variant of either knob. The grid knobs measure interpolation and
-    // tolerance against direct solves on the *same* discretisation; the
-    // force the device renders is off by both. A point probe has none:
-    // its force does not converge as the mesh is refined.
-    const bool point_probe =
-      !(p0.boundary_conditions.active_node.tip_radius > 0);
-    if (!point_probe)
-      for (const std::string knob : {"mesh", "element"})
-        {
-          // The knob's rows for this probe: the scene's first, the finest
-          // (the reference) last.
-          std::vector<const StudyRow *> rows;
-          for (const auto &row : result.rows)
-            if (row.knob == knob && row.probe == "tip " + mm(tip))
-              rows.push_back(&row);
-          if (rows.size() >= 2 && rows.front()->covered > 0 &&
-              rows.front()->err_p95_pct > result.discretization_pct)
+      /** The discretisation error of the scene's own mesh and element. */
+      void
+      bound_discretisation_error()
+      {
+        // --- The discretisation error of the scene's own mesh and element,
+        // for the scene's own probe: the largest p95 difference to the finer
+        // variant of either knob. The grid knobs measure interpolation and
+        // tolerance against direct solves on the *same* discretisation; the
+        // force the device renders is off by both. A point probe has none:
+        // its force does not converge as the mesh is refined.
+        point_probe = !(p0.boundary_conditions.active_node.tip_radius > 0);
+        if (!point_probe)
+          for (const std::string knob : {"mesh", "element"})
             {
-              result.discretization_pct     = rows.front()->err_p95_pct;
-              result.discretization_against = knob + " " + rows.front()->value +
-                                              " against " + rows.back()->value;
+              // The knob's rows for this probe: the scene's first, the finest
+              // (the reference) last.
+              std::vector<const StudyRow *> rows;
+              for (const auto &row : result.rows)
+                if (row.knob == knob && row.probe == "tip " + mm(tip))
+                  rows.push_back(&row);
+              if (rows.size() >= 2 && rows.front()->covered > 0 &&
+                  rows.front()->err_p95_pct > result.discretization_pct)
+                {
+                  result.discretization_pct = rows.front()->err_p95_pct;
+                  result.discretization_against =
+                    knob + " " + rows.front()->value + " against " +
+                    rows.back()->value;
+                }
             }
-        }
-
-    // --- The recommendation: the fastest grid-knob setting whose p95
-    // force error, plus the discretisation error where it is known, is
-    // below the threshold and that covers 95 % of the positions.
-    const double budget =
-      result.threshold_pct - std::max(0.0, result.discretization_pct);
-    for (unsigned int r = 0; r < result.rows.size(); ++r)
-      {
-        const auto &row = result.rows[r];
-        if (!passes(row, budget))
-          continue;
-        if (result.recommended < 0 ||
-            row.speed_mm_s > result.rows[result.recommended].speed_mm_s)
-          result.recommended = r;
       }
 
-    // --- Tables.
-    const auto print_grid_table = [&](const std::string &knob,
-                                      const std::string &title) {
-      bool any = false;
-      for (const auto &row : result.rows)
-        any = any || row.knob == knob;
-      if (!any)
-        return;
-      out << "\n" << title << "\n";
-      out << "| " << std::left << std::setw(10) << knob
-          << " | interpolation | covered | force error mean / p95 / max (%) "
-             "| max (N) | shape (mm) | state (ms) | states/cm | region: "
-             "states, precompute (s), MiB | speed (mm/s) |\n";
-      out << "|---|---|---|---|---|---|---|---|---|---|\n";
-      for (unsigned int r = 0; r < result.rows.size(); ++r)
-        {
-          const auto &row = result.rows[r];
-          if (row.knob != knob)
-            continue;
-          out << "| " << std::setw(10) << row.value << " | " << std::setw(13)
-              << row.interpolation << " | " << row.covered << "/" << row.samples
-              << " | " << fixed(row.err_mean_pct, 2) << " / "
-              << fixed(row.err_p95_pct, 2) << " / " << fixed(row.err_max_pct, 2)
-              << " | " << fixed(row.err_max_N, 4) << " | "
-              << (row.shape_err_mm >= 0 ? fixed(row.shape_err_mm, 3) : "-")
-              << " | " << fixed(row.state_ms, 1) << " | "
-              << fixed(row.states_per_cm, 1) << " | " << row.region_states
-              << ", " << fixed(row.precompute_s, 1) << ", "
-              << fixed(row.memory_MiB, 1) << " | " << fixed(row.speed_mm_s, 0)
-              << (int(r) == result.recommended ? " (recommended)" : "")
-              << " |\n";
-        }
-    };
-    print_grid_table("grid",
-                     "Grid spacing and interpolation (the scene's "
-                     "tolerance and staging):");
-    print_grid_table("tolerance",
-                     "Newton residual tolerance (grid spacing " + mm(h0) +
-                       "):");
-    print_grid_table("increment",
-                     "Staging: longest increment (grid spacing " + mm(h0) +
-                       "):");
-    print_grid_table("combined",
-                     "Together: the fastest grid setting that passes, with "
-                     "the loosest tolerance that passes:");
-    for (const std::string knob : {"mesh", "element"})
+      void
+      recommend()
       {
-        bool any = false;
-        for (const auto &row : result.rows)
-          any = any || row.knob == knob;
-        if (!any)
-          continue;
-        out << "\n"
-            << (knob == "mesh" ? "Mesh resolution" : "Element order")
-            << ": direct solves at "
-            << std::min<unsigned>(n_disc, positions.size())
-            << " positions, against the finest (the last row of each probe):\n";
-        out << "| " << knob
-            << " | probe | converged | force difference mean / p95 / max (%) "
-               "| max (N) | state (ms) |\n|---|---|---|---|---|---|\n";
-        for (const auto &row : result.rows)
-          if (row.knob == knob)
-            out << "| " << row.value << " | " << row.probe << " | "
-                << row.samples - row.failures << "/" << row.samples << " | "
-                << fixed(row.err_mean_pct, 2) << " / "
-                << fixed(row.err_p95_pct, 2) << " / "
-                << fixed(row.err_max_pct, 2) << " | " << fixed(row.err_max_N, 4)
-                << " | " << fixed(row.state_ms, 1) << " |\n";
-        if (knob == "mesh")
-          out << "A point probe has no mesh-converged force (a point load in "
-                 "3-D has infinite compliance): compare the point rows with "
-                 "the tip rows.\n";
-      }
-
-    out << "\nDiscretisation error (the scene's mesh and element, its "
-           "probe, p95):\n  ";
-    if (point_probe)
-      out << "not bounded: a point probe's force does not converge as the "
-             "mesh is refined (Boundary conditions / Active node / Tip = "
-             "sphere gives one that does).\n";
-    else if (result.discretization_pct >= 0)
-      out << fixed(result.discretization_pct, 2) << " % ("
-          << result.discretization_against
-          << (budget > 0 ?
-                "); the recommendation keeps interpolation and tolerance "
-                "within " +
-                  fixed(budget, 2) + " % so that the total stays within " +
-                  fixed(result.threshold_pct, 1) + " %.\n" :
-                "), which alone exceeds " + fixed(result.threshold_pct, 1) +
-                  " %.\n");
-    else
-      out << "not measured (no finer mesh or element to compare with).\n";
-
-    out << "\nRecommendation (fastest setting with p95 force error <= "
-        << result.threshold_pct
-        << " %, half the human force discrimination threshold"
-        << (result.discretization_pct >= 0 ? ", discretisation included" :
-                                             std::string())
-        << "):\n";
-    if (result.recommended >= 0)
-      {
-        const auto &row = result.rows[result.recommended];
-        out << "  " << row.knob << " " << row.value << ", " << row.interpolation
-            << ", h = " << row.h_mm << " mm: p95 force error "
-            << fixed(row.err_p95_pct, 2) << " %"
-            << (result.discretization_pct >= 0 ?
-                  " (total with the discretisation: " +
-                    fixed(row.err_p95_pct + result.discretization_pct, 2) +
-                    " %)" :
-                  std::string())
-            << ", " << fixed(row.state_ms, 1) << " ms per state, about "
-            << fixed(row.speed_mm_s, 0) << " mm/s straight-line speed with "
-            << workers << " worker(s).\n"
-            << "  In the scene: State space / Grid spacing = "
-            << row.h_mm / 1000 << ", Interpolation = "
-            << (row.interpolation == "Hermite" ? "tricubic Hermite" :
-                                                 "trilinear");
-        if (row.residual_tolerance != p0.nonlinear_solver.residual_tolerance)
-          out << "; Nonlinear solver / Residual tolerance = "
-              << row.residual_tolerance;
-        if (row.max_increment != p0.nonlinear_solver.max_increment_length)
-          out << "; Nonlinear solver / Maximum increment length = "
-              << row.max_increment;
-        out << ".\n";
-      }
-    else
-      out << "  none of the settings keeps the p95 error below "
-          << result.threshold_pct << " % on 95 % of the positions"
-          << (result.discretization_pct >= result.threshold_pct ?
-                ": the discretisation alone is off by " +
-                  fixed(result.discretization_pct, 2) +
-                  " %; use a finer mesh or element.\n" :
-                ": use a finer grid or Hermite.\n");
-
-    // --- CSV, with the recommendation marked.
-    write_csv();
-    out << "\nThe table as CSV: " << result.csv_file << "\n";
-
-    // --- The Pareto plot, by the plotting script of the source tree
-    // (matplotlib), next to the CSV.
-    if (options.plot)
-      {
-        const std::filesystem::path script =
-          std::filesystem::path(PALPATE_SOURCE_DIR) / "doc" / "images" /
-          "accuracy_pareto.py";
-        std::filesystem::path png(result.csv_file);
-        png.replace_extension(".png");
-        const std::string command = "/usr/bin/python3 '" + script.string() +
-                                    "' '" + result.csv_file + "' '" +
-                                    png.string() + "'";
-        if (std::filesystem::exists(script) &&
-            std::system((command + " > /dev/null 2>&1").c_str()) == 0)
+        // --- The recommendation: the fastest grid-knob setting whose p95
+        // force error, plus the discretisation error where it is known, is
+        // below the threshold and that covers 95 % of the positions.
+        budget =
+          result.threshold_pct - std::max(0.0, result.discretization_pct);
+        for (unsigned int r = 0; r < result.rows.size(); ++r)
           {
-            result.plot_file = png.string();
-            out << "The Pareto plot (force error against speed): "
-                << result.plot_file << "\n";
+            const auto &row = result.rows[r];
+            if (!passes(row, budget))
+              continue;
+            if (result.recommended < 0 ||
+                row.speed_mm_s > result.rows[result.recommended].speed_mm_s)
+              result.recommended = r;
+          }
+      }
+
+      void
+      print_tables() const
+      {
+        // --- Tables.
+        const auto print_grid_table = [&](const std::string &knob,
+                                          const std::string &title) {
+          bool any = false;
+          for (const auto &row : result.rows)
+            any = any || row.knob == knob;
+          if (!any)
+            return;
+          out << "\n" << title << "\n";
+          out
+            << "| " << std::left << std::setw(10) << knob
+            << " | interpolation | covered | force error mean / p95 / max (%) "
+               "| max (N) | shape (mm) | state (ms) | states/cm | region: "
+               "states, precompute (s), MiB | speed (mm/s) |\n";
+          out << "|---|---|---|---|---|---|---|---|---|---|\n";
+          for (unsigned int r = 0; r < result.rows.size(); ++r)
+            {
+              const auto &row = result.rows[r];
+              if (row.knob != knob)
+                continue;
+              out << "| " << std::setw(10) << row.value << " | "
+                  << std::setw(13) << row.interpolation << " | " << row.covered
+                  << "/" << row.samples << " | " << fixed(row.err_mean_pct, 2)
+                  << " / " << fixed(row.err_p95_pct, 2) << " / "
+                  << fixed(row.err_max_pct, 2) << " | "
+                  << fixed(row.err_max_N, 4) << " | "
+                  << (row.shape_err_mm >= 0 ? fixed(row.shape_err_mm, 3) : "-")
+                  << " | " << fixed(row.state_ms, 1) << " | "
+                  << fixed(row.states_per_cm, 1) << " | " << row.region_states
+                  << ", " << fixed(row.precompute_s, 1) << ", "
+                  << fixed(row.memory_MiB, 1) << " | "
+                  << fixed(row.speed_mm_s, 0)
+                  << (int(r) == result.recommended ? " (recommended)" : "")
+                  << " |\n";
+            }
+        };
+        print_grid_table("grid",
+                         "Grid spacing and interpolation (the scene's "
+                         "tolerance and staging):");
+        print_grid_table("tolerance",
+                         "Newton residual tolerance (grid spacing " + mm(h0) +
+                           "):");
+        print_grid_table("increment",
+                         "Staging: longest increment (grid spacing " + mm(h0) +
+                           "):");
+        print_grid_table("combined",
+                         "Together: the fastest grid setting that passes, with "
+                         "the loosest tolerance that passes:");
+        for (const std::string knob : {"mesh", "element"})
+          {
+            bool any = false;
+            for (const auto &row : result.rows)
+              any = any || row.knob == knob;
+            if (!any)
+              continue;
+            out
+              << "\n"
+              << (knob == "mesh" ? "Mesh resolution" : "Element order")
+              << ": direct solves at "
+              << std::min<unsigned>(n_disc, positions.size())
+              << " positions, against the finest (the last row of each probe):\n";
+            out
+              << "| " << knob
+              << " | probe | converged | force difference mean / p95 / max (%) "
+                 "| max (N) | state (ms) |\n|---|---|---|---|---|---|\n";
+            for (const auto &row : result.rows)
+              if (row.knob == knob)
+                out << "| " << row.value << " | " << row.probe << " | "
+                    << row.samples - row.failures << "/" << row.samples << " | "
+                    << fixed(row.err_mean_pct, 2) << " / "
+                    << fixed(row.err_p95_pct, 2) << " / "
+                    << fixed(row.err_max_pct, 2) << " | "
+                    << fixed(row.err_max_N, 4) << " | "
+                    << fixed(row.state_ms, 1) << " |\n";
+            if (knob == "mesh")
+              out
+                << "A point probe has no mesh-converged force (a point load in "
+                   "3-D has infinite compliance): compare the point rows with "
+                   "the tip rows.\n";
+          }
+      }
+
+      void
+      print_discretisation_error_and_recommendation() const
+      {
+        out << "\nDiscretisation error (the scene's mesh and element, its "
+               "probe, p95):\n  ";
+        if (point_probe)
+          out << "not bounded: a point probe's force does not converge as the "
+                 "mesh is refined (Boundary conditions / Active node / Tip = "
+                 "sphere gives one that does).\n";
+        else if (result.discretization_pct >= 0)
+          out << fixed(result.discretization_pct, 2) << " % ("
+              << result.discretization_against
+              << (budget > 0 ?
+                    "); the recommendation keeps interpolation and tolerance "
+                    "within " +
+                      fixed(budget, 2) + " % so that the total stays within " +
+                      fixed(result.threshold_pct, 1) + " %.\n" :
+                    "), which alone exceeds " + fixed(result.threshold_pct, 1) +
+                      " %.\n");
+        else
+          out << "not measured (no finer mesh or element to compare with).\n";
+
+        out << "\nRecommendation (fastest setting with p95 force error <= "
+            << result.threshold_pct
+            << " %, half the human force discrimination threshold"
+            << (result.discretization_pct >= 0 ? ", discretisation included" :
+                                                 std::string())
+            << "):\n";
+        if (result.recommended >= 0)
+          {
+            const auto &row = result.rows[result.recommended];
+            out << "  " << row.knob << " " << row.value << ", "
+                << row.interpolation << ", h = " << row.h_mm
+                << " mm: p95 force error " << fixed(row.err_p95_pct, 2) << " %"
+                << (result.discretization_pct >= 0 ?
+                      " (total with the discretisation: " +
+                        fixed(row.err_p95_pct + result.discretization_pct, 2) +
+                        " %)" :
+                      std::string())
+                << ", " << fixed(row.state_ms, 1) << " ms per state, about "
+                << fixed(row.speed_mm_s, 0) << " mm/s straight-line speed with "
+                << workers << " worker(s).\n"
+                << "  In the scene: State space / Grid spacing = "
+                << row.h_mm / 1000 << ", Interpolation = "
+                << (row.interpolation == "Hermite" ? "tricubic Hermite" :
+                                                     "trilinear");
+            if (row.residual_tolerance !=
+                p0.nonlinear_solver.residual_tolerance)
+              out << "; Nonlinear solver / Residual tolerance = "
+                  << row.residual_tolerance;
+            if (row.max_increment != p0.nonlinear_solver.max_increment_length)
+              out << "; Nonlinear solver / Maximum increment length = "
+                  << row.max_increment;
+            out << ".\n";
           }
         else
-          out << "No Pareto plot: it needs python3 with matplotlib (Debian: "
-                 "apt install python3-matplotlib); then run "
-              << command << "\n";
+          out << "  none of the settings keeps the p95 error below "
+              << result.threshold_pct << " % on 95 % of the positions"
+              << (result.discretization_pct >= result.threshold_pct ?
+                    ": the discretisation alone is off by " +
+                      fixed(result.discretization_pct, 2) +
+                      " %; use a finer mesh or element.\n" :
+                    ": use a finer grid or Hermite.\n");
       }
-    result.seconds = seconds_since(study_start);
-    out << "Study time " << fixed(result.seconds, 0) << " s; "
-        << reference_line();
-    return result;
+
+      /** The CSV with the recommendation marked, and the Pareto plot. */
+      void
+      write_csv_and_plot()
+      {
+        // --- CSV, with the recommendation marked.
+        write_csv();
+        out << "\nThe table as CSV: " << result.csv_file << "\n";
+
+        // --- The Pareto plot, by the plotting script of the source tree
+        // (matplotlib), next to the CSV.
+        if (options.plot)
+          {
+            const std::filesystem::path script =
+              std::filesystem::path(PALPATE_SOURCE_DIR) / "doc" / "images" /
+              "accuracy_pareto.py";
+            std::filesystem::path png(result.csv_file);
+            png.replace_extension(".png");
+            const std::string command = "/usr/bin/python3 '" + script.string() +
+                                        "' '" + result.csv_file + "' '" +
+                                        png.string() + "'";
+            if (std::filesystem::exists(script) &&
+                std::system((command + " > /dev/null 2>&1").c_str()) == 0)
+              {
+                result.plot_file = png.string();
+                out << "The Pareto plot (force error against speed): "
+                    << result.plot_file << "\n";
+              }
+            else
+              out
+                << "No Pareto plot: it needs python3 with matplotlib (Debian: "
+                   "apt install python3-matplotlib); then run "
+                << command << "\n";
+          }
+      }
+
+      std::ostream                    &out;
+      const Scene                     &scene;
+      const StudyOptions              &options;
+      const Parameters::AllParameters &p0;
+      const bool                       quick;
+      const unsigned int               workers;
+      const Clock::time_point          study_start = Clock::now();
+      StudyResult                      result;
+      // The HIP positions and their paths.
+      unsigned int                     n_paths = 0;
+      double                           radius  = 0;
+      std::vector<std::vector<Point3>> paths;
+      std::vector<Point3>              positions;
+      // The knobs' values.
+      double               h0 = 0;
+      std::vector<double>  spacings, tolerances, increments;
+      std::optional<Scene> finer;
+      std::string          coarse_name = "scene mesh", finer_name;
+      // The probe of the discretisation knobs, how many positions they
+      // solve at, and whether the element knob runs.
+      double       tip     = 0;
+      unsigned int n_disc  = 0;
+      bool         p2_knob = false;
+      // Relative cost of a direct solve on the finer mesh and with P2.
+      static constexpr double    finer_cost = 12, p2_cost = 20;
+      double                     total = 0;
+      std::optional<Body>        base;
+      std::optional<StopRequest> stop;
+      std::optional<Progress>    progress;
+      std::vector<Sample>        reference;
+      unsigned int               n_reference = 0;
+      std::vector<int>           node_of_dof;
+      bool                       point_probe = true;
+      double                     budget      = 0;
+    };
+  } // namespace
+
+
+
+  StudyResult
+  run_study(std::ostream &out, const Scene &scene, const StudyOptions &options)
+  {
+    Study study(out, scene, options);
+    return study.run();
   }
 } // namespace palpate
