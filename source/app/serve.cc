@@ -1291,6 +1291,22 @@ namespace palpate
     static constexpr double request_limit = 3;
     GuardedServer           server{request_limit};
     std::thread             http;
+
+    /** The steps of LiveServer's constructor. */
+    void
+    guard_requests();
+    void
+    add_reads();
+    void
+    add_device_requests();
+    void
+    add_material_change();
+    void
+    add_active_node_change();
+    void
+    limit_connections();
+    void
+    listen(const std::string &host, const int port);
   };
 
 
@@ -1302,7 +1318,37 @@ namespace palpate
                          std::ostream      *log)
     : impl(std::make_unique<Impl>(scene, max_speed, log))
   {
-    Impl &s      = *impl;
+    Impl &s = *impl;
+    s.guard_requests();
+    s.add_reads();
+    s.add_device_requests();
+    // On-the-fly changes (the paper's): a material constant, as
+    // "ENTRY=VALUE" of the scene's model; another active node, as "node N"
+    // (N as the mesh file numbers it, as the scene's Active node / Node id
+    // and the scene report do) or as the point "x,y,z" (m, mesh
+    // coordinates) whose nearest surface node it becomes.
+    s.add_material_change();
+    s.add_active_node_change();
+    s.limit_connections();
+    s.listen(host, port);
+    s.interaction.attach();
+    // The browser's mouse runs in the common haptic loop, as every device
+    // does (real-time priority, statistics, force log), until the view
+    // stops.
+    s.loop = std::make_unique<HapticLoop>(
+      s.interaction, s.device, s.rate, HapticLoop::continuous, s.force_log);
+    s.loop->start(HapticLoop::continuous);
+    s.loop->start_motion();
+    s.http = std::thread([&s] { s.server.listen_after_bind(); });
+  }
+
+
+
+  /** Who may ask, checked before any handler; the answers' own headers. */
+  void
+  LiveServer::Impl::guard_requests()
+  {
+    Impl &s      = *this;
     auto &server = s.server;
     // Before any handler, and before a POST's body is read: who may ask
     // (Impl::refusal()). A refused client's connection is closed (the body
@@ -1323,6 +1369,16 @@ namespace palpate
     // an image (no-cors), nor guessed as another type than it says.
     server.set_default_headers({{"Cross-Origin-Resource-Policy", "same-origin"},
                                 {"X-Content-Type-Options", "nosniff"}});
+  }
+
+
+
+  /** The page, three.js, the model (/mesh, /material) and its frames. */
+  void
+  LiveServer::Impl::add_reads()
+  {
+    Impl &s      = *this;
+    auto &server = s.server;
     server.Get("/", [&s](const httplib::Request &, httplib::Response &res) {
       // The page holds the run's token: not kept by the browser's cache
       // (a page from an earlier run would send a stale one), and never
@@ -1363,6 +1419,16 @@ namespace palpate
                [&s](const httplib::Request &, httplib::Response &res) {
                  res.set_content(s.frame(), "application/json");
                });
+  }
+
+
+
+  /** The probe's target, attach, detach and back to rest. */
+  void
+  LiveServer::Impl::add_device_requests()
+  {
+    Impl &s      = *this;
+    auto &server = s.server;
     server.Post(
       "/hip", [&s](const httplib::Request &req, httplib::Response &res) {
         // "x,y,z": the target displacement from rest (m). Anything else, or
@@ -1387,11 +1453,44 @@ namespace palpate
                             "text/plain");
           }
       });
-    // On-the-fly changes (the paper's): a material constant, as
-    // "ENTRY=VALUE" of the scene's model; another active node, as "node N"
-    // (N as the mesh file numbers it, as the scene's Active node / Node id
-    // and the scene report do) or as the point "x,y,z" (m, mesh
-    // coordinates) whose nearest surface node it becomes.
+    // Attach and detach are recorded when they change something (a
+    // second d changes nothing).
+    server.Post("/attach",
+                [&s](const httplib::Request &, httplib::Response &res) {
+                  std::lock_guard<std::mutex> lock(s.control_mutex);
+                  if (!s.interaction.attached())
+                    {
+                      s.interaction.attach();
+                      s.record("attached");
+                    }
+                  res.set_content("ok", "text/plain");
+                });
+    server.Post("/detach",
+                [&s](const httplib::Request &, httplib::Response &res) {
+                  std::lock_guard<std::mutex> lock(s.control_mutex);
+                  if (s.interaction.attached())
+                    {
+                      s.interaction.detach();
+                      s.record("detached (the force fades to zero)");
+                    }
+                  res.set_content("ok", "text/plain");
+                });
+    server.Post("/reset",
+                [&s](const httplib::Request &, httplib::Response &res) {
+                  s.device.set_target({{0, 0, 0}});
+                  s.record("the probe sent back to rest");
+                  res.set_content("ok", "text/plain");
+                });
+  }
+
+
+
+  /** A material constant of the scene's model, "ENTRY=VALUE". */
+  void
+  LiveServer::Impl::add_material_change()
+  {
+    Impl &s      = *this;
+    auto &server = s.server;
     server.Post(
       "/material", [&s](const httplib::Request &req, httplib::Response &res) {
         const auto eq = req.body.find('=');
@@ -1466,6 +1565,16 @@ namespace palpate
                           "refused: " + refused,
                         "text/plain");
       });
+  }
+
+
+
+  /** Another active node: "node N" or the point "x,y,z". */
+  void
+  LiveServer::Impl::add_active_node_change()
+  {
+    Impl &s      = *this;
+    auto &server = s.server;
     server.Post(
       "/active", [&s](const httplib::Request &req, httplib::Response &res) {
         std::string refused;
@@ -1561,34 +1670,17 @@ namespace palpate
         res.status = 400;
         res.set_content("refused: " + refused, "text/plain");
       });
-    // Attach and detach are recorded when they change something (a
-    // second d changes nothing).
-    server.Post("/attach",
-                [&s](const httplib::Request &, httplib::Response &res) {
-                  std::lock_guard<std::mutex> lock(s.control_mutex);
-                  if (!s.interaction.attached())
-                    {
-                      s.interaction.attach();
-                      s.record("attached");
-                    }
-                  res.set_content("ok", "text/plain");
-                });
-    server.Post("/detach",
-                [&s](const httplib::Request &, httplib::Response &res) {
-                  std::lock_guard<std::mutex> lock(s.control_mutex);
-                  if (s.interaction.attached())
-                    {
-                      s.interaction.detach();
-                      s.record("detached (the force fades to zero)");
-                    }
-                  res.set_content("ok", "text/plain");
-                });
-    server.Post("/reset",
-                [&s](const httplib::Request &, httplib::Response &res) {
-                  s.device.set_target({{0, 0, 0}});
-                  s.record("the probe sent back to rest");
-                  res.set_content("ok", "text/plain");
-                });
+  }
+
+
+
+  /** What a request may be, and how long a connection may take. */
+  void
+  LiveServer::Impl::limit_connections()
+  {
+    Impl &s      = *this;
+    auto &server = s.server;
+    server.set_payload_max_length(4096);
     server.set_payload_max_length(4096);
     // Slow or idle clients cannot keep the page waiting. Each connection
     // has a thread of its own (ConnectionThreads: a browser keeps several
@@ -1629,8 +1721,19 @@ namespace palpate
       setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
       s.listening = sock;
     });
-    s.bound = port == 0 ? server.bind_to_any_port(host) :
-                          (server.bind_to_port(host, port) ? port : -1);
+  }
+
+
+
+  /** Bind (a port in use is an error that says so), listen with a long
+   * queue, and the names and address requests may use. */
+  void
+  LiveServer::Impl::listen(const std::string &host, const int port)
+  {
+    Impl &s      = *this;
+    auto &server = s.server;
+    s.bound      = port == 0 ? server.bind_to_any_port(host) :
+                               (server.bind_to_port(host, port) ? port : -1);
     // cpp-httplib listens with a backlog of 5 connections: the kernel drops
     // the next ones that arrive before they are accepted, and their
     // clients try again after 1 s (then 3 s, 7 s). A burst of connections
@@ -1659,15 +1762,6 @@ namespace palpate
                  "127.0.0.1";
       }
     s.address = "http://" + here + ":" + std::to_string(s.bound) + "/";
-    s.interaction.attach();
-    // The browser's mouse runs in the common haptic loop, as every device
-    // does (real-time priority, statistics, force log), until the view
-    // stops.
-    s.loop = std::make_unique<HapticLoop>(
-      s.interaction, s.device, s.rate, HapticLoop::continuous, s.force_log);
-    s.loop->start(HapticLoop::continuous);
-    s.loop->start_motion();
-    s.http = std::thread([&s] { s.server.listen_after_bind(); });
   }
 
 
