@@ -451,6 +451,229 @@ namespace palpate
       return ExitStatus::success;
     }
 
+    /** palpate solve SCENE.prm [--to X,Y,Z]: a static solve. */
+    int
+    run_solve_command(const std::vector<std::string> &args,
+                      const std::vector<std::string> &settings,
+                      std::ostream                   &out)
+    {
+      if (args.size() < 2)
+        throw InputError("command line",
+                         0,
+                         "solve",
+                         "'solve' needs a scene file",
+                         "run 'palpate solve SCENE.prm [--to X,Y,Z]'.");
+      std::optional<Utilities::Point3> target;
+      for (unsigned int i = 2; i < args.size(); ++i)
+        if (args[i] == "--to" && i + 1 < args.size())
+          {
+            try
+              {
+                target = Utilities::parse_point(args[++i]);
+              }
+            catch (const std::invalid_argument &e)
+              {
+                throw InputError("command line",
+                                 0,
+                                 "--to " + args[i],
+                                 e.what(),
+                                 "give the displacement in metres as "
+                                 "X,Y,Z, e.g. --to 0,0,-0.02.");
+              }
+          }
+        else
+          throw unexpected(args[i]);
+      return run_scene(args[1], settings, target, true, out);
+    }
+
+
+
+    /** palpate serve SCENE.prm [--port P] [--host H]: the live view. */
+    int
+    run_serve_command(const std::vector<std::string> &args,
+                      const std::vector<std::string> &settings,
+                      std::ostream                   &out)
+    {
+      if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
+        throw InputError("command line",
+                         0,
+                         "serve",
+                         "'serve' needs a scene file",
+                         "run 'palpate serve SCENE.prm [--port P]'.");
+      // Under mpirun the servers read this scene too and now wait for
+      // its engine: released however this ends, a bad option included.
+      const auto release =
+        release_servers_at_end(Scene::read(args[1], settings));
+      int         port = 8080;
+      std::string host = "127.0.0.1";
+      for (unsigned int i = 2; i < args.size(); ++i)
+        if (args[i] == "--port" && i + 1 < args.size())
+          port = static_cast<int>(
+            number_argument("--port", args[++i], 1, 65535, "8080"));
+        else if (args[i] == "--host" && i + 1 < args.size())
+          {
+            host = args[++i];
+            // An address or a host name: letters, digits, '.', '-',
+            // and ':' '[' ']' for IPv6. An empty one would listen on
+            // every interface without saying so.
+            const bool valid =
+              !host.empty() && host.size() <= 253 &&
+              std::all_of(host.begin(), host.end(), [](const char c) {
+                return std::isalnum(static_cast<unsigned char>(c)) ||
+                       c == '.' || c == '-' || c == ':' || c == '[' || c == ']';
+              });
+            if (!valid)
+              throw InputError(
+                "command line",
+                0,
+                "--host '" + host.substr(0, 80) + "'",
+                host.empty() ? "the address to listen on is empty" :
+                               "not an address or a host name (letters, "
+                               "digits, '.', '-'; IPv6 in brackets)",
+                "give 127.0.0.1 (this machine only, the default), "
+                "0.0.0.0 (every interface) or one of this machine's "
+                "addresses.");
+            // An IPv6 address as a URL writes it, [::1]: the address
+            // itself is inside the brackets.
+            if (host.size() > 2 && host.front() == '[' && host.back() == ']')
+              host = host.substr(1, host.size() - 2);
+          }
+        else
+          throw unexpected(args[i]);
+      const Scene scene = read_and_report(args[1], settings, out);
+      return run_serve(out, scene, host, port);
+    }
+
+
+
+    /** palpate precompute SCENE.prm [--radius R]: states into the store. */
+    int
+    run_precompute_command(const std::vector<std::string> &args,
+                           const std::vector<std::string> &settings,
+                           std::ostream                   &out)
+    {
+      if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
+        throw InputError("command line",
+                         0,
+                         "precompute",
+                         "'precompute' needs a scene file",
+                         "run 'palpate precompute SCENE.prm [--radius "
+                         "R]'.");
+      // Under mpirun the servers read this scene too and now wait for
+      // its engine: released however this ends, a bad option included.
+      const auto release =
+        release_servers_at_end(Scene::read(args[1], settings));
+      double radius = 0;
+      for (unsigned int i = 2; i < args.size(); ++i)
+        if (args[i] == "--radius" && i + 1 < args.size())
+          radius = number_argument("--radius", args[++i], 1e-4, 10, "0.05");
+        else
+          throw unexpected(args[i]);
+      const Scene scene = read_and_report(args[1], settings, out);
+      return run_precompute(out, scene, radius);
+    }
+
+
+
+    /** palpate study SCENE.prm [options]: what accuracy costs in time. */
+    int
+    run_study_command(const std::vector<std::string> &args,
+                      const std::vector<std::string> &settings,
+                      std::ostream                   &out)
+    {
+      if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
+        throw InputError("command line",
+                         0,
+                         "study",
+                         "'study' needs a scene file",
+                         "run 'palpate study SCENE.prm [--quick]'.");
+      StudyOptions options;
+      for (unsigned int i = 2; i < args.size(); ++i)
+        {
+          const bool has_value = i + 1 < args.size();
+          if (args[i] == "--quick")
+            options.quick = true;
+          else if (args[i] == "--finer-mesh" && has_value)
+            options.finer_mesh = args[++i];
+          else if (args[i] == "--csv" && has_value)
+            options.csv_file = args[++i];
+          else if (args[i] == "--time-limit" && has_value)
+            options.time_limit =
+              number_argument("--time-limit", args[++i], 1, 7 * 86400, "600");
+          else if (args[i] == "--skip" && has_value)
+            {
+              const std::string           knobs = args[++i];
+              const std::set<std::string> known = {"grid",
+                                                   "tolerance",
+                                                   "increment",
+                                                   "combined",
+                                                   "mesh",
+                                                   "element"};
+              std::stringstream           list(knobs);
+              for (std::string knob; std::getline(list, knob, ',');)
+                {
+                  if (known.count(knob) == 0)
+                    throw InputError(
+                      "command line",
+                      0,
+                      "--skip " + knobs,
+                      "'" + knob + "' is not one of the study's knobs",
+                      "name some of grid, tolerance, increment, "
+                      "combined, mesh, element, separated by commas: "
+                      "e.g. --skip element,mesh.");
+                  options.skip.push_back(knob);
+                }
+            }
+          else if (args[i] == "--samples" && has_value)
+            {
+              const std::string v   = args[++i];
+              std::size_t       end = 0;
+              long              n   = 0;
+              try
+                {
+                  n = std::stol(v, &end);
+                }
+              catch (const std::exception &)
+                {
+                  end = 0;
+                }
+              if (end != v.size() || n < 8 || n > 5000)
+                throw InputError("command line",
+                                 0,
+                                 "--samples " + v,
+                                 "the number of HIP positions must be a "
+                                 "whole number from 8 to 5000",
+                                 "e.g. --samples 240 (the default; 80 "
+                                 "with --quick).");
+              options.samples = static_cast<unsigned int>(n);
+            }
+          else
+            throw unexpected(args[i]);
+        }
+      if (!options.finer_mesh.empty() && !std::ifstream(options.finer_mesh))
+        throw InputError("command line",
+                         0,
+                         "--finer-mesh " + options.finer_mesh,
+                         "the mesh file '" + options.finer_mesh +
+                           "' cannot be read",
+                         "give a finer mesh of the same organ, in the "
+                         "scene's file unit (its Scale factor applies).");
+      const Scene       scene  = read_and_report(args[1], settings, out);
+      const StudyResult result = run_study(out, scene, options);
+      if (result.stop_signal != 0)
+        {
+          out.flush();
+          std::cerr << "\npalpate: the study was " << result.stopped
+                    << "; what it measured was printed and written to "
+                    << result.csv_file << ". Exit status "
+                    << 128 + result.stop_signal << ".\n";
+          return 128 + result.stop_signal;
+        }
+      return ExitStatus::success;
+    }
+
+
+
     int
     dispatch(const std::vector<std::string> &args,
              const std::vector<std::string> &settings,
@@ -501,204 +724,15 @@ namespace palpate
                          "unknown option '" + args[0] + "'",
                          "run 'palpate --help' for the options.");
       if (args[0] == "solve")
-        {
-          if (args.size() < 2)
-            throw InputError("command line",
-                             0,
-                             "solve",
-                             "'solve' needs a scene file",
-                             "run 'palpate solve SCENE.prm [--to X,Y,Z]'.");
-          std::optional<Utilities::Point3> target;
-          for (unsigned int i = 2; i < args.size(); ++i)
-            if (args[i] == "--to" && i + 1 < args.size())
-              {
-                try
-                  {
-                    target = Utilities::parse_point(args[++i]);
-                  }
-                catch (const std::invalid_argument &e)
-                  {
-                    throw InputError("command line",
-                                     0,
-                                     "--to " + args[i],
-                                     e.what(),
-                                     "give the displacement in metres as "
-                                     "X,Y,Z, e.g. --to 0,0,-0.02.");
-                  }
-              }
-            else
-              throw unexpected(args[i]);
-          return run_scene(args[1], settings, target, true, out);
-        }
+        return run_solve_command(args, settings, out);
       if (args[0] == "mesh")
         return run_mesh(args, out);
       if (args[0] == "serve")
-        {
-          if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
-            throw InputError("command line",
-                             0,
-                             "serve",
-                             "'serve' needs a scene file",
-                             "run 'palpate serve SCENE.prm [--port P]'.");
-          // Under mpirun the servers read this scene too and now wait for
-          // its engine: released however this ends, a bad option included.
-          const auto release =
-            release_servers_at_end(Scene::read(args[1], settings));
-          int         port = 8080;
-          std::string host = "127.0.0.1";
-          for (unsigned int i = 2; i < args.size(); ++i)
-            if (args[i] == "--port" && i + 1 < args.size())
-              port = static_cast<int>(
-                number_argument("--port", args[++i], 1, 65535, "8080"));
-            else if (args[i] == "--host" && i + 1 < args.size())
-              {
-                host = args[++i];
-                // An address or a host name: letters, digits, '.', '-',
-                // and ':' '[' ']' for IPv6. An empty one would listen on
-                // every interface without saying so.
-                const bool valid =
-                  !host.empty() && host.size() <= 253 &&
-                  std::all_of(host.begin(), host.end(), [](const char c) {
-                    return std::isalnum(static_cast<unsigned char>(c)) ||
-                           c == '.' || c == '-' || c == ':' || c == '[' ||
-                           c == ']';
-                  });
-                if (!valid)
-                  throw InputError(
-                    "command line",
-                    0,
-                    "--host '" + host.substr(0, 80) + "'",
-                    host.empty() ? "the address to listen on is empty" :
-                                   "not an address or a host name (letters, "
-                                   "digits, '.', '-'; IPv6 in brackets)",
-                    "give 127.0.0.1 (this machine only, the default), "
-                    "0.0.0.0 (every interface) or one of this machine's "
-                    "addresses.");
-                // An IPv6 address as a URL writes it, [::1]: the address
-                // itself is inside the brackets.
-                if (host.size() > 2 && host.front() == '[' &&
-                    host.back() == ']')
-                  host = host.substr(1, host.size() - 2);
-              }
-            else
-              throw unexpected(args[i]);
-          const Scene scene = read_and_report(args[1], settings, out);
-          return run_serve(out, scene, host, port);
-        }
+        return run_serve_command(args, settings, out);
       if (args[0] == "precompute")
-        {
-          if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
-            throw InputError("command line",
-                             0,
-                             "precompute",
-                             "'precompute' needs a scene file",
-                             "run 'palpate precompute SCENE.prm [--radius "
-                             "R]'.");
-          // Under mpirun the servers read this scene too and now wait for
-          // its engine: released however this ends, a bad option included.
-          const auto release =
-            release_servers_at_end(Scene::read(args[1], settings));
-          double radius = 0;
-          for (unsigned int i = 2; i < args.size(); ++i)
-            if (args[i] == "--radius" && i + 1 < args.size())
-              radius = number_argument("--radius", args[++i], 1e-4, 10, "0.05");
-            else
-              throw unexpected(args[i]);
-          const Scene scene = read_and_report(args[1], settings, out);
-          return run_precompute(out, scene, radius);
-        }
+        return run_precompute_command(args, settings, out);
       if (args[0] == "study")
-        {
-          if (args.size() < 2 || args[1].empty() || args[1][0] == '-')
-            throw InputError("command line",
-                             0,
-                             "study",
-                             "'study' needs a scene file",
-                             "run 'palpate study SCENE.prm [--quick]'.");
-          StudyOptions options;
-          for (unsigned int i = 2; i < args.size(); ++i)
-            {
-              const bool has_value = i + 1 < args.size();
-              if (args[i] == "--quick")
-                options.quick = true;
-              else if (args[i] == "--finer-mesh" && has_value)
-                options.finer_mesh = args[++i];
-              else if (args[i] == "--csv" && has_value)
-                options.csv_file = args[++i];
-              else if (args[i] == "--time-limit" && has_value)
-                options.time_limit = number_argument(
-                  "--time-limit", args[++i], 1, 7 * 86400, "600");
-              else if (args[i] == "--skip" && has_value)
-                {
-                  const std::string           knobs = args[++i];
-                  const std::set<std::string> known = {"grid",
-                                                       "tolerance",
-                                                       "increment",
-                                                       "combined",
-                                                       "mesh",
-                                                       "element"};
-                  std::stringstream           list(knobs);
-                  for (std::string knob; std::getline(list, knob, ',');)
-                    {
-                      if (known.count(knob) == 0)
-                        throw InputError(
-                          "command line",
-                          0,
-                          "--skip " + knobs,
-                          "'" + knob + "' is not one of the study's knobs",
-                          "name some of grid, tolerance, increment, "
-                          "combined, mesh, element, separated by commas: "
-                          "e.g. --skip element,mesh.");
-                      options.skip.push_back(knob);
-                    }
-                }
-              else if (args[i] == "--samples" && has_value)
-                {
-                  const std::string v   = args[++i];
-                  std::size_t       end = 0;
-                  long              n   = 0;
-                  try
-                    {
-                      n = std::stol(v, &end);
-                    }
-                  catch (const std::exception &)
-                    {
-                      end = 0;
-                    }
-                  if (end != v.size() || n < 8 || n > 5000)
-                    throw InputError("command line",
-                                     0,
-                                     "--samples " + v,
-                                     "the number of HIP positions must be a "
-                                     "whole number from 8 to 5000",
-                                     "e.g. --samples 240 (the default; 80 "
-                                     "with --quick).");
-                  options.samples = static_cast<unsigned int>(n);
-                }
-              else
-                throw unexpected(args[i]);
-            }
-          if (!options.finer_mesh.empty() && !std::ifstream(options.finer_mesh))
-            throw InputError("command line",
-                             0,
-                             "--finer-mesh " + options.finer_mesh,
-                             "the mesh file '" + options.finer_mesh +
-                               "' cannot be read",
-                             "give a finer mesh of the same organ, in the "
-                             "scene's file unit (its Scale factor applies).");
-          const Scene       scene  = read_and_report(args[1], settings, out);
-          const StudyResult result = run_study(out, scene, options);
-          if (result.stop_signal != 0)
-            {
-              out.flush();
-              std::cerr << "\npalpate: the study was " << result.stopped
-                        << "; what it measured was printed and written to "
-                        << result.csv_file << ". Exit status "
-                        << 128 + result.stop_signal << ".\n";
-              return 128 + result.stop_signal;
-            }
-          return ExitStatus::success;
-        }
+        return run_study_command(args, settings, out);
       if (args.size() > 1)
         throw InputError("command line",
                          0,
