@@ -181,17 +181,17 @@ namespace palpate
     // Gmsh (.msh), format 2.2 and the legacy format 1
     // ------------------------------------------------------------------
 
-    MeshData
-    read_gmsh(const std::string &filename)
+    /**
+     * Read the header of a Gmsh file whose first line is @p line: the
+     * $MeshFormat section, or the legacy format's $NOD line. Returns whether
+     * the file is in the legacy format 1.
+     */
+    bool
+    read_gmsh_header(LineReader        &reader,
+                     const std::string &line,
+                     const std::string &filename,
+                     MeshData          &data)
     {
-      LineReader reader(filename);
-      MeshData   data;
-
-      std::string line;
-      if (!reader.next(line))
-        throw reader.error("the file is empty",
-                           "write the mesh again from Gmsh or TetGen.");
-
       bool legacy = false;
       if (line == "$MeshFormat")
         {
@@ -229,6 +229,182 @@ namespace palpate
                            "$MeshFormat or $NOD",
                            "check the file name and extension (.msh, .vtk, "
                            ".vtu).");
+      return legacy;
+    }
+
+
+
+    /**
+     * Read a node section (after its first line, @p nodes_begin) into
+     * @p data, and the index of each node's tag into @p tags.
+     */
+    void
+    read_gmsh_nodes(LineReader                   &reader,
+                    const std::string            &nodes_begin,
+                    const std::string            &nodes_end,
+                    std::map<long, unsigned int> &tags,
+                    MeshData                     &data)
+    {
+      const long n = parse_number<long>(reader,
+                                        reader.expect("the node count"),
+                                        "node count");
+      for (long i = 0; i < n; ++i)
+        {
+          const auto t = tokens_of(reader.expect("a node"));
+          // The section ended before the count: the header's count
+          // is wrong, not the line.
+          if (!t.empty() && t[0] == nodes_end)
+            throw reader.error(
+              "the node section's header says " + std::to_string(n) +
+                " nodes, but it ends after " + std::to_string(i),
+              "correct the count in the line after " + nodes_begin + " to " +
+                std::to_string(i) + ", or export the mesh again.");
+          if (t.size() < 4)
+            throw reader.error("a node line needs 'number x y z'",
+                               "the file is damaged; export it "
+                               "again.");
+          const long tag = parse_number<long>(reader, t[0], "node number");
+          Utilities::Point3 x;
+          for (unsigned int d = 0; d < 3; ++d)
+            x[d] = parse_number<double>(reader, t[d + 1], "coordinate");
+          if (!tags.emplace(tag, data.nodes.size()).second)
+            throw reader.error("node " + std::to_string(tag) +
+                                 " is defined twice",
+                               "the file is damaged; export it "
+                               "again.");
+          data.nodes.push_back(x);
+          data.node_ids.push_back(tag);
+        }
+      if (reader.expect(nodes_end) != nodes_end)
+        throw reader.error("expected " + nodes_end + " after the nodes",
+                           "the node count does not match the "
+                           "nodes; export the file again.");
+    }
+
+
+
+    /**
+     * Read an element section (after its first line) into @p data: its
+     * tetrahedra and triangles.
+     */
+    void
+    read_gmsh_elements(LineReader                         &reader,
+                       const bool                          legacy,
+                       const std::string                  &elements_end,
+                       const std::map<long, unsigned int> &tags,
+                       MeshData                           &data)
+    {
+      const long n = parse_number<long>(reader,
+                                        reader.expect("the element count"),
+                                        "element count");
+      for (long i = 0; i < n; ++i)
+        {
+          const auto t = tokens_of(reader.expect("an element"));
+          if (t.size() < 3)
+            throw reader.error("an element line is too short",
+                               "the file is damaged.");
+          const long id   = parse_number<long>(reader, t[0], "element number");
+          const int  type = parse_number<int>(reader, t[1], "element type");
+          const auto type_it = gmsh_types().find(type);
+          if (type_it == gmsh_types().end())
+            throw reader.error("element " + std::to_string(id) +
+                                 " has the unknown type " + t[1],
+                               "palpate needs linear tetrahedra "
+                               "(type 4) and optionally triangles "
+                               "(type 2) for boundary ids.");
+          unsigned int first_node = 0;
+          unsigned int physical   = 0;
+          if (legacy)
+            {
+              // number type physical elementary n-nodes nodes...
+              if (t.size() < 5)
+                throw reader.error("an element line is too short",
+                                   "the file is damaged.");
+              physical =
+                parse_number<unsigned int>(reader, t[2], "physical tag");
+              first_node = 5;
+            }
+          else
+            {
+              // number type n-tags tags... nodes...
+              const unsigned int n_tags =
+                parse_number<unsigned int>(reader, t[2], "tag count");
+              if (n_tags > 0 && t.size() > 3)
+                physical =
+                  parse_number<unsigned int>(reader, t[3], "physical tag");
+              first_node = 3 + n_tags;
+            }
+          const GmshType &gt = type_it->second;
+          if (t.size() != first_node + gt.n_nodes)
+            throw reader.error("element " + std::to_string(id) + " (" +
+                                 gt.name + ") should list " +
+                                 std::to_string(gt.n_nodes) + " nodes",
+                               "the file is damaged; export it "
+                               "again.");
+          std::vector<unsigned int> v(gt.n_nodes);
+          for (int k = 0; k < gt.n_nodes; ++k)
+            v[k] = node_index(reader,
+                              tags,
+                              parse_number<long>(reader,
+                                                 t[first_node + k],
+                                                 "node number"));
+          if (type == 4)
+            {
+              data.tetrahedra.push_back({{v[0], v[1], v[2], v[3]}});
+              data.tetrahedron_material_ids.push_back(physical);
+              data.tetrahedron_lines.push_back(reader.number);
+              data.tetrahedron_ids.push_back(id);
+            }
+          else if (type == 2)
+            {
+              data.triangles.push_back({{v[0], v[1], v[2]}});
+              data.triangle_boundary_ids.push_back(physical);
+              data.triangle_lines.push_back(reader.number);
+            }
+          else if (gt.dimension >= 2)
+            throw reader.error(
+              "element " + std::to_string(id) + " is a " + gt.name +
+                "; palpate's finite elements are linear tetrahedra",
+              "mesh the body with 4-node tetrahedra only (Gmsh: "
+              "Mesh.ElementOrder = 1, no recombination; TetGen "
+              "does this by default).");
+          // Points and lines carry nothing palpate needs.
+        }
+      if (reader.expect(elements_end) != elements_end)
+        throw reader.error("expected " + elements_end + " after the elements",
+                           "the element count does not match the "
+                           "elements; export the file again.");
+    }
+
+
+
+    /** Skip the section whose first line is @p line. */
+    void
+    skip_gmsh_section(LineReader        &reader,
+                      const std::string &line,
+                      const bool         legacy)
+    {
+      // Skip any other section ($PhysicalNames, $NodeData, ...).
+      const std::string end =
+        legacy ? "$END" + line.substr(1) : "$End" + line.substr(1);
+      std::string skip;
+      while (reader.next(skip) && skip != end)
+        ;
+    }
+
+
+
+    MeshData
+    read_gmsh(const std::string &filename)
+    {
+      LineReader reader(filename);
+      MeshData   data;
+
+      std::string line;
+      if (!reader.next(line))
+        throw reader.error("the file is empty",
+                           "write the mesh again from Gmsh or TetGen.");
+      const bool legacy = read_gmsh_header(reader, line, filename, data);
 
       std::map<long, unsigned int> tags;
       bool                         have_nodes = false, have_elements = false;
@@ -243,42 +419,7 @@ namespace palpate
           first = false;
           if (line == nodes_begin)
             {
-              const long n = parse_number<long>(reader,
-                                                reader.expect("the node count"),
-                                                "node count");
-              for (long i = 0; i < n; ++i)
-                {
-                  const auto t = tokens_of(reader.expect("a node"));
-                  // The section ended before the count: the header's count
-                  // is wrong, not the line.
-                  if (!t.empty() && t[0] == nodes_end)
-                    throw reader.error(
-                      "the node section's header says " + std::to_string(n) +
-                        " nodes, but it ends after " + std::to_string(i),
-                      "correct the count in the line after " + nodes_begin +
-                        " to " + std::to_string(i) +
-                        ", or export the mesh again.");
-                  if (t.size() < 4)
-                    throw reader.error("a node line needs 'number x y z'",
-                                       "the file is damaged; export it "
-                                       "again.");
-                  const long tag =
-                    parse_number<long>(reader, t[0], "node number");
-                  Utilities::Point3 x;
-                  for (unsigned int d = 0; d < 3; ++d)
-                    x[d] = parse_number<double>(reader, t[d + 1], "coordinate");
-                  if (!tags.emplace(tag, data.nodes.size()).second)
-                    throw reader.error("node " + std::to_string(tag) +
-                                         " is defined twice",
-                                       "the file is damaged; export it "
-                                       "again.");
-                  data.nodes.push_back(x);
-                  data.node_ids.push_back(tag);
-                }
-              if (reader.expect(nodes_end) != nodes_end)
-                throw reader.error("expected " + nodes_end + " after the nodes",
-                                   "the node count does not match the "
-                                   "nodes; export the file again.");
+              read_gmsh_nodes(reader, nodes_begin, nodes_end, tags, data);
               have_nodes = true;
             }
           else if (line == elements_begin)
@@ -286,103 +427,11 @@ namespace palpate
               if (!have_nodes)
                 throw reader.error("the elements come before the nodes",
                                    "export the file again.");
-              const long n =
-                parse_number<long>(reader,
-                                   reader.expect("the element count"),
-                                   "element count");
-              for (long i = 0; i < n; ++i)
-                {
-                  const auto t = tokens_of(reader.expect("an element"));
-                  if (t.size() < 3)
-                    throw reader.error("an element line is too short",
-                                       "the file is damaged.");
-                  const long id =
-                    parse_number<long>(reader, t[0], "element number");
-                  const int type =
-                    parse_number<int>(reader, t[1], "element type");
-                  const auto type_it = gmsh_types().find(type);
-                  if (type_it == gmsh_types().end())
-                    throw reader.error("element " + std::to_string(id) +
-                                         " has the unknown type " + t[1],
-                                       "palpate needs linear tetrahedra "
-                                       "(type 4) and optionally triangles "
-                                       "(type 2) for boundary ids.");
-                  unsigned int first_node = 0;
-                  unsigned int physical   = 0;
-                  if (legacy)
-                    {
-                      // number type physical elementary n-nodes nodes...
-                      if (t.size() < 5)
-                        throw reader.error("an element line is too short",
-                                           "the file is damaged.");
-                      physical   = parse_number<unsigned int>(reader,
-                                                            t[2],
-                                                            "physical tag");
-                      first_node = 5;
-                    }
-                  else
-                    {
-                      // number type n-tags tags... nodes...
-                      const unsigned int n_tags =
-                        parse_number<unsigned int>(reader, t[2], "tag count");
-                      if (n_tags > 0 && t.size() > 3)
-                        physical = parse_number<unsigned int>(reader,
-                                                              t[3],
-                                                              "physical tag");
-                      first_node = 3 + n_tags;
-                    }
-                  const GmshType &gt = type_it->second;
-                  if (t.size() != first_node + gt.n_nodes)
-                    throw reader.error("element " + std::to_string(id) + " (" +
-                                         gt.name + ") should list " +
-                                         std::to_string(gt.n_nodes) + " nodes",
-                                       "the file is damaged; export it "
-                                       "again.");
-                  std::vector<unsigned int> v(gt.n_nodes);
-                  for (int k = 0; k < gt.n_nodes; ++k)
-                    v[k] = node_index(reader,
-                                      tags,
-                                      parse_number<long>(reader,
-                                                         t[first_node + k],
-                                                         "node number"));
-                  if (type == 4)
-                    {
-                      data.tetrahedra.push_back({{v[0], v[1], v[2], v[3]}});
-                      data.tetrahedron_material_ids.push_back(physical);
-                      data.tetrahedron_lines.push_back(reader.number);
-                      data.tetrahedron_ids.push_back(id);
-                    }
-                  else if (type == 2)
-                    {
-                      data.triangles.push_back({{v[0], v[1], v[2]}});
-                      data.triangle_boundary_ids.push_back(physical);
-                      data.triangle_lines.push_back(reader.number);
-                    }
-                  else if (gt.dimension >= 2)
-                    throw reader.error(
-                      "element " + std::to_string(id) + " is a " + gt.name +
-                        "; palpate's finite elements are linear tetrahedra",
-                      "mesh the body with 4-node tetrahedra only (Gmsh: "
-                      "Mesh.ElementOrder = 1, no recombination; TetGen "
-                      "does this by default).");
-                  // Points and lines carry nothing palpate needs.
-                }
-              if (reader.expect(elements_end) != elements_end)
-                throw reader.error("expected " + elements_end +
-                                     " after the elements",
-                                   "the element count does not match the "
-                                   "elements; export the file again.");
+              read_gmsh_elements(reader, legacy, elements_end, tags, data);
               have_elements = true;
             }
           else if (!line.empty() && line[0] == '$')
-            {
-              // Skip any other section ($PhysicalNames, $NodeData, ...).
-              const std::string end =
-                legacy ? "$END" + line.substr(1) : "$End" + line.substr(1);
-              std::string skip;
-              while (reader.next(skip) && skip != end)
-                ;
-            }
+            skip_gmsh_section(reader, line, legacy);
           else
             throw reader.error("unexpected line " +
                                  Utilities::quoted_excerpt(line) +
@@ -522,30 +571,35 @@ namespace palpate
         }
     }
 
-    MeshData
-    read_vtk(const std::string &filename)
+    /**
+     * Refuse a legacy VTK surface (POLYDATA), whatever its encoding, before
+     * anything else: it is not a volume mesh.
+     */
+    void
+    check_not_polydata(const std::string &filename)
     {
-      // A surface (POLYDATA) is not a volume mesh, whatever its encoding:
-      // say so before anything else.
-      {
-        std::ifstream head(filename, std::ios::binary);
-        std::string   start(512, '\0');
-        head.read(&start[0], start.size());
-        start.resize(head.gcount());
-        if (start.find("DATASET POLYDATA") != std::string::npos)
-          throw InputError(filename,
-                           0,
-                           "mesh file",
-                           "this legacy VTK file is a surface (POLYDATA): "
-                           "palpate needs a tetrahedral volume mesh here",
-                           "make one with 'palpate mesh " + filename +
-                             " OUT.msh --scale S' (S = metres per file "
-                             "unit, 0.001 for millimetres), or set Mesh / "
-                             "Source = surface with this file as File name.");
-      }
-      LineReader reader(filename);
-      MeshData   data;
+      std::ifstream head(filename, std::ios::binary);
+      std::string   start(512, '\0');
+      head.read(&start[0], start.size());
+      start.resize(head.gcount());
+      if (start.find("DATASET POLYDATA") != std::string::npos)
+        throw InputError(filename,
+                         0,
+                         "mesh file",
+                         "this legacy VTK file is a surface (POLYDATA): "
+                         "palpate needs a tetrahedral volume mesh here",
+                         "make one with 'palpate mesh " + filename +
+                           " OUT.msh --scale S' (S = metres per file "
+                           "unit, 0.001 for millimetres), or set Mesh / "
+                           "Source = surface with this file as File name.");
+    }
 
+
+
+    /** Read the legacy VTK header into @p data: its version and encoding. */
+    void
+    read_vtk_header(LineReader &reader, MeshData &data)
+    {
       const std::string header = reader.expect("the VTK header");
       std::smatch       m;
       if (!std::regex_match(header,
@@ -564,6 +618,120 @@ namespace palpate
                            "save it as ASCII (ParaView: File > Save Data, "
                            "File type Legacy VTK, File type ASCII), or as "
                            ".vtu.");
+    }
+
+
+
+    /**
+     * Read a count, checked before it is trusted: each item it counts takes
+     * at least two bytes of the file, which holds at most @p most items.
+     */
+    long
+    read_count(TokenReader &tokens, const long most, const char *what)
+    {
+      LineReader &reader = tokens.reader;
+      const long  n      = tokens.number<long>(what);
+      if (n < 0 || n > most)
+        throw reader.error(std::string("the ") + what + " " +
+                             std::to_string(n) +
+                             " cannot be right: it is negative or more "
+                             "than the file could hold",
+                           "the file is damaged; write it again.");
+      return n;
+    }
+
+
+
+    /**
+     * Read the cells of a VTK 5.1 CELLS section (@p n offsets and @p size
+     * connectivity entries), after its counts.
+     */
+    void
+    read_vtk_offset_cells(TokenReader                    &tokens,
+                          const long                      n,
+                          const long                      size,
+                          std::vector<std::vector<long>> &cells,
+                          std::vector<unsigned int>      &cell_lines)
+    {
+      LineReader &reader = tokens.reader;
+      // VTK 5.1: CELLS n_offsets n_connectivity, then arrays.
+      tokens.next("OFFSETS");
+      tokens.next("the offset type");
+      std::vector<long> offsets;
+      for (long i = 0; i < n; ++i)
+        {
+          offsets.push_back(tokens.number<long>("offset"));
+          if (offsets.back() < (i == 0 ? 0 : offsets[i - 1]) ||
+              offsets.back() > size)
+            throw reader.error("offset " + std::to_string(i) + " (" +
+                                 std::to_string(offsets.back()) +
+                                 ") is not between the previous offset and the "
+                                 "connectivity size " +
+                                 std::to_string(size),
+                               "the file is damaged; write it again.");
+        }
+      if (tokens.next("CONNECTIVITY") != "CONNECTIVITY")
+        throw reader.error("expected CONNECTIVITY after OFFSETS",
+                           "the file is damaged.");
+      tokens.next("the connectivity type");
+      std::vector<long> connectivity;
+      for (long i = 0; i < size; ++i)
+        connectivity.push_back(tokens.number<long>("point index"));
+      for (long c = 0; c + 1 < n; ++c)
+        {
+          cells.emplace_back(connectivity.begin() + offsets[c],
+                             connectivity.begin() + offsets[c + 1]);
+          cell_lines.push_back(reader.number);
+        }
+    }
+
+
+
+    /**
+     * Read a CELLS section, after its keyword, into @p cells and the line of
+     * each.
+     */
+    void
+    read_vtk_cells(TokenReader                    &tokens,
+                   const long                      most,
+                   std::vector<std::vector<long>> &cells,
+                   std::vector<unsigned int>      &cell_lines)
+    {
+      LineReader &reader = tokens.reader;
+      const long  n      = read_count(tokens, most, "cell count");
+      const long  size   = read_count(tokens, most, "cell list size");
+      if (tokens.at_end())
+        throw reader.error("the CELLS section is empty",
+                           "the file is truncated.");
+      if (tokens.tokens[tokens.position] == "OFFSETS")
+        read_vtk_offset_cells(tokens, n, size, cells, cell_lines);
+      else
+        for (long c = 0; c < n; ++c)
+          {
+            const long k = tokens.number<long>("cell size");
+            if (k < 0 || k > 64)
+              throw reader.error("cell " + std::to_string(c) + " has " +
+                                   std::to_string(k) +
+                                   " points; a cell has at most 64",
+                                 "the file is damaged; write it "
+                                 "again.");
+            std::vector<long> cell(k);
+            for (auto &p : cell)
+              p = tokens.number<long>("point index");
+            cells.push_back(cell);
+            cell_lines.push_back(reader.number);
+          }
+    }
+
+
+
+    MeshData
+    read_vtk(const std::string &filename)
+    {
+      check_not_polydata(filename);
+      LineReader reader(filename);
+      MeshData   data;
+      read_vtk_header(reader, data);
 
       TokenReader tokens(reader);
       if (tokens.next("DATASET") != "DATASET" ||
@@ -578,14 +746,7 @@ namespace palpate
       const auto      bytes = std::filesystem::file_size(filename, ec);
       const long      most  = ec ? 0 : static_cast<long>(bytes / 2);
       const auto      count = [&](const char *what) {
-        const long n = tokens.number<long>(what);
-        if (n < 0 || n > most)
-          throw reader.error(std::string("the ") + what + " " +
-                               std::to_string(n) +
-                               " cannot be right: it is negative or more "
-                                    "than the file could hold",
-                             "the file is damaged; write it again.");
-        return n;
+        return read_count(tokens, most, what);
       };
 
       std::vector<std::vector<long>> cells;
@@ -608,62 +769,7 @@ namespace palpate
                 }
             }
           else if (keyword == "CELLS")
-            {
-              const long n    = count("cell count");
-              const long size = count("cell list size");
-              if (tokens.at_end())
-                throw reader.error("the CELLS section is empty",
-                                   "the file is truncated.");
-              if (tokens.tokens[tokens.position] == "OFFSETS")
-                {
-                  // VTK 5.1: CELLS n_offsets n_connectivity, then arrays.
-                  tokens.next("OFFSETS");
-                  tokens.next("the offset type");
-                  std::vector<long> offsets;
-                  for (long i = 0; i < n; ++i)
-                    {
-                      offsets.push_back(tokens.number<long>("offset"));
-                      if (offsets.back() < (i == 0 ? 0 : offsets[i - 1]) ||
-                          offsets.back() > size)
-                        throw reader.error(
-                          "offset " + std::to_string(i) + " (" +
-                            std::to_string(offsets.back()) +
-                            ") is not between the previous offset and the "
-                            "connectivity size " +
-                            std::to_string(size),
-                          "the file is damaged; write it again.");
-                    }
-                  if (tokens.next("CONNECTIVITY") != "CONNECTIVITY")
-                    throw reader.error("expected CONNECTIVITY after OFFSETS",
-                                       "the file is damaged.");
-                  tokens.next("the connectivity type");
-                  std::vector<long> connectivity;
-                  for (long i = 0; i < size; ++i)
-                    connectivity.push_back(tokens.number<long>("point index"));
-                  for (long c = 0; c + 1 < n; ++c)
-                    {
-                      cells.emplace_back(connectivity.begin() + offsets[c],
-                                         connectivity.begin() + offsets[c + 1]);
-                      cell_lines.push_back(reader.number);
-                    }
-                }
-              else
-                for (long c = 0; c < n; ++c)
-                  {
-                    const long k = tokens.number<long>("cell size");
-                    if (k < 0 || k > 64)
-                      throw reader.error("cell " + std::to_string(c) + " has " +
-                                           std::to_string(k) +
-                                           " points; a cell has at most 64",
-                                         "the file is damaged; write it "
-                                         "again.");
-                    std::vector<long> cell(k);
-                    for (auto &p : cell)
-                      p = tokens.number<long>("point index");
-                    cells.push_back(cell);
-                    cell_lines.push_back(reader.number);
-                  }
-            }
+            read_vtk_cells(tokens, most, cells, cell_lines);
           else if (keyword == "CELL_TYPES")
             {
               const long n = count("cell type count");
@@ -1211,27 +1317,86 @@ namespace palpate
                -1;
     }
 
-    MeshData
-    read_vtk_xml(const std::string &filename, const bool polydata)
+    /**
+     * The steps of read_vtk_xml() on one file, and what they share: the
+     * file's text, how its arrays are stored, the piece's arrays and the
+     * mesh read so far.
+     */
+    struct VtkXmlReader
     {
-      std::string text = file_contents(filename);
+      VtkXmlReader(const std::string &filename, const bool polydata);
 
-      MeshData   data;
-      VtuContext ctx;
+      /** The text of the XML tag that starts at @p begin, up to its '>'. */
+      std::string
+      tag_at(const std::size_t begin) const;
+
+      /** Check the <VTKFile> tag and take how the data are stored. */
+      void
+      read_file_tag();
+
+      /** Take the appended data out of the text. */
+      void
+      cut_appended_data();
+
+      /** Read the <Piece>'s counts and its arrays. */
+      void
+      read_piece();
+
+      /** Take the points of the piece's arrays. */
+      void
+      take_points();
+
+      /** The cells of the piece's arrays: their points and types. */
+      void
+      read_cells(std::vector<std::vector<long>> &cells,
+                 std::vector<int>               &types);
+
+      /** Take the polygons of a .vtp as triangles. */
+      void
+      take_polygons(const std::vector<std::vector<long>> &cells);
+
+      const std::string                          filename;
+      const bool                                 polydata;
+      std::string                                text;
+      MeshData                                   data;
+      VtuContext                                 ctx;
+      bool                                       big_endian  = false;
+      bool                                       binary_read = false;
+      std::uint64_t                              n_points    = 0;
+      std::uint64_t                              n_cells     = 0;
+      std::map<std::string, std::vector<double>> arrays;
+    };
+
+
+
+    VtkXmlReader::VtkXmlReader(const std::string &filename, const bool polydata)
+      : filename(filename)
+      , polydata(polydata)
+      , text(file_contents(filename))
+    {
       ctx.filename = filename;
+    }
 
-      // The text of the XML tag that starts at @p begin, up to its '>'.
-      const auto tag_at = [&](const std::size_t begin) {
-        const auto end = text.find('>', begin);
-        if (end == std::string::npos)
-          throw InputError(filename,
-                           line_at(text, begin),
-                           "mesh file",
-                           "the file ends inside an XML tag",
-                           "the file is truncated; write it again.");
-        return text.substr(begin, end - begin);
-      };
 
+
+    std::string
+    VtkXmlReader::tag_at(const std::size_t begin) const
+    {
+      const auto end = text.find('>', begin);
+      if (end == std::string::npos)
+        throw InputError(filename,
+                         line_at(text, begin),
+                         "mesh file",
+                         "the file ends inside an XML tag",
+                         "the file is truncated; write it again.");
+      return text.substr(begin, end - begin);
+    }
+
+
+
+    void
+    VtkXmlReader::read_file_tag()
+    {
       const auto file_tag_begin = text.find("<VTKFile");
       if (file_tag_begin == std::string::npos)
         throw InputError(filename,
@@ -1261,7 +1426,7 @@ namespace palpate
       // another simulator's examples declare BigEndian even for ascii
       // data. Binary values are swapped to this machine's order.
       const std::string byte_order = attribute(file_tag, "byte_order");
-      const bool        big_endian = byte_order == "BigEndian";
+      big_endian                   = byte_order == "BigEndian";
       if (big_endian || byte_order == "LittleEndian")
         ctx.swap_bytes = big_endian == host_is_little_endian();
       else if (!byte_order.empty())
@@ -1280,7 +1445,13 @@ namespace palpate
       ctx.compressed = !compressor.empty();
       data.format    = std::string("VTU ") +
                     (ctx.compressed ? "zlib-compressed" : "uncompressed");
+    }
 
+
+
+    void
+    VtkXmlReader::cut_appended_data()
+    {
       // Appended data: everything after the '_' marker up to the closing
       // tag (raw bytes may contain anything, so search from the end). A
       // file without the closing tag was cut short.
@@ -1310,7 +1481,13 @@ namespace palpate
             ctx.appended = strip_space(ctx.appended);
           text = text.substr(0, appended_tag); // keep the XML part
         }
+    }
 
+
+
+    void
+    VtkXmlReader::read_piece()
+    {
       const auto piece = text.find("<Piece");
       if (piece == std::string::npos)
         throw InputError(filename,
@@ -1318,20 +1495,17 @@ namespace palpate
                          "mesh file",
                          "the file has no <Piece>",
                          "write the mesh again.");
-      const std::string   piece_tag  = tag_at(piece);
-      const unsigned int  piece_line = line_at(text, piece);
-      const std::uint64_t n_points   = count_attribute(
+      const std::string  piece_tag  = tag_at(piece);
+      const unsigned int piece_line = line_at(text, piece);
+      n_points                      = count_attribute(
         filename, piece_line, "Piece", piece_tag, "NumberOfPoints");
-      const std::uint64_t n_cells =
-        count_attribute(filename,
-                        piece_line,
-                        "Piece",
-                        piece_tag,
-                        polydata ? "NumberOfPolys" : "NumberOfCells");
+      n_cells = count_attribute(filename,
+                                piece_line,
+                                "Piece",
+                                piece_tag,
+                                polydata ? "NumberOfPolys" : "NumberOfCells");
 
       // Collect the data arrays of the <Points> and <Cells> sections.
-      std::map<std::string, std::vector<double>> arrays;
-      bool                                       binary_read = false;
       for (const std::string &section :
            {std::string("Points"), std::string(polydata ? "Polys" : "Cells")})
         {
@@ -1374,6 +1548,13 @@ namespace palpate
               pos = next;
             }
         }
+    }
+
+
+
+    void
+    VtkXmlReader::take_points()
+    {
       if (polydata)
         arrays["types"].assign(n_cells, 0); // polygons, split below
       for (const std::string key :
@@ -1399,6 +1580,14 @@ namespace palpate
             {{points[3 * i], points[3 * i + 1], points[3 * i + 2]}});
           data.node_ids.push_back(i);
         }
+    }
+
+
+
+    void
+    VtkXmlReader::read_cells(std::vector<std::vector<long>> &cells,
+                             std::vector<int>               &types)
+    {
       const auto &connectivity = arrays["connectivity"];
       const auto &offsets      = arrays["offsets"];
       const auto &types_d      = arrays["types"];
@@ -1409,9 +1598,7 @@ namespace palpate
                          "the offsets or types arrays do not have one entry "
                          "per cell",
                          "the file is damaged; write it again.");
-      std::vector<std::vector<long>> cells;
-      std::vector<int>               types;
-      std::size_t                    begin = 0;
+      std::size_t begin = 0;
       for (std::size_t c = 0; c < n_cells; ++c)
         {
           const long end = as_index(offsets[c]);
@@ -1440,39 +1627,65 @@ namespace palpate
           types.push_back(type <= 255 ? static_cast<int>(type) : -1);
           begin = end;
         }
+    }
+
+
+
+    void
+    VtkXmlReader::take_polygons(const std::vector<std::vector<long>> &cells)
+    {
+      // Polygons: split into fans of triangles.
+      for (const auto &cell : cells)
+        for (std::size_t k = 1; k + 1 < cell.size(); ++k)
+          {
+            for (const long v : {cell[0], cell[k], cell[k + 1]})
+              if (static_cast<std::size_t>(v) >= n_points)
+                throw InputError(filename,
+                                 1,
+                                 "surface file",
+                                 "a polygon refers to point " +
+                                   std::to_string(v) + " of " +
+                                   std::to_string(n_points),
+                                 "the file is damaged; write it again.");
+            data.triangles.push_back(
+              {{static_cast<unsigned int>(cell[0]),
+                static_cast<unsigned int>(cell[k]),
+                static_cast<unsigned int>(cell[k + 1])}});
+            data.triangle_boundary_ids.push_back(0);
+            data.triangle_lines.push_back(0);
+          }
+      data.format = std::string("VTP ") +
+                    (ctx.compressed ? "zlib-compressed" : "uncompressed") +
+                    (big_endian && binary_read ? ", big-endian" : "");
+    }
+
+
+
+    MeshData
+    read_vtk_xml(const std::string &filename, const bool polydata)
+    {
+      VtkXmlReader r(filename, polydata);
+      r.read_file_tag();
+      r.cut_appended_data();
+      r.read_piece();
+      r.take_points();
+      std::vector<std::vector<long>> cells;
+      std::vector<int>               types;
+      r.read_cells(cells, types);
       if (polydata)
         {
-          // Polygons: split into fans of triangles.
-          for (const auto &cell : cells)
-            for (std::size_t k = 1; k + 1 < cell.size(); ++k)
-              {
-                for (const long v : {cell[0], cell[k], cell[k + 1]})
-                  if (static_cast<std::size_t>(v) >= n_points)
-                    throw InputError(filename,
-                                     1,
-                                     "surface file",
-                                     "a polygon refers to point " +
-                                       std::to_string(v) + " of " +
-                                       std::to_string(n_points),
-                                     "the file is damaged; write it again.");
-                data.triangles.push_back(
-                  {{static_cast<unsigned int>(cell[0]),
-                    static_cast<unsigned int>(cell[k]),
-                    static_cast<unsigned int>(cell[k + 1])}});
-                data.triangle_boundary_ids.push_back(0);
-                data.triangle_lines.push_back(0);
-              }
-          data.format = std::string("VTP ") +
-                        (ctx.compressed ? "zlib-compressed" : "uncompressed") +
-                        (big_endian && binary_read ? ", big-endian" : "");
-          return data;
+          r.take_polygons(cells);
+          return std::move(r.data);
         }
-      if (big_endian && binary_read)
-        data.format += ", big-endian";
+      if (r.big_endian && r.binary_read)
+        r.data.format += ", big-endian";
       LineReader reader(filename);
-      add_vtk_cells(
-        reader, cells, types, std::vector<unsigned int>(cells.size(), 0), data);
-      return data;
+      add_vtk_cells(reader,
+                    cells,
+                    types,
+                    std::vector<unsigned int>(cells.size(), 0),
+                    r.data);
+      return std::move(r.data);
     }
   } // namespace
 

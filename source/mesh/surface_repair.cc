@@ -137,24 +137,91 @@ namespace palpate
 
 
 
-  SurfaceRepair
-  repair_surface(Surface           &s,
-                 const std::string &filename,
-                 const unsigned int max_hole_edges)
+  namespace
   {
-    SurfaceRepair r;
-    const double  size   = s.diameter();
-    const auto    refuse = [&](const std::string &problem,
-                            const std::string &fix) {
-      return InputError(filename, 0, "surface", problem, fix);
+    /**
+     * The steps of repair_surface() on one surface, and what they share:
+     * the edges' triangles and each triangle's shell.
+     */
+    class Repairer
+    {
+    public:
+      Repairer(Surface &s, const std::string &filename);
+
+      /**
+       * Triangles with a repeated vertex; duplicates (the same three
+       * vertices). Two copies facing opposite ways are a fin: both go.
+       */
+      void
+      drop_bad_triangles();
+
+      /** Edges and their triangles. More than two: not a manifold. */
+      void
+      find_edges();
+
+      /**
+       * Shells (connected over edges), oriented consistently by a
+       * breadth-first walk: a neighbour must run the shared edge the other
+       * way round.
+       */
+      void
+      orient_shells();
+
+      /**
+       * Holes: loops of boundary edges (one triangle). Small ones are
+       * closed by a fan around their centroid; a large one means the
+       * surface is open, which no repair can decide how to close.
+       */
+      void
+      fill_holes(const unsigned int max_hole_edges);
+
+      /**
+       * Shells: keep the largest body; remove shells of almost no volume
+       * (segmentation specks, zero-volume leftovers); refuse a second body.
+       */
+      void
+      keep_largest_shell();
+
+      /** Vertices no triangle uses. */
+      void
+      drop_unused_vertices();
+
+      Surface      &s;
+      SurfaceRepair r;
+      /** The body's size (before any repair). */
+      const double size;
+
+    private:
+      /** The error that refuses the surface. */
+      InputError
+      refuse(const std::string &problem, const std::string &fix) const;
+
+      const std::string                                           &filename;
+      std::unordered_map<std::uint64_t, std::vector<unsigned int>> edges;
+      std::vector<int>                                             shell;
+      int                                                          n_shells = 0;
     };
 
-    // 1. Coincident vertices (to 1e-7 of the body's size: far below any
-    // segmentation's resolution, far above float round-off).
-    r.merged_vertices = merge_vertices(s, 1e-7 * size);
 
-    // 2. Triangles with a repeated vertex; duplicates (the same three
-    // vertices). Two copies facing opposite ways are a fin: both go.
+
+    Repairer::Repairer(Surface &s, const std::string &filename)
+      : s(s)
+      , size(s.diameter())
+      , filename(filename)
+    {}
+
+
+
+    InputError
+    Repairer::refuse(const std::string &problem, const std::string &fix) const
+    {
+      return InputError(filename, 0, "surface", problem, fix);
+    }
+
+
+
+    void
+    Repairer::drop_bad_triangles()
     {
       std::map<std::array<unsigned int, 3>, std::vector<unsigned int>> seen;
       std::vector<Triangle>                                            kept;
@@ -184,100 +251,108 @@ namespace palpate
           s.triangles.push_back(kept[t]);
     }
 
-    // 3. Edges and their triangles. More than two: not a manifold.
-    std::unordered_map<std::uint64_t, std::vector<unsigned int>> edges;
-    for (unsigned int t = 0; t < s.triangles.size(); ++t)
-      for (unsigned int k = 0; k < 3; ++k)
-        edges[edge_key(s.triangles[t][k], s.triangles[t][(k + 1) % 3])]
-          .push_back(t);
+
+
+    void
+    Repairer::find_edges()
     {
-      unsigned int bad = 0;
-      Point3       where{{0, 0, 0}};
-      for (const auto &[key, tris] : edges)
-        if (tris.size() > 2)
-          {
-            if (bad++ == 0)
-              where = s.vertices[key >> 32];
-          }
-      if (bad > 0)
-        throw refuse(std::to_string(bad) +
-                       " edges are shared by more than two triangles (the "
-                       "first at " +
-                       at(where) +
-                       "): the surface is not the boundary of one solid",
-                     "export a single closed surface of the organ (in 3D "
-                     "Slicer: one segment, 'Export to files' as STL or OBJ; "
-                     "in MeshLab: Filters > Cleaning and Repairing > Remove "
-                     "Non Manifold Edges).");
+      for (unsigned int t = 0; t < s.triangles.size(); ++t)
+        for (unsigned int k = 0; k < 3; ++k)
+          edges[edge_key(s.triangles[t][k], s.triangles[t][(k + 1) % 3])]
+            .push_back(t);
+      {
+        unsigned int bad = 0;
+        Point3       where{{0, 0, 0}};
+        for (const auto &[key, tris] : edges)
+          if (tris.size() > 2)
+            {
+              if (bad++ == 0)
+                where = s.vertices[key >> 32];
+            }
+        if (bad > 0)
+          throw refuse(std::to_string(bad) +
+                         " edges are shared by more than two triangles (the "
+                         "first at " +
+                         at(where) +
+                         "): the surface is not the boundary of one solid",
+                       "export a single closed surface of the organ (in 3D "
+                       "Slicer: one segment, 'Export to files' as STL or OBJ; "
+                       "in MeshLab: Filters > Cleaning and Repairing > Remove "
+                       "Non Manifold Edges).");
+      }
     }
 
-    // 4. Shells (connected over edges), oriented consistently by a
-    // breadth-first walk: a neighbour must run the shared edge the other
-    // way round.
-    std::vector<int>  shell(s.triangles.size(), -1);
-    std::vector<bool> turned(s.triangles.size(), false);
-    int               n_shells = 0;
-    for (unsigned int seed = 0; seed < s.triangles.size(); ++seed)
-      if (shell[seed] < 0)
-        {
-          std::vector<unsigned int> members{seed};
-          std::queue<unsigned int>  queue;
-          queue.push(seed);
-          shell[seed] = n_shells;
-          while (!queue.empty())
-            {
-              const unsigned int t = queue.front();
-              queue.pop();
-              for (unsigned int k = 0; k < 3; ++k)
-                {
-                  const unsigned int a = s.triangles[t][k],
-                                     b = s.triangles[t][(k + 1) % 3];
-                  for (const unsigned int n : edges[edge_key(a, b)])
-                    if (n != t)
-                      {
-                        // Does n run a -> b too (then it disagrees)?
-                        bool same = false;
-                        for (unsigned int j = 0; j < 3; ++j)
-                          same = same || (s.triangles[n][j] == a &&
-                                          s.triangles[n][(j + 1) % 3] == b);
-                        if (shell[n] < 0)
-                          {
-                            if (same)
-                              {
-                                std::swap(s.triangles[n][1], s.triangles[n][2]);
-                                turned[n] = true;
-                              }
-                            shell[n] = n_shells;
-                            members.push_back(n);
-                            queue.push(n);
-                          }
-                        else if (same)
-                          throw refuse(
-                            "the surface cannot be oriented (a Moebius-like "
-                            "twist near " +
-                              at(s.vertices[a]) + ")",
-                            "export the organ's closed surface again.");
-                      }
-                }
-            }
-          // The walk followed the seed's orientation; the majority's is the
-          // file's: if most were turned, turn the whole shell back.
-          unsigned int n_turned = 0;
-          for (const unsigned int t : members)
-            n_turned += turned[t];
-          if (2 * n_turned > members.size())
-            {
-              for (const unsigned int t : members)
-                std::swap(s.triangles[t][1], s.triangles[t][2]);
-              n_turned = members.size() - n_turned;
-            }
-          r.reoriented_triangles += n_turned;
-          ++n_shells;
-        }
 
-    // 5. Holes: loops of boundary edges (one triangle). Small ones are
-    // closed by a fan around their centroid; a large one means the surface
-    // is open, which no repair can decide how to close.
+
+    void
+    Repairer::orient_shells()
+    {
+      shell.assign(s.triangles.size(), -1);
+      std::vector<bool> turned(s.triangles.size(), false);
+      for (unsigned int seed = 0; seed < s.triangles.size(); ++seed)
+        if (shell[seed] < 0)
+          {
+            std::vector<unsigned int> members{seed};
+            std::queue<unsigned int>  queue;
+            queue.push(seed);
+            shell[seed] = n_shells;
+            while (!queue.empty())
+              {
+                const unsigned int t = queue.front();
+                queue.pop();
+                for (unsigned int k = 0; k < 3; ++k)
+                  {
+                    const unsigned int a = s.triangles[t][k],
+                                       b = s.triangles[t][(k + 1) % 3];
+                    for (const unsigned int n : edges[edge_key(a, b)])
+                      if (n != t)
+                        {
+                          // Does n run a -> b too (then it disagrees)?
+                          bool same = false;
+                          for (unsigned int j = 0; j < 3; ++j)
+                            same = same || (s.triangles[n][j] == a &&
+                                            s.triangles[n][(j + 1) % 3] == b);
+                          if (shell[n] < 0)
+                            {
+                              if (same)
+                                {
+                                  std::swap(s.triangles[n][1],
+                                            s.triangles[n][2]);
+                                  turned[n] = true;
+                                }
+                              shell[n] = n_shells;
+                              members.push_back(n);
+                              queue.push(n);
+                            }
+                          else if (same)
+                            throw refuse(
+                              "the surface cannot be oriented (a Moebius-like "
+                              "twist near " +
+                                at(s.vertices[a]) + ")",
+                              "export the organ's closed surface again.");
+                        }
+                  }
+              }
+            // The walk followed the seed's orientation; the majority's is the
+            // file's: if most were turned, turn the whole shell back.
+            unsigned int n_turned = 0;
+            for (const unsigned int t : members)
+              n_turned += turned[t];
+            if (2 * n_turned > members.size())
+              {
+                for (const unsigned int t : members)
+                  std::swap(s.triangles[t][1], s.triangles[t][2]);
+                n_turned = members.size() - n_turned;
+              }
+            r.reoriented_triangles += n_turned;
+            ++n_shells;
+          }
+    }
+
+
+
+    void
+    Repairer::fill_holes(const unsigned int max_hole_edges)
     {
       std::map<unsigned int, unsigned int> next; // boundary a -> b
       for (const auto &[key, tris] : edges)
@@ -339,52 +414,59 @@ namespace palpate
         }
     }
 
-    // 6. Shells: keep the largest body; remove shells of almost no volume
-    // (segmentation specks, zero-volume leftovers); refuse a second body.
-    std::vector<std::vector<unsigned int>> members(n_shells);
-    for (unsigned int t = 0; t < s.triangles.size(); ++t)
-      members[shell[t]].push_back(t);
-    std::vector<double> volume(n_shells);
-    int                 largest = 0;
-    for (int k = 0; k < n_shells; ++k)
-      {
-        volume[k] = signed_volume(s, members[k]);
-        if (std::abs(volume[k]) > std::abs(volume[largest]))
-          largest = k;
-      }
-    std::vector<bool> keep_triangle(s.triangles.size(), true);
-    for (int k = 0; k < n_shells; ++k)
-      if (k != largest)
-        {
-          if (std::abs(volume[k]) > 0.01 * std::abs(volume[largest]))
-            throw refuse(
-              "the file holds " + std::to_string(n_shells) +
-                " separate surfaces, and two are bodies of comparable size (" +
-                Utilities::to_string(std::abs(volume[largest]) * 1e6, 3) +
-                " and " + Utilities::to_string(std::abs(volume[k]) * 1e6, 3) +
-                " cm^3)",
-              "palpate meshes one organ: export its segment alone.");
-          ++r.removed_shells;
-          r.removed_triangles += members[k].size();
-          r.removed_volume += std::abs(volume[k]);
-          for (const unsigned int t : members[k])
-            keep_triangle[t] = false;
-        }
-    {
-      std::vector<Triangle> kept;
-      for (unsigned int t = 0; t < s.triangles.size(); ++t)
-        if (keep_triangle[t])
-          kept.push_back(s.triangles[t]);
-      s.triangles = kept;
-    }
-    if (volume[largest] < 0)
-      {
-        for (auto &t : s.triangles)
-          std::swap(t[1], t[2]);
-        r.turned_outward = true;
-      }
 
-    // 7. Vertices no triangle uses.
+
+    void
+    Repairer::keep_largest_shell()
+    {
+      std::vector<std::vector<unsigned int>> members(n_shells);
+      for (unsigned int t = 0; t < s.triangles.size(); ++t)
+        members[shell[t]].push_back(t);
+      std::vector<double> volume(n_shells);
+      int                 largest = 0;
+      for (int k = 0; k < n_shells; ++k)
+        {
+          volume[k] = signed_volume(s, members[k]);
+          if (std::abs(volume[k]) > std::abs(volume[largest]))
+            largest = k;
+        }
+      std::vector<bool> keep_triangle(s.triangles.size(), true);
+      for (int k = 0; k < n_shells; ++k)
+        if (k != largest)
+          {
+            if (std::abs(volume[k]) > 0.01 * std::abs(volume[largest]))
+              throw refuse(
+                "the file holds " + std::to_string(n_shells) +
+                  " separate surfaces, and two are bodies of comparable size (" +
+                  Utilities::to_string(std::abs(volume[largest]) * 1e6, 3) +
+                  " and " + Utilities::to_string(std::abs(volume[k]) * 1e6, 3) +
+                  " cm^3)",
+                "palpate meshes one organ: export its segment alone.");
+            ++r.removed_shells;
+            r.removed_triangles += members[k].size();
+            r.removed_volume += std::abs(volume[k]);
+            for (const unsigned int t : members[k])
+              keep_triangle[t] = false;
+          }
+      {
+        std::vector<Triangle> kept;
+        for (unsigned int t = 0; t < s.triangles.size(); ++t)
+          if (keep_triangle[t])
+            kept.push_back(s.triangles[t]);
+        s.triangles = kept;
+      }
+      if (volume[largest] < 0)
+        {
+          for (auto &t : s.triangles)
+            std::swap(t[1], t[2]);
+          r.turned_outward = true;
+        }
+    }
+
+
+
+    void
+    Repairer::drop_unused_vertices()
     {
       std::vector<int>    map(s.vertices.size(), -1);
       std::vector<Point3> kept;
@@ -401,7 +483,26 @@ namespace palpate
       r.unused_vertices = s.vertices.size() - kept.size();
       s.vertices        = kept;
     }
-    return r;
+  } // namespace
+
+
+
+  SurfaceRepair
+  repair_surface(Surface           &s,
+                 const std::string &filename,
+                 const unsigned int max_hole_edges)
+  {
+    Repairer repair(s, filename);
+    // Coincident vertices (to 1e-7 of the body's size: far below any
+    // segmentation's resolution, far above float round-off).
+    repair.r.merged_vertices = merge_vertices(s, 1e-7 * repair.size);
+    repair.drop_bad_triangles();
+    repair.find_edges();
+    repair.orient_shells();
+    repair.fill_holes(max_hole_edges);
+    repair.keep_largest_shell();
+    repair.drop_unused_vertices();
+    return repair.r;
   }
 
 

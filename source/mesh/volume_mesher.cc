@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 #include <thread>
 
@@ -63,6 +64,192 @@ namespace palpate
         }
       return pass.h / ((lo + hi) / 2);
     }
+
+    /**
+     * Give Gmsh @p s as one discrete surface, classified into patches at
+     * @p angle degrees, and the volume it bounds.
+     */
+    void
+    add_body(const Surface &s, const double angle)
+    {
+      gmsh::model::add("organ");
+      const int                tag = gmsh::model::addDiscreteEntity(2);
+      std::vector<std::size_t> node_tags(s.vertices.size());
+      std::vector<double>      xyz;
+      for (std::size_t v = 0; v < s.vertices.size(); ++v)
+        {
+          node_tags[v] = v + 1;
+          for (const double x : s.vertices[v])
+            xyz.push_back(x);
+        }
+      gmsh::model::mesh::addNodes(2, tag, node_tags, xyz);
+      std::vector<std::size_t> element_tags, element_nodes;
+      for (std::size_t t = 0; t < s.triangles.size(); ++t)
+        {
+          element_tags.push_back(t + 1);
+          for (const unsigned int v : s.triangles[t])
+            element_nodes.push_back(v + 1);
+        }
+      gmsh::model::mesh::addElementsByType(tag, 2, element_tags, element_nodes);
+      gmsh::model::mesh::classifySurfaces(angle * M_PI / 180, true, true, M_PI);
+      gmsh::model::mesh::createGeometry();
+      std::vector<std::pair<int, int>> surfaces;
+      gmsh::model::getEntities(surfaces, 2);
+      std::vector<int> surface_tags;
+      for (const auto &e : surfaces)
+        surface_tags.push_back(e.second);
+      const int loop = gmsh::model::geo::addSurfaceLoop(surface_tags);
+      const int body = gmsh::model::geo::addVolume({loop});
+      gmsh::model::geo::synchronize();
+      gmsh::model::addPhysicalGroup(3, {body}, 1);
+      gmsh::model::addPhysicalGroup(2, surface_tags, 1);
+    }
+
+
+
+    /**
+     * Gmsh's element sizes: in [h/2, h], or (@p grading) from its fine size
+     * near its centre, growing to @p h.
+     */
+    void
+    set_sizes(const double h, const MeshGrading &grading)
+    {
+      const bool graded  = grading.fine_size > 0;
+      const bool refined = graded && grading.fine_size < h;
+      gmsh::option::setNumber("Mesh.MeshSizeMin",
+                              0.5 * (refined ? grading.fine_size : h));
+      if (refined)
+        {
+          // size(r) = fine + growth max(0, r - radius), capped
+          // at h by MeshSizeMax; max(0, t) = (t + |t|)/2
+          // written with Sqrt, which MathEval surely has.
+          const auto        &c = grading.center;
+          std::ostringstream r, f;
+          r.precision(17);
+          f.precision(17);
+          r << "(Sqrt((x-(" << c[0] << "))^2+(y-(" << c[1] << "))^2+(z-("
+            << c[2] << "))^2)-" << grading.radius << ")";
+          f << grading.fine_size << "+" << grading.growth << "*(" << r.str()
+            << "+Sqrt(" << r.str() << "^2))/2";
+          const int field = gmsh::model::mesh::field::add("MathEval");
+          gmsh::model::mesh::field::setString(field, "F", f.str());
+          gmsh::model::mesh::field::setAsBackgroundMesh(field);
+        }
+      gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+      gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+      gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+      gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+      gmsh::option::setNumber("Mesh.Algorithm",
+                              6);                     // Frontal-Delaunay
+      gmsh::option::setNumber("Mesh.Algorithm3D", 1); // Delaunay
+      gmsh::option::setNumber("Mesh.Optimize", 1);
+    }
+
+
+
+    /** The counts of the mesh Gmsh made at element size @p h. */
+    Pass
+    counts_of_mesh(const double h)
+    {
+      std::size_t              nodes = 0, tets = 0, triangles = 0;
+      std::vector<std::size_t> tags;
+      std::vector<double>      coords, parametric;
+      gmsh::model::mesh::getNodes(tags, coords, parametric);
+      std::vector<int>                      types;
+      std::vector<std::vector<std::size_t>> elements, enodes;
+      gmsh::model::mesh::getElements(types, elements, enodes, 3);
+      nodes = tags.size();
+      tets  = 0;
+      for (std::size_t k = 0; k < types.size(); ++k)
+        if (types[k] == 4)
+          tets += elements[k].size();
+      gmsh::model::mesh::getElements(types, elements, enodes, 2);
+      triangles = 0;
+      for (std::size_t k = 0; k < types.size(); ++k)
+        if (types[k] == 2)
+          triangles += elements[k].size();
+      return {h, nodes, tets, triangles};
+    }
+
+
+
+    /**
+     * One attempt to mesh @p s at element size @p h, classified at
+     * @p angle degrees: its counts in @p result, and the mesh written to
+     * @p out if @p is_best says it is the best so far. False (with Gmsh's
+     * error in @p last_error) if Gmsh fails.
+     */
+    bool
+    mesh_attempt(const Surface                          &s,
+                 const double                            angle,
+                 const double                            h,
+                 const MeshGrading                      &grading,
+                 const std::string                      &out,
+                 const std::function<bool(std::size_t)> &is_best,
+                 Pass                                   &result,
+                 std::string                            &last_error)
+    {
+      bool meshed = false;
+      gmsh::initialize();
+      gmsh::option::setNumber("General.Terminal", 0);
+      gmsh::option::setNumber("General.NumThreads", 1);
+      gmsh::logger::start();
+      try
+        {
+          add_body(s, angle);
+          set_sizes(h, grading);
+          gmsh::model::mesh::generate(3);
+          result = counts_of_mesh(h);
+          if (result.tetrahedra == 0)
+            throw std::runtime_error("Gmsh made no tetrahedra");
+          // Only the pass closest to the target is kept: a later
+          // pass can land farther off than an earlier one.
+          if (is_best(result.nodes))
+            {
+              gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
+              gmsh::option::setNumber("Mesh.Binary", 0);
+              // Written aside and renamed: a child killed while
+              // writing leaves the last complete mesh in @p out.
+              gmsh::write(out + ".pass.msh");
+              std::rename((out + ".pass.msh").c_str(), out.c_str());
+            }
+          meshed = true;
+        }
+      catch (...)
+        {
+          std::string error;
+          gmsh::logger::getLastError(error);
+          last_error = error.empty() ? "Gmsh failed" : error;
+        }
+      gmsh::logger::stop();
+      gmsh::finalize();
+      return meshed;
+    }
+
+
+
+    /**
+     * Tell the parent through @p progress_fd that the best mesh so far,
+     * @p best, is in the output file.
+     */
+    void
+    report_pass(const int          progress_fd,
+                const Pass        &best,
+                const unsigned int attempts,
+                const unsigned int passes,
+                const bool         within)
+    {
+      std::ostringstream r;
+      r.precision(17);
+      r << "PASS " << best.nodes << ' ' << best.tetrahedra << ' '
+        << best.triangles << ' ' << best.h << ' ' << attempts << ' ' << passes
+        << ' ' << within << " 1\n";
+      const std::string line = r.str();
+      if (::write(progress_fd, line.data(), line.size()) < 0)
+        {} // the parent is gone: nothing to tell
+    }
+
+
 
     /**
      * The meshing itself, in the child process: Gmsh's STL-remeshing
@@ -115,128 +302,23 @@ namespace palpate
       };
       for (unsigned int pass = 0; pass < max_passes; ++pass)
         {
-          const auto  pass_start = Clock::now();
-          bool        meshed     = false;
-          std::size_t nodes = 0, tets = 0, triangles = 0;
+          const auto pass_start = Clock::now();
+          bool       meshed     = false;
+          Pass       this_pass;
           for (const double angle : {180., 60., 40., 20.})
             {
               ++attempts;
-              gmsh::initialize();
-              gmsh::option::setNumber("General.Terminal", 0);
-              gmsh::option::setNumber("General.NumThreads", 1);
-              gmsh::logger::start();
-              try
-                {
-                  gmsh::model::add("organ");
-                  const int tag = gmsh::model::addDiscreteEntity(2);
-                  std::vector<std::size_t> node_tags(s.vertices.size());
-                  std::vector<double>      xyz;
-                  for (std::size_t v = 0; v < s.vertices.size(); ++v)
-                    {
-                      node_tags[v] = v + 1;
-                      for (const double x : s.vertices[v])
-                        xyz.push_back(x);
-                    }
-                  gmsh::model::mesh::addNodes(2, tag, node_tags, xyz);
-                  std::vector<std::size_t> element_tags, element_nodes;
-                  for (std::size_t t = 0; t < s.triangles.size(); ++t)
-                    {
-                      element_tags.push_back(t + 1);
-                      for (const unsigned int v : s.triangles[t])
-                        element_nodes.push_back(v + 1);
-                    }
-                  gmsh::model::mesh::addElementsByType(tag,
-                                                       2,
-                                                       element_tags,
-                                                       element_nodes);
-                  gmsh::model::mesh::classifySurfaces(angle * M_PI / 180,
-                                                      true,
-                                                      true,
-                                                      M_PI);
-                  gmsh::model::mesh::createGeometry();
-                  std::vector<std::pair<int, int>> surfaces;
-                  gmsh::model::getEntities(surfaces, 2);
-                  std::vector<int> surface_tags;
-                  for (const auto &e : surfaces)
-                    surface_tags.push_back(e.second);
-                  const int loop =
-                    gmsh::model::geo::addSurfaceLoop(surface_tags);
-                  const int body = gmsh::model::geo::addVolume({loop});
-                  gmsh::model::geo::synchronize();
-                  gmsh::model::addPhysicalGroup(3, {body}, 1);
-                  gmsh::model::addPhysicalGroup(2, surface_tags, 1);
-                  const bool refined = graded && grading.fine_size < h;
-                  gmsh::option::setNumber("Mesh.MeshSizeMin",
-                                          0.5 *
-                                            (refined ? grading.fine_size : h));
-                  if (refined)
-                    {
-                      // size(r) = fine + growth max(0, r - radius), capped
-                      // at h by MeshSizeMax; max(0, t) = (t + |t|)/2
-                      // written with Sqrt, which MathEval surely has.
-                      const auto        &c = grading.center;
-                      std::ostringstream r, f;
-                      r.precision(17);
-                      f.precision(17);
-                      r << "(Sqrt((x-(" << c[0] << "))^2+(y-(" << c[1]
-                        << "))^2+(z-(" << c[2] << "))^2)-" << grading.radius
-                        << ")";
-                      f << grading.fine_size << "+" << grading.growth << "*("
-                        << r.str() << "+Sqrt(" << r.str() << "^2))/2";
-                      const int field =
-                        gmsh::model::mesh::field::add("MathEval");
-                      gmsh::model::mesh::field::setString(field, "F", f.str());
-                      gmsh::model::mesh::field::setAsBackgroundMesh(field);
-                    }
-                  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
-                  gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-                  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-                  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-                  gmsh::option::setNumber("Mesh.Algorithm",
-                                          6); // Frontal-Delaunay
-                  gmsh::option::setNumber("Mesh.Algorithm3D", 1); // Delaunay
-                  gmsh::option::setNumber("Mesh.Optimize", 1);
-                  gmsh::model::mesh::generate(3);
-
-                  std::vector<std::size_t> tags;
-                  std::vector<double>      coords, parametric;
-                  gmsh::model::mesh::getNodes(tags, coords, parametric);
-                  std::vector<int>                      types;
-                  std::vector<std::vector<std::size_t>> elements, enodes;
-                  gmsh::model::mesh::getElements(types, elements, enodes, 3);
-                  nodes = tags.size();
-                  tets  = 0;
-                  for (std::size_t k = 0; k < types.size(); ++k)
-                    if (types[k] == 4)
-                      tets += elements[k].size();
-                  gmsh::model::mesh::getElements(types, elements, enodes, 2);
-                  triangles = 0;
-                  for (std::size_t k = 0; k < types.size(); ++k)
-                    if (types[k] == 2)
-                      triangles += elements[k].size();
-                  if (tets == 0)
-                    throw std::runtime_error("Gmsh made no tetrahedra");
-                  // Only the pass closest to the target is kept: a later
-                  // pass can land farther off than an earlier one.
-                  if (best.nodes == 0 || off(nodes) < off(best.nodes))
-                    {
-                      gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
-                      gmsh::option::setNumber("Mesh.Binary", 0);
-                      // Written aside and renamed: a child killed while
-                      // writing leaves the last complete mesh in @p out.
-                      gmsh::write(out + ".pass.msh");
-                      std::rename((out + ".pass.msh").c_str(), out.c_str());
-                    }
-                  meshed = true;
-                }
-              catch (...)
-                {
-                  std::string error;
-                  gmsh::logger::getLastError(error);
-                  last_error = error.empty() ? "Gmsh failed" : error;
-                }
-              gmsh::logger::stop();
-              gmsh::finalize();
+              meshed = mesh_attempt(
+                s,
+                angle,
+                h,
+                grading,
+                out,
+                [&](const std::size_t nodes) {
+                  return best.nodes == 0 || off(nodes) < off(best.nodes);
+                },
+                this_pass,
+                last_error);
               if (meshed)
                 break;
             }
@@ -251,23 +333,16 @@ namespace palpate
           ++passes;
           const double seconds =
             std::chrono::duration<double>(Clock::now() - pass_start).count();
-          const Pass this_pass{h, nodes, tets, triangles};
-          if (best.nodes == 0 || off(nodes) < off(best.nodes))
+          if (best.nodes == 0 || off(this_pass.nodes) < off(best.nodes))
             best = this_pass;
           // The best mesh so far is in @p out: say so at once, so that if
           // the next pass overruns the time limit and the parent kills this
           // process, the parent keeps this one instead of failing.
-          {
-            std::ostringstream r;
-            r.precision(17);
-            r << "PASS " << best.nodes << ' ' << best.tetrahedra << ' '
-              << best.triangles << ' ' << best.h << ' ' << attempts << ' '
-              << passes << ' ' << (off(best.nodes) <= target_nodes_tolerance)
-              << " 1\n";
-            const std::string line = r.str();
-            if (::write(progress_fd, line.data(), line.size()) < 0)
-              {} // the parent is gone: nothing to tell
-          }
+          report_pass(progress_fd,
+                      best,
+                      attempts,
+                      passes,
+                      off(best.nodes) <= target_nodes_tolerance);
           if (off(best.nodes) <= target_nodes_tolerance ||
               pass + 1 == max_passes)
             break;
@@ -278,7 +353,7 @@ namespace palpate
           const double elapsed =
             std::chrono::duration<double>(Clock::now() - start).count();
           const double next_seconds =
-            1.5 * seconds * std::max(1., double(target) / nodes);
+            1.5 * seconds * std::max(1., double(target) / this_pass.nodes);
           if (elapsed + next_seconds > 0.8 * time_limit)
             {
               stopped_by_time = true;
