@@ -167,6 +167,9 @@ namespace palpate
     Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
     Clock::time_point previous_call;
     bool first_call = true, was_complete = false, in_contact = false;
+    // Whether track() has seen a finite position (the first has no
+    // velocity).
+    bool velocity_known = false;
 
     // Shared with other threads: atomics only.
     std::atomic<bool>         is_attached{false}, complete{false}, reset{false};
@@ -183,6 +186,44 @@ namespace palpate
     std::atomic<double>        event_position[3] = {};
     std::uint64_t              reported_events   = 0;
     Clock::time_point          attach_time;
+
+    /** Seconds since the last force() call (1 ms at the first). */
+    double
+    tick() noexcept
+    {
+      const auto now = Clock::now();
+      double     dt  = first_call ?
+                         0.001 :
+                         std::chrono::duration<double>(now - previous_call).count();
+      if (!(dt > 0))
+        dt = 1e-6;
+      previous_call = now;
+      first_call    = false;
+      return dt;
+    }
+
+    /** The HIP's velocity for the scheduler's look-ahead: first-order low
+     * pass of the position differences, time constant 20 ms; both go to
+     * the HIP channel. False (and nothing written) for a non-finite
+     * position. */
+    bool
+    track(const Utilities::Point3 &position, const double dt) noexcept
+    {
+      for (const double x : position)
+        if (!std::isfinite(x))
+          return false;
+      const double alpha = std::min(1.0, dt / 0.02);
+      for (unsigned int d = 0; d < 3; ++d)
+        {
+          const double v =
+            velocity_known ? (position[d] - previous_position[d]) / dt : 0.0;
+          velocity[d] += alpha * (v - velocity[d]);
+        }
+      velocity_known = true;
+      hip.write(position, velocity);
+      previous_position = position;
+      return true;
+    }
   };
 
 
@@ -282,34 +323,11 @@ namespace palpate
         s.previous_held  = false;
         s.hold.reset();
       }
-    const auto now = Clock::now();
-    double     dt  = s.first_call ?
-                       0.001 :
-                       std::chrono::duration<double>(now - s.previous_call).count();
-    if (!(dt > 0))
-      dt = 1e-6;
-
-    // A non-finite position is treated as "outside": no force.
-    bool finite = true;
-    for (const double x : position)
-      finite = finite && std::isfinite(x);
-
-    // Velocity for the scheduler's look-ahead: first-order low pass of the
-    // position differences, time constant 20 ms.
-    if (finite)
-      {
-        const double alpha = std::min(1.0, dt / 0.02);
-        for (unsigned int d = 0; d < 3; ++d)
-          {
-            const double v =
-              s.first_call ? 0.0 : (position[d] - s.previous_position[d]) / dt;
-            s.velocity[d] += alpha * (v - s.velocity[d]);
-          }
-        s.hip.write(position, s.velocity);
-        s.previous_position = position;
-      }
-    s.previous_call = now;
-    s.first_call    = false;
+    // The time since the last call, and the HIP's position and velocity
+    // for the scheduler; a non-finite position is treated as "outside":
+    // no force.
+    const double dt     = s.tick();
+    const bool   finite = s.track(position, dt);
 
     // Interpolation from the 8 corners (and, for Hermite, their
     // neighbours' stiffnesses), if all corners are there.

@@ -62,6 +62,36 @@ namespace palpate
          const NodeSelection             &nodes,
          const Parameters::AllParameters &p);
 
+    // The constructor's steps (step-44's system_setup, in parts).
+    /** The DoFs, and where each cell's displacement and pressure DoFs are
+     * among its local ones. */
+    void
+    distribute_dofs();
+    /** Which DoFs are fixed, which are the active node's (and a rigid
+     * tip's other nodes', into @p tip_dofs); returns the fixed mask. */
+    std::vector<bool>
+    find_fixed_and_active_dofs(std::vector<unsigned int> &tip_dofs);
+    /** Tip = sphere: the surface nodes that may touch it. */
+    void
+    find_contact_candidates(const Parameters::AllParameters &p,
+                            const std::vector<bool>         &dof_fixed);
+    /** The equations' numbering; returns how many. */
+    unsigned int
+    number_equations(const Parameters::AllParameters &p,
+                     const std::vector<bool>         &dof_fixed,
+                     const std::vector<unsigned int> &tip_dofs,
+                     const bool                       sphere,
+                     const bool                       has_active);
+    /** Shape gradients, JxW and DoF indices per cell, cached once. */
+    void
+    cache_geometry(const double mu);
+    /** The sparsity pattern and where each local entry goes. */
+    void
+    build_sparsity(const unsigned int n_eq);
+    /** Cell colours for lock-free threaded assembly. */
+    void
+    color_cells();
+
     /** Residual and tangent contributions of cell @p c, scattered. */
     template <bool with_matrix, bool to_dofs>
     bool
@@ -223,6 +253,43 @@ namespace palpate
     , dof_handler(mesh.triangulation())
     , n_threads(p.nonlinear_solver.assembly_threads)
   {
+    distribute_dofs();
+    const unsigned int n_cells = mesh.n_cells();
+    L                          = mesh.diameter();
+    const double h_mean        = std::cbrt(mesh.volume() / n_cells);
+
+    std::vector<unsigned int> tip_dofs;
+    const std::vector<bool>   dof_fixed = find_fixed_and_active_dofs(tip_dofs);
+    const bool                has_active =
+      nodes.active_vertex != NodeSelection::no_active_node;
+    const bool sphere = has_active && p.boundary_conditions.active_node.tip ==
+                                        Parameters::ActiveNode::Tip::sphere;
+    if (sphere)
+      find_contact_candidates(p, dof_fixed);
+    const unsigned int n_eq =
+      number_equations(p, dof_fixed, tip_dofs, sphere, has_active);
+    const double mu = material->shear_modulus();
+    cache_geometry(mu);
+    build_sparsity(n_eq);
+
+    // --- Scales: the constraint rows by a typical diagonal stiffness E h,
+    // the pressure unknowns by mu/h, so that every row is a force (N) and
+    // every unknown a length (m).
+    beta = material->youngs_modulus() * h_mean;
+    if (mixed)
+      pressure_scale = mu / h_mean;
+
+    color_cells();
+    if (n_threads > 1)
+      arena = std::make_unique<tbb::task_arena>(n_threads);
+    u_work.resize(dof_handler.n_dofs());
+  }
+
+
+
+  void
+  HyperelasticSystem::Impl::distribute_dofs()
+  {
     dof_handler.distribute_dofs(*fe);
     n_nodes_per_cell = fe->base_element(0).n_dofs_per_cell();
     n_pressure       = mixed ? fe->base_element(1).n_dofs_per_cell() : 0;
@@ -234,30 +301,32 @@ namespace palpate
         local_dof[3 * k + c] = fe->component_to_system_index(c, k);
     for (unsigned int m = 0; m < n_pressure; ++m)
       local_pdof.push_back(fe->component_to_system_index(3, m));
+  }
 
-    const unsigned int n_cells = mesh.n_cells();
-    const unsigned int n_dofs  = dof_handler.n_dofs();
-    L                          = mesh.diameter();
-    const double h_mean        = std::cbrt(mesh.volume() / n_cells);
 
-    // --- Which DoFs are fixed, which are the active node's. A DoF on a
-    // vertex belongs to that node; a DoF on an edge (P2) is fixed when both
-    // of the edge's end nodes are. Pressure DoFs are never fixed.
+
+  // A DoF on a vertex belongs to that node; a DoF on an edge (P2) is fixed
+  // when both of the edge's end nodes are. Pressure DoFs are never fixed.
+  std::vector<bool>
+  HyperelasticSystem::Impl::find_fixed_and_active_dofs(
+    std::vector<unsigned int> &tip_dofs)
+  {
+    const unsigned int n_dofs = dof_handler.n_dofs();
+    const bool         has_active =
+      nodes.active_vertex != NodeSelection::no_active_node;
     std::vector<unsigned int> vertex_mask(mesh.n_vertices(),
                                           0); // bit c: component c fixed
     for (const unsigned int v : nodes.fixed_vertices)
       vertex_mask[v] = 7;
     for (const auto &[v, c] : nodes.fixed_components)
       vertex_mask[v] |= 1u << c;
-    const bool has_active =
-      nodes.active_vertex != NodeSelection::no_active_node;
     std::vector<bool> dof_fixed(n_dofs, false);
     active.fill(static_cast<unsigned int>(-1));
     // A rigid tip: its other nodes' DoFs, in the order of tip_vertices.
     std::vector<int> tip_index(mesh.n_vertices(), -1);
     for (unsigned int t = 0; t < nodes.tip_vertices.size(); ++t)
       tip_index[nodes.tip_vertices[t]] = t;
-    std::vector<unsigned int> tip_dofs(3 * nodes.tip_vertices.size(), 0);
+    tip_dofs.assign(3 * nodes.tip_vertices.size(), 0);
     dof_position.resize(n_dofs);
     dof_component.resize(n_dofs);
     std::vector<types::global_dof_index> dofs(dofs_per_cell);
@@ -303,81 +372,100 @@ namespace palpate
       if (dof_fixed[d])
         fixed.push_back(d);
     fixed_value.assign(n_dofs, 0.0);
+    return dof_fixed;
+  }
 
+
+
+  void
+  HyperelasticSystem::Impl::find_contact_candidates(
+    const Parameters::AllParameters &p,
+    const std::vector<bool>         &dof_fixed)
+  {
     // --- Tip = sphere: the contact candidates are the free surface nodes,
     // the vertices and (P2) the midpoints of the surface triangles' edges.
     // All of them, not only those near the probe's rest position: the
     // probe may go anywhere (palpate solve --to, the live view), a
     // candidate that is not touched costs one trivial row, and the
     // residual's loop over them is nothing next to the cells'.
-    const bool sphere = has_active && p.boundary_conditions.active_node.tip ==
-                                        Parameters::ActiveNode::Tip::sphere;
-    if (sphere)
+    std::vector<types::global_dof_index> dofs(dofs_per_cell);
+    const unsigned int first_line = fe->get_first_line_index();
+    const unsigned int first_quad = fe->get_first_quad_index(0);
+    sphere_radius      = p.boundary_conditions.active_node.tip_radius;
+    sphere_rest_center = nodes.sphere_center;
+    std::set<std::pair<unsigned int, unsigned int>> surface_edges;
+    for (const auto &face : mesh.surface_faces())
+      for (unsigned int i = 0; i < 3; ++i)
+        surface_edges.insert(
+          std::minmax(face.vertices[i], face.vertices[(i + 1) % 3]));
+    // Node key: vertex v -> v, edge -> n_vertices + line index.
+    std::map<unsigned int, std::array<unsigned int, 3>> node_dofs;
+    std::map<unsigned int, Utilities::Point3>           node_position;
+    for (const auto &cell : dof_handler.active_cell_iterators())
       {
-        sphere_radius      = p.boundary_conditions.active_node.tip_radius;
-        sphere_rest_center = nodes.sphere_center;
-        std::set<std::pair<unsigned int, unsigned int>> surface_edges;
-        for (const auto &face : mesh.surface_faces())
-          for (unsigned int i = 0; i < 3; ++i)
-            surface_edges.insert(
-              std::minmax(face.vertices[i], face.vertices[(i + 1) % 3]));
-        // Node key: vertex v -> v, edge -> n_vertices + line index.
-        std::map<unsigned int, std::array<unsigned int, 3>> node_dofs;
-        std::map<unsigned int, Utilities::Point3>           node_position;
-        for (const auto &cell : dof_handler.active_cell_iterators())
+        cell->get_dof_indices(dofs);
+        for (unsigned int i = 0; i < first_quad && i < dofs_per_cell; ++i)
           {
-            cell->get_dof_indices(dofs);
-            for (unsigned int i = 0; i < first_quad && i < dofs_per_cell; ++i)
+            const unsigned int component =
+              fe->system_to_component_index(i).first;
+            if (component >= 3)
+              continue;
+            unsigned int key;
+            if (i < first_line)
               {
-                const unsigned int component =
-                  fe->system_to_component_index(i).first;
-                if (component >= 3)
+                key = cell->vertex_index(i / fe->n_dofs_per_vertex());
+                if (!mesh.on_surface()[key])
                   continue;
-                unsigned int key;
-                if (i < first_line)
-                  {
-                    key = cell->vertex_index(i / fe->n_dofs_per_vertex());
-                    if (!mesh.on_surface()[key])
-                      continue;
-                  }
-                else
-                  {
-                    const auto line =
-                      cell->line((i - first_line) / fe->n_dofs_per_line());
-                    if (!surface_edges.count(std::minmax(
-                          line->vertex_index(0), line->vertex_index(1))))
-                      continue;
-                    key = mesh.n_vertices() + line->index();
-                  }
-                node_dofs[key][component] = dofs[i];
-                node_position[key]        = dof_position[dofs[i]];
               }
-          }
-        for (const auto &face : mesh.surface_faces())
-          {
-            std::array<std::array<unsigned int, 3>, 3> d;
-            std::array<Utilities::Point3, 3>           X;
-            for (unsigned int i = 0; i < 3; ++i)
+            else
               {
-                d[i] = node_dofs.at(face.vertices[i]);
-                X[i] = node_position.at(face.vertices[i]);
+                const auto line =
+                  cell->line((i - first_line) / fe->n_dofs_per_line());
+                if (!surface_edges.count(std::minmax(line->vertex_index(0),
+                                                     line->vertex_index(1))))
+                  continue;
+                key = mesh.n_vertices() + line->index();
               }
-            surface_dofs.push_back(d);
-            surface_rest.push_back(X);
+            node_dofs[key][component] = dofs[i];
+            node_position[key]        = dof_position[dofs[i]];
           }
-        // A node with some components fixed (a symmetry plane) slides on
-        // its plane and may touch; one fixed entirely cannot move.
-        for (const auto &[key, d] : node_dofs)
-          if (!dof_fixed[d[0]] || !dof_fixed[d[1]] || !dof_fixed[d[2]])
-            {
-              ContactNode c;
-              c.dof      = d;
-              c.position = node_position[key];
-              contact.push_back(c);
-            }
-        n_contact = contact.size();
       }
+    for (const auto &face : mesh.surface_faces())
+      {
+        std::array<std::array<unsigned int, 3>, 3> d;
+        std::array<Utilities::Point3, 3>           X;
+        for (unsigned int i = 0; i < 3; ++i)
+          {
+            d[i] = node_dofs.at(face.vertices[i]);
+            X[i] = node_position.at(face.vertices[i]);
+          }
+        surface_dofs.push_back(d);
+        surface_rest.push_back(X);
+      }
+    // A node with some components fixed (a symmetry plane) slides on
+    // its plane and may touch; one fixed entirely cannot move.
+    for (const auto &[key, d] : node_dofs)
+      if (!dof_fixed[d[0]] || !dof_fixed[d[1]] || !dof_fixed[d[2]])
+        {
+          ContactNode c;
+          c.dof      = d;
+          c.position = node_position[key];
+          contact.push_back(c);
+        }
+    n_contact = contact.size();
+  }
 
+
+
+  unsigned int
+  HyperelasticSystem::Impl::number_equations(
+    const Parameters::AllParameters &p,
+    const std::vector<bool>         &dof_fixed,
+    const std::vector<unsigned int> &tip_dofs,
+    const bool                       sphere,
+    const bool                       has_active)
+  {
+    const unsigned int n_dofs = dof_handler.n_dofs();
     // --- Equations: free DoFs first (in DoF order), then multipliers: the
     // active node's three, then the fixed DoFs' if they use multipliers.
     const bool eliminate =
@@ -402,8 +490,16 @@ namespace palpate
     for (auto &c : contact)
       for (unsigned int a = 0; a < 3; ++a)
         c.eq[a] = eq_of_dof[c.dof[a]];
-    const unsigned int n_eq = n_free + n_contact + multiplier_dof.size();
+    return n_free + n_contact + multiplier_dof.size();
+  }
 
+
+
+  void
+  HyperelasticSystem::Impl::cache_geometry(const double mu)
+  {
+    const unsigned int                   n_cells = mesh.n_cells();
+    std::vector<types::global_dof_index> dofs(dofs_per_cell);
     // --- Geometry, cached once: shape gradients, JxW, DoF indices; the
     // pressure shape values (the same on every cell of an affine simplex
     // mesh) and, for the stabilisation, gradients and cell sizes.
@@ -427,7 +523,6 @@ namespace palpate
         pressure_gradients.resize(std::size_t(n_cells) * n_pressure * 3);
         stabilization_tau.resize(n_cells);
       }
-    const double mu = material->shear_modulus();
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         const unsigned int c = cell->active_cell_index();
@@ -476,7 +571,14 @@ namespace palpate
               }
           }
       }
+  }
 
+
+
+  void
+  HyperelasticSystem::Impl::build_sparsity(const unsigned int n_eq)
+  {
+    const unsigned int n_cells = mesh.n_cells();
     // --- Sparsity pattern of the equations, and where each local entry
     // goes.
     std::vector<std::vector<unsigned int>> rows(n_eq);
@@ -549,14 +651,14 @@ namespace palpate
                                            -1;
           }
       }
+  }
 
-    // --- Scales: the constraint rows by a typical diagonal stiffness E h,
-    // the pressure unknowns by mu/h, so that every row is a force (N) and
-    // every unknown a length (m).
-    beta = material->youngs_modulus() * h_mean;
-    if (mixed)
-      pressure_scale = mu / h_mean;
 
+
+  void
+  HyperelasticSystem::Impl::color_cells()
+  {
+    const unsigned int n_cells = mesh.n_cells();
     // --- Cell colours: no two cells of a colour share a node, so threads
     // can add into the global vectors without locks. (Vertices are taken
     // from the DoF cells, indexed as the assembly indexes them.)
@@ -584,9 +686,6 @@ namespace palpate
           colors.resize(k + 1);
         colors[k].push_back(c);
       }
-    if (n_threads > 1)
-      arena = std::make_unique<tbb::task_arena>(n_threads);
-    u_work.resize(n_dofs);
   }
 
 
@@ -639,6 +738,12 @@ namespace palpate
 
 
 
+  // One function on purpose (about 150 lines): the assembly's kernel, run
+  // for every cell at every Newton iteration. It reads top-down as the weak
+  // form (kinematics, stress, residual, tangent, scatter), and its loops
+  // share the quadrature point's F, S and C and the cell's local arrays;
+  // split, they would pass between the pieces on the hottest path of the
+  // solver (doc/benchmarks/newton.md times it).
   template <bool with_matrix, bool to_dofs>
   bool
   HyperelasticSystem::Impl::assemble_cell(const unsigned int         c,

@@ -248,6 +248,61 @@ namespace palpate
            State                   &state,
            const bool               may_cut_back = false);
 
+    /** Whether @p from is a start for a solve to @p target: a finite
+     * target, and a converged, finite state of this body. If not, @p state
+     * is the failure point that says so. */
+    bool
+    admissible_start(const State             &from,
+                     const Utilities::Point3 &target,
+                     State                   &state) const;
+
+    /** A converged state behind @p from on the line to @p target (and a
+     * second one behind it, for one increment) as the increment before the
+     * first: sets @p previous and @p previous_t for the secant predictor,
+     * or leaves them empty. */
+    void
+    predictor_from_behind(const State               &from,
+                          const Utilities::Point3   &target,
+                          const State               *behind,
+                          const State               *behind2,
+                          const unsigned int         n,
+                          const std::vector<double> &x,
+                          std::vector<double>       &previous,
+                          double                    &previous_t) const;
+
+    /** Whether the converged end @p x (in @p state) is one to hand out: a
+     * finite force and, with a sphere, a sphere still outside the deformed
+     * surface. Otherwise @p failure says why. */
+    bool
+    acceptable_end(const std::vector<double> &x,
+                   State                     &state,
+                   Outcome                   &failure) const;
+
+    /** The Newton step K dx = -R into `step` (from `residual`), exactly or
+     * by GMRES on a kept factorisation; fills @p record's solver fields.
+     * False if the linear solver failed. */
+    bool
+    newton_step(NewtonIteration &record);
+
+    /** The step length along `step` from @p x: the accepted trial is left
+     * in best_x and best_residual. Returns (alpha, force scale there);
+     * alpha < 0 when every step tried inverts an element. */
+    /** Why the Newton solve stagnates after @p record (its last
+     * accepted step), or "": no progress from a start outside the basin,
+     * or a line search cutting every step short (counted in
+     * @p short_steps). */
+    std::string
+    stagnation(const State           &state,
+               const NewtonIteration &record,
+               const unsigned int     iteration,
+               const bool             may_cut_back,
+               unsigned int          &short_steps) const;
+
+    std::pair<double, double>
+    line_search(const std::vector<double> &x,
+                const Utilities::Point3   &target,
+                const unsigned int         iteration);
+
     /**
      * Whether @p residual is an equilibrium: force residual below the
      * tolerance relative to the force scale and the constraints satisfied;
@@ -419,6 +474,188 @@ namespace palpate
 
 
 
+  bool
+  StateSolver::Impl::newton_step(NewtonIteration &record)
+  {
+    // The Newton step: K dx = -R. With a kept factorisation (of an
+    // earlier tangent in this state, or of the last state this solver
+    // computed, usually a neighbour) GMRES solves it in a few
+    // preconditioned iterations, at a fraction of a factorisation. When
+    // GMRES needs more than the allowed iterations the tangent has
+    // drifted too far from the factorised one: factorise it.
+    //
+    // How exactly: to |K dx + R| <= 1e-4 |R|. Each Newton step then
+    // cuts the residual by at least 1e-4, which within the three or
+    // four steps a state takes is as good as quadratic convergence
+    // (measured: the same Newton iterations per state as exact steps;
+    // Eisenstat and Walker's adaptive forcing terms cost 0.9 more
+    // iterations per state here), while GMRES from a neighbour's
+    // factorisation reaches it in a few iterations. The convergence
+    // test of the state is the same either way.
+    step = residual;
+    for (double &s : step)
+      s = -s;
+    const double eta         = 1e-4;
+    record.factorized        = true;
+    record.krylov_iterations = 0;
+    if (settings.reuse_factorization && factorized)
+      {
+        record.krylov_iterations = preconditioned_gmres(step, eta);
+        record.factorized        = record.krylov_iterations == 0;
+      }
+    return !record.factorized ||
+           factorize_and_solve(step, eta, record.krylov_iterations);
+  }
+
+
+
+  std::pair<double, double>
+  StateSolver::Impl::line_search(const std::vector<double> &x,
+                                 const Utilities::Point3   &target,
+                                 const unsigned int         iteration)
+  {
+    // Step length. While the active node's constraint is violated (the
+    // first iteration of an increment), the step is the predictor that
+    // moves the node onto its target: take the longest admissible one
+    // of 1, 1/2, 1/4, ... Afterwards every Newton step keeps the
+    // constraint (B dx = 0), the multipliers drop out of
+    // s(alpha) = R(x + alpha dx) . dx = dPi/dalpha, and the line search
+    // looks for a step where the energy Pi stops decreasing:
+    // |s(alpha)| <= 0.8 |s(0)| (Crisfield's criterion), by regula falsi
+    // on s. If dx is not a descent direction (s(0) >= 0: the tangent is
+    // indefinite near a buckling point), it backtracks on the residual
+    // norm instead. Without line search the full step is taken.
+    const double phi0 = norm(residual);
+    //
+    // With a sphere the constraints are the contact conditions, which
+    // stay violated while the active set changes from step to step:
+    // only the first step of an increment (the probe has moved) is a
+    // predictor; afterwards the residual norm must decrease, which
+    // keeps the semi-smooth Newton method from cycling between active
+    // sets (full steps cycled for 25 iterations on the liver).
+    const bool predictor =
+      system->constraint_violation(residual) >
+        settings.increment_tolerance * system->length_scale() &&
+      (iteration == 0 || !system->has_contact());
+    const double s0 = directional_derivative(residual, step);
+    // The energy of the mixed u-p formulation has a saddle in p, so
+    // there the residual norm is the merit function.
+    // So it is with contact, whose active set may change under the
+    // step (the energy is then not smooth along it).
+    const bool energy =
+      !predictor && s0 < 0 && !system->has_pressure() && !system->has_contact();
+    double alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
+    double lower = 0, s_lower = s0, upper = -1, s_upper = 0;
+    const unsigned int steps =
+      settings.line_search ? settings.max_line_search_steps : 1;
+    for (unsigned int k = 0; k < steps; ++k)
+      {
+        trial = x;
+        for (unsigned int i = 0; i < x.size(); ++i)
+          trial[i] += alpha * step[i];
+        double trial_scale = 0;
+        if (!system->assemble(
+              trial, target, trial_residual, nullptr, &trial_scale))
+          {
+            // Inadmissible (an element inverts): shorten the step.
+            upper   = alpha;
+            s_upper = std::numeric_limits<double>::max();
+            alpha   = 0.5 * (lower + alpha);
+            continue;
+          }
+        const double phi   = norm(trial_residual);
+        const double s     = directional_derivative(trial_residual, step);
+        const double merit = energy ? std::abs(s) : phi;
+        if (best_alpha < 0 || merit < best_merit)
+          {
+            best_alpha = alpha;
+            best_merit = merit;
+            best_scale = trial_scale;
+            best_x.swap(trial);
+            best_residual.swap(trial_residual);
+          }
+        if (predictor)
+          break; // the longest admissible predictor step
+        if (energy)
+          {
+            if (std::abs(s) <= 0.8 * std::abs(s0) || (s < 0 && upper < 0))
+              break; // energy stationary enough, or still descending at the
+                     // full step
+            // Regula falsi on s between the bracket ends.
+            if (s < 0)
+              lower = alpha, s_lower = s;
+            else
+              upper = alpha, s_upper = s;
+            alpha = (s_upper == std::numeric_limits<double>::max()) ?
+                      0.5 * (lower + upper) :
+                      lower - s_lower * (upper - lower) / (s_upper - s_lower);
+            alpha = std::clamp(alpha,
+                               lower + 0.05 * (upper - lower),
+                               upper - 0.05 * (upper - lower));
+          }
+        else
+          {
+            if (phi <= (1 - 1e-4 * alpha) * phi0)
+              break;
+            // g(a) = phi(a)^2 has g'(0) = -2 g(0) along the Newton
+            // step; minimise the quadratic through g(0), g'(0), g(a).
+            const double g0 = phi0 * phi0;
+            const double a =
+              g0 * alpha * alpha / (phi * phi - g0 + 2 * g0 * alpha);
+            alpha = std::clamp(a, 0.1 * alpha, 0.5 * alpha);
+          }
+      }
+    return {best_alpha, best_scale};
+  }
+
+
+
+  std::string
+  StateSolver::Impl::stagnation(const State           &state,
+                                const NewtonIteration &record,
+                                const unsigned int     iteration,
+                                const bool             may_cut_back,
+                                unsigned int          &short_steps) const
+  {
+    // Stagnation while the increment can still be halved, where the
+    // residual norm is the line search's merit (a pressure field or
+    // contact): four accepted steps that did not reduce it by a tenth.
+    // Newton's method near a solution cuts it by far more, even while
+    // the sphere's contact set settles (0.97 -> 0.04 in three steps):
+    // this is a start outside the basin. A sphere moved 5 mm sideways
+    // pressed nodes deep into it and the semi-smooth iteration wandered
+    // at a relative residual of 1 for 20 iterations before it found the
+    // way (1,607-node liver, doc/benchmarks/organ-speed.md); two half
+    // increments cost less. (With the energy as merit the residual may
+    // rise on the way to a solution: a locking StVK at nu = 0.4999
+    // converges so, tests/hyperelastic/hard_cases.)
+    const std::size_t n_history = state.history.size();
+    if (may_cut_back && (system->has_pressure() || system->has_contact()) &&
+        iteration >= 4 && n_history >= 5 &&
+        state.history[n_history - 5].increment == state.increments &&
+        record.residual_after >
+          0.9 * state.history[n_history - 5].residual_after)
+      {
+        return "Newton stagnates: the relative residual " +
+               Utilities::to_string(record.residual_after, 3) +
+               " fell by less than a tenth in four iterations";
+      }
+
+    // A line search that keeps cutting the step to almost nothing is
+    // not getting anywhere: stop instead of burning the iteration
+    // budget (the state is a failure point either way).
+    short_steps = record.step_length < 1e-2 ? short_steps + 1 : 0;
+    if (short_steps == 4)
+      {
+        return "Newton stagnates: 4 line-search steps shorter than 1/100 "
+               "(relative residual " +
+               Utilities::to_string(record.residual_after, 3) + ")";
+      }
+    return "";
+  }
+
+
+
   StateSolver::Impl::Outcome
   StateSolver::Impl::newton(std::vector<double>     &x,
                             const Utilities::Point3 &target,
@@ -486,35 +723,8 @@ namespace palpate
         record.residual_before = system->force_residual_norm(residual) / scale;
         record.assembly_time   = assembly_time;
 
-        // The Newton step: K dx = -R. With a kept factorisation (of an
-        // earlier tangent in this state, or of the last state this solver
-        // computed, usually a neighbour) GMRES solves it in a few
-        // preconditioned iterations, at a fraction of a factorisation. When
-        // GMRES needs more than the allowed iterations the tangent has
-        // drifted too far from the factorised one: factorise it.
-        //
-        // How exactly: to |K dx + R| <= 1e-4 |R|. Each Newton step then
-        // cuts the residual by at least 1e-4, which within the three or
-        // four steps a state takes is as good as quadratic convergence
-        // (measured: the same Newton iterations per state as exact steps;
-        // Eisenstat and Walker's adaptive forcing terms cost 0.9 more
-        // iterations per state here), while GMRES from a neighbour's
-        // factorisation reaches it in a few iterations. The convergence
-        // test of the state is the same either way.
         start = Clock::now();
-        step  = residual;
-        for (double &s : step)
-          s = -s;
-        const double eta         = 1e-4;
-        record.factorized        = true;
-        record.krylov_iterations = 0;
-        if (settings.reuse_factorization && factorized)
-          {
-            record.krylov_iterations = preconditioned_gmres(step, eta);
-            record.factorized        = record.krylov_iterations == 0;
-          }
-        if (record.factorized &&
-            !factorize_and_solve(step, eta, record.krylov_iterations))
+        if (!newton_step(record))
           {
             outcome.status     = SolveStatus::linear_solver_failure;
             outcome.iterations = iteration;
@@ -525,100 +735,9 @@ namespace palpate
           }
         record.solve_time = seconds_since(start);
 
-        // Step length. While the active node's constraint is violated (the
-        // first iteration of an increment), the step is the predictor that
-        // moves the node onto its target: take the longest admissible one
-        // of 1, 1/2, 1/4, ... Afterwards every Newton step keeps the
-        // constraint (B dx = 0), the multipliers drop out of
-        // s(alpha) = R(x + alpha dx) . dx = dPi/dalpha, and the line search
-        // looks for a step where the energy Pi stops decreasing:
-        // |s(alpha)| <= 0.8 |s(0)| (Crisfield's criterion), by regula falsi
-        // on s. If dx is not a descent direction (s(0) >= 0: the tangent is
-        // indefinite near a buckling point), it backtracks on the residual
-        // norm instead. Without line search the full step is taken.
-        start             = Clock::now();
-        const double phi0 = norm(residual);
-        //
-        // With a sphere the constraints are the contact conditions, which
-        // stay violated while the active set changes from step to step:
-        // only the first step of an increment (the probe has moved) is a
-        // predictor; afterwards the residual norm must decrease, which
-        // keeps the semi-smooth Newton method from cycling between active
-        // sets (full steps cycled for 25 iterations on the liver).
-        const bool predictor =
-          system->constraint_violation(residual) >
-            settings.increment_tolerance * system->length_scale() &&
-          (iteration == 0 || !system->has_contact());
-        const double s0 = directional_derivative(residual, step);
-        // The energy of the mixed u-p formulation has a saddle in p, so
-        // there the residual norm is the merit function.
-        // So it is with contact, whose active set may change under the
-        // step (the energy is then not smooth along it).
-        const bool energy = !predictor && s0 < 0 && !system->has_pressure() &&
-                            !system->has_contact();
-        double alpha = 1, best_alpha = -1, best_merit = 0, best_scale = 0;
-        double lower = 0, s_lower = s0, upper = -1, s_upper = 0;
-        const unsigned int steps =
-          settings.line_search ? settings.max_line_search_steps : 1;
-        for (unsigned int k = 0; k < steps; ++k)
-          {
-            trial = x;
-            for (unsigned int i = 0; i < x.size(); ++i)
-              trial[i] += alpha * step[i];
-            double trial_scale = 0;
-            if (!system->assemble(
-                  trial, target, trial_residual, nullptr, &trial_scale))
-              {
-                // Inadmissible (an element inverts): shorten the step.
-                upper   = alpha;
-                s_upper = std::numeric_limits<double>::max();
-                alpha   = 0.5 * (lower + alpha);
-                continue;
-              }
-            const double phi   = norm(trial_residual);
-            const double s     = directional_derivative(trial_residual, step);
-            const double merit = energy ? std::abs(s) : phi;
-            if (best_alpha < 0 || merit < best_merit)
-              {
-                best_alpha = alpha;
-                best_merit = merit;
-                best_scale = trial_scale;
-                best_x.swap(trial);
-                best_residual.swap(trial_residual);
-              }
-            if (predictor)
-              break; // the longest admissible predictor step
-            if (energy)
-              {
-                if (std::abs(s) <= 0.8 * std::abs(s0) || (s < 0 && upper < 0))
-                  break; // energy stationary enough, or still descending at the
-                         // full step
-                // Regula falsi on s between the bracket ends.
-                if (s < 0)
-                  lower = alpha, s_lower = s;
-                else
-                  upper = alpha, s_upper = s;
-                alpha =
-                  (s_upper == std::numeric_limits<double>::max()) ?
-                    0.5 * (lower + upper) :
-                    lower - s_lower * (upper - lower) / (s_upper - s_lower);
-                alpha = std::clamp(alpha,
-                                   lower + 0.05 * (upper - lower),
-                                   upper - 0.05 * (upper - lower));
-              }
-            else
-              {
-                if (phi <= (1 - 1e-4 * alpha) * phi0)
-                  break;
-                // g(a) = phi(a)^2 has g'(0) = -2 g(0) along the Newton
-                // step; minimise the quadratic through g(0), g'(0), g(a).
-                const double g0 = phi0 * phi0;
-                const double a =
-                  g0 * alpha * alpha / (phi * phi - g0 + 2 * g0 * alpha);
-                alpha = std::clamp(a, 0.1 * alpha, 0.5 * alpha);
-              }
-          }
-        record.line_search_time = seconds_since(start);
+        start                               = Clock::now();
+        const auto [best_alpha, best_scale] = line_search(x, target, iteration);
+        record.line_search_time             = seconds_since(start);
         if (best_alpha < 0)
           {
             record.step_length      = 0;
@@ -646,45 +765,15 @@ namespace palpate
         // a short line-search step says nothing about being close.
         last_correction = system->max_displacement(step);
 
-        // Stagnation while the increment can still be halved, where the
-        // residual norm is the line search's merit (a pressure field or
-        // contact): four accepted steps that did not reduce it by a tenth.
-        // Newton's method near a solution cuts it by far more, even while
-        // the sphere's contact set settles (0.97 -> 0.04 in three steps):
-        // this is a start outside the basin. A sphere moved 5 mm sideways
-        // pressed nodes deep into it and the semi-smooth iteration wandered
-        // at a relative residual of 1 for 20 iterations before it found the
-        // way (1,607-node liver, doc/benchmarks/organ-speed.md); two half
-        // increments cost less. (With the energy as merit the residual may
-        // rise on the way to a solution: a locking StVK at nu = 0.4999
-        // converges so, tests/hyperelastic/hard_cases.)
-        const std::size_t n_history = state.history.size();
-        if (may_cut_back && (system->has_pressure() || system->has_contact()) &&
-            iteration >= 4 && n_history >= 5 &&
-            state.history[n_history - 5].increment == state.increments &&
-            record.residual_after >
-              0.9 * state.history[n_history - 5].residual_after)
+        // Stagnation (a start outside the basin, or a line search that
+        // gets nowhere): give up this Newton solve early.
+        if (const std::string why =
+              stagnation(state, record, iteration, may_cut_back, short_steps);
+            !why.empty())
           {
             outcome.status     = SolveStatus::max_iterations;
             outcome.iterations = iteration + 1;
-            outcome.message    = "Newton stagnates: the relative residual " +
-                              Utilities::to_string(record.residual_after, 3) +
-                              " fell by less than a tenth in four iterations";
-            return outcome;
-          }
-
-        // A line search that keeps cutting the step to almost nothing is
-        // not getting anywhere: stop instead of burning the iteration
-        // budget (the state is a failure point either way).
-        short_steps = best_alpha < 1e-2 ? short_steps + 1 : 0;
-        if (short_steps == 4)
-          {
-            outcome.status     = SolveStatus::max_iterations;
-            outcome.iterations = iteration + 1;
-            outcome.message    = "Newton stagnates: 4 line-search steps "
-                                 "shorter than 1/100 (relative residual " +
-                              Utilities::to_string(record.residual_after, 3) +
-                              ")";
+            outcome.message    = why;
             return outcome;
           }
 
@@ -747,16 +836,11 @@ namespace palpate
 
 
 
-  State
-  StateSolver::solve(const State             &from,
-                     const Utilities::Point3 &target,
-                     const State             *behind,
-                     const State             *behind2)
+  bool
+  StateSolver::Impl::admissible_start(const State             &from,
+                                      const Utilities::Point3 &target,
+                                      State                   &state) const
   {
-    const auto start = Clock::now();
-    State      state;
-    state.active_displacement = target;
-
     for (const double t : target)
       if (!std::isfinite(t))
         {
@@ -766,13 +850,12 @@ namespace palpate
           state.solution  = from.solution;
           state.multipliers.assign(from.multipliers.size(), 0.0);
           state.force = {{0, 0, 0}};
-          return state;
+          return false;
         }
 
     // The start must be an equilibrium of this body.
-    bool usable = from.converged &&
-                  from.solution.size() == impl->system->n_dofs() &&
-                  from.multipliers.size() == impl->system->n_multipliers();
+    bool usable = from.converged && from.solution.size() == system->n_dofs() &&
+                  from.multipliers.size() == system->n_multipliers();
     for (const double v : from.active_displacement)
       usable = usable && std::isfinite(v);
     for (unsigned int i = 0; usable && i < from.solution.size(); ++i)
@@ -783,11 +866,148 @@ namespace palpate
         state.status    = SolveStatus::not_finite;
         state.message =
           "the starting state is not a converged state of this body";
-        state.solution.assign(impl->system->n_dofs(), 0.0);
-        state.multipliers.assign(impl->system->n_multipliers(), 0.0);
+        state.solution.assign(system->n_dofs(), 0.0);
+        state.multipliers.assign(system->n_multipliers(), 0.0);
         state.force = {{0, 0, 0}};
-        return state;
+        return false;
       }
+    return true;
+  }
+
+
+
+  void
+  StateSolver::Impl::predictor_from_behind(const State               &from,
+                                           const Utilities::Point3   &target,
+                                           const State               *behind,
+                                           const State               *behind2,
+                                           const unsigned int         n,
+                                           const std::vector<double> &x,
+                                           std::vector<double>       &previous,
+                                           double &previous_t) const
+  {
+    const auto   a      = from.active_displacement;
+    const double length = Utilities::distance(a, target);
+    if (behind != nullptr && behind->converged &&
+        behind->solution.size() == from.solution.size() &&
+        behind->multipliers.size() == from.multipliers.size() && length > 0)
+      {
+        Utilities::Point3 back, ahead;
+        for (unsigned int d = 0; d < 3; ++d)
+          {
+            back[d]  = a[d] - behind->active_displacement[d];
+            ahead[d] = target[d] - a[d];
+          }
+        const double b      = Utilities::norm(back);
+        double       cosine = 0;
+        for (unsigned int d = 0; d < 3; ++d)
+          cosine += back[d] * ahead[d];
+        cosine /= std::max(b * length, 1e-300);
+        if (b > 0 && cosine > 1 - 1e-9)
+          {
+            bool finite = true;
+            for (const double v : behind->solution)
+              finite = finite && std::isfinite(v);
+            if (finite)
+              {
+                previous   = system->from_state(*behind);
+                previous_t = -b / length;
+                // With a second state behind, at the same spacing on the
+                // same line, and one increment: the quadratic through the
+                // three, 3 x - 3 x_b + x_bb at the target (third order).
+                // The secant predictor below computes x + (x - previous),
+                // so previous becomes the point that makes it that.
+                if (behind2 != nullptr && behind2->converged && n == 1 &&
+                    std::abs(b - length) <= 1e-9 * length &&
+                    behind2->solution.size() == from.solution.size() &&
+                    behind2->multipliers.size() == from.multipliers.size())
+                  {
+                    double off = 0;
+                    for (unsigned int d = 0; d < 3; ++d)
+                      off = std::max(off,
+                                     std::abs(behind2->active_displacement[d] -
+                                              (a[d] - 2 * back[d])));
+                    bool finite2 = off <= 1e-9 * length;
+                    for (const double v : behind2->solution)
+                      finite2 = finite2 && std::isfinite(v);
+                    if (finite2)
+                      {
+                        const std::vector<double> bb =
+                          system->from_state(*behind2);
+                        for (unsigned int i = 0; i < previous.size(); ++i)
+                          previous[i] = 3 * previous[i] - bb[i] - x[i];
+                      }
+                  }
+              }
+          }
+      }
+  }
+
+
+
+  bool
+  StateSolver::Impl::acceptable_end(const std::vector<double> &x,
+                                    State                     &state,
+                                    Outcome                   &failure) const
+  {
+    if (!(std::isfinite(state.force[0]) && std::isfinite(state.force[1]) &&
+          std::isfinite(state.force[2])))
+      {
+        // The last line of defence: a force sent to a device is finite.
+        failure.status = SolveStatus::not_finite;
+        failure.message =
+          "the force is not finite (are the material constants within "
+          "their physical range?)";
+        return false;
+      }
+    if (system->has_contact())
+      {
+        const double R = system->sphere_radius();
+        const double d =
+          system->sphere_center_distance(x, state.active_displacement);
+        // Between the nodes the surface sags into a sphere smaller than
+        // its triangles by up to about h^2 / 8R, so a sphere that nodes
+        // hold may overlap the triangles a little; one that no node holds
+        // must not. (A 6 mm sphere moved sideways into liver501 was 2.55 mm
+        // into the surface with no node touching: 0 N.)
+        const bool held =
+          state.force[0] != 0 || state.force[1] != 0 || state.force[2] != 0;
+        if (d < 0.5 * R || (!held && d < 0.9 * R))
+          {
+            failure.status = SolveStatus::sphere_through_surface;
+            failure.message =
+              "the sphere (radius " + Utilities::to_string(1000 * R, 3) +
+              " mm) went between the surface nodes: its centre is " +
+              Utilities::to_string(1000 * std::abs(d), 3) + " mm " +
+              (d < 0 ? "inside the deformed surface" :
+               held  ? "from the deformed surface, less than half its radius" :
+                       "from the deformed surface and no node touches it") +
+              ". The contact acts at nodes, and a sphere smaller than the "
+              "surface triangles where it pushes slips past the node it "
+              "pushes, so its force would be the mesh's. Use a larger Tip "
+              "radius, a mesh finer near the probe (Mesh / Source = surface "
+              "with Refinement size about a third of the radius), or "
+              "Polynomial degree = 2";
+            return false;
+          }
+      }
+    return true;
+  }
+
+
+
+  State
+  StateSolver::solve(const State             &from,
+                     const Utilities::Point3 &target,
+                     const State             *behind,
+                     const State             *behind2)
+  {
+    const auto start = Clock::now();
+    State      state;
+    state.active_displacement = target;
+
+    if (!impl->admissible_start(from, target, state))
+      return state;
 
     const auto         &s      = impl->settings;
     std::vector<double> x      = impl->system->from_state(from);
@@ -839,59 +1059,8 @@ namespace palpate
     // A state behind the source on the line to the target is the
     // increment before the first one: the secant predictor below then
     // extrapolates it to the first increment's end.
-    if (behind != nullptr && behind->converged &&
-        behind->solution.size() == from.solution.size() &&
-        behind->multipliers.size() == from.multipliers.size() && length > 0)
-      {
-        Utilities::Point3 back, ahead;
-        for (unsigned int d = 0; d < 3; ++d)
-          {
-            back[d]  = a[d] - behind->active_displacement[d];
-            ahead[d] = target[d] - a[d];
-          }
-        const double b      = Utilities::norm(back);
-        double       cosine = 0;
-        for (unsigned int d = 0; d < 3; ++d)
-          cosine += back[d] * ahead[d];
-        cosine /= std::max(b * length, 1e-300);
-        if (b > 0 && cosine > 1 - 1e-9)
-          {
-            bool finite = true;
-            for (const double v : behind->solution)
-              finite = finite && std::isfinite(v);
-            if (finite)
-              {
-                previous   = impl->system->from_state(*behind);
-                previous_t = -b / length;
-                // With a second state behind, at the same spacing on the
-                // same line, and one increment: the quadratic through the
-                // three, 3 x - 3 x_b + x_bb at the target (third order).
-                // The secant predictor below computes x + (x - previous),
-                // so previous becomes the point that makes it that.
-                if (behind2 != nullptr && behind2->converged && n == 1 &&
-                    std::abs(b - length) <= 1e-9 * length &&
-                    behind2->solution.size() == from.solution.size() &&
-                    behind2->multipliers.size() == from.multipliers.size())
-                  {
-                    double off = 0;
-                    for (unsigned int d = 0; d < 3; ++d)
-                      off = std::max(off,
-                                     std::abs(behind2->active_displacement[d] -
-                                              (a[d] - 2 * back[d])));
-                    bool finite2 = off <= 1e-9 * length;
-                    for (const double v : behind2->solution)
-                      finite2 = finite2 && std::isfinite(v);
-                    if (finite2)
-                      {
-                        const std::vector<double> bb =
-                          impl->system->from_state(*behind2);
-                        for (unsigned int i = 0; i < previous.size(); ++i)
-                          previous[i] = 3 * previous[i] - bb[i] - x[i];
-                      }
-                  }
-              }
-          }
-      }
+    impl->predictor_from_behind(
+      from, target, behind, behind2, n, x, previous, previous_t);
     std::function<bool(double, double, unsigned int)> increment =
       [&](const double t0, const double t1, const unsigned int depth) {
         const std::vector<double> saved     = x;
@@ -962,47 +1131,8 @@ namespace palpate
       ok = increment(double(i - 1) / n, double(i) / n, 0);
 
     impl->system->to_state(x, state);
-    if (ok && !(std::isfinite(state.force[0]) &&
-                std::isfinite(state.force[1]) && std::isfinite(state.force[2])))
-      {
-        // The last line of defence: a force sent to a device is finite.
-        ok             = false;
-        failure.status = SolveStatus::not_finite;
-        failure.message =
-          "the force is not finite (are the material constants within "
-          "their physical range?)";
-      }
-    if (ok && impl->system->has_contact())
-      {
-        const double R = impl->system->sphere_radius();
-        const double d =
-          impl->system->sphere_center_distance(x, state.active_displacement);
-        // Between the nodes the surface sags into a sphere smaller than
-        // its triangles by up to about h^2 / 8R, so a sphere that nodes
-        // hold may overlap the triangles a little; one that no node holds
-        // must not. (A 6 mm sphere moved sideways into liver501 was 2.55 mm
-        // into the surface with no node touching: 0 N.)
-        const bool held =
-          state.force[0] != 0 || state.force[1] != 0 || state.force[2] != 0;
-        if (d < 0.5 * R || (!held && d < 0.9 * R))
-          {
-            ok             = false;
-            failure.status = SolveStatus::sphere_through_surface;
-            failure.message =
-              "the sphere (radius " + Utilities::to_string(1000 * R, 3) +
-              " mm) went between the surface nodes: its centre is " +
-              Utilities::to_string(1000 * std::abs(d), 3) + " mm " +
-              (d < 0 ? "inside the deformed surface" :
-               held  ? "from the deformed surface, less than half its radius" :
-                       "from the deformed surface and no node touches it") +
-              ". The contact acts at nodes, and a sphere smaller than the "
-              "surface triangles where it pushes slips past the node it "
-              "pushes, so its force would be the mesh's. Use a larger Tip "
-              "radius, a mesh finer near the probe (Mesh / Source = surface "
-              "with Refinement size about a third of the radius), or "
-              "Polynomial degree = 2";
-          }
-      }
+    if (ok)
+      ok = impl->acceptable_end(x, state, failure);
     if (!ok)
       {
         // A failure point: keep the last equilibrium reached on the way,
