@@ -451,7 +451,25 @@ namespace palpate
         : keep(keep)
         , most(most)
         , evict(std::move(evict))
-      {}
+      {
+        // Evictions also while no connection arrives: a queued connection
+        // (the page's) waited behind threads whose clients stopped
+        // reading until their write timeout, since evictions came only
+        // with new connections (the sixth re-run: 9.5 s).
+        if (this->evict)
+          watchdog = std::thread([this] {
+            std::unique_lock<std::mutex> lock(mutex);
+            while (!stopping)
+              {
+                wake_watchdog.wait_for(lock, std::chrono::milliseconds(100));
+                if (!stopping && jobs.size() > waiting &&
+                    threads.size() >= this->most)
+                  for (std::size_t k = waiting; k < jobs.size(); ++k)
+                    if (!this->evict())
+                      break;
+              }
+          });
+      }
 
       ~ConnectionThreads() override
       {
@@ -496,6 +514,9 @@ namespace palpate
           stopping = true;
           all.swap(threads);
         }
+        wake_watchdog.notify_all();
+        if (watchdog.joinable())
+          watchdog.join();
         // The connections accepted and not served yet are closed by the
         // threads on their way out.
         wake.notify_all();
@@ -567,7 +588,8 @@ namespace palpate
       const std::size_t                      keep, most;
       const std::function<bool()>            evict;
       std::mutex                             mutex;
-      std::condition_variable                wake;
+      std::condition_variable                wake, wake_watchdog;
+      std::thread                            watchdog;
       std::deque<std::function<void()>>      jobs;
       std::map<std::thread::id, std::thread> threads;
       std::vector<std::thread::id>           finished;
@@ -603,7 +625,9 @@ namespace palpate
       {}
 
       /** Close the connection that has waited longest (at least 0.1 s)
-       * for its request; false if there is none. */
+       * for its request; if none waits, the one whose answer has taken
+       * longest (at least 1 s: a client that does not read what it asked
+       * for); false if there is neither. */
       bool
       evict_slowest()
       {
@@ -615,8 +639,32 @@ namespace palpate
               now - c.waiting_since > std::chrono::milliseconds(100) &&
               (slowest == nullptr || c.waiting_since < slowest->waiting_since))
             slowest = &c;
+        // 260 clients that pipelined requests for three.js and never read
+        // the answers held every thread in its write for the whole write
+        // timeout, again and again: the page's /frame waited 9.5 s (the
+        // sixth re-run). The page reads its answers within milliseconds:
+        // every connection whose answer has not been taken for 1 s is
+        // closed (one at a time was not enough: each freed thread went to
+        // the next such client's reconnect).
         if (slowest == nullptr)
-          return false;
+          {
+            bool any = false;
+            for (auto &[socket, c] : connections)
+              {
+                const auto since = c.write_blocked_since->load();
+                if (!c.closed && since != 0 &&
+                    now.time_since_epoch().count() - since >
+                      std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::seconds(1))
+                        .count())
+                  {
+                    ::shutdown(c.socket, SHUT_RDWR);
+                    c.closed = true;
+                    any      = true;
+                  }
+              }
+            return any;
+          }
         // The thread serving it sees the end of the stream and returns.
         ::shutdown(slowest->socket, SHUT_RDWR);
         slowest->closed = true;
@@ -629,15 +677,22 @@ namespace palpate
         socket_t          socket = -1;
         Clock::time_point waiting_since;
         bool              waiting = true, closed = false;
+        /** Since when its answer waits for the client to take it (steady
+         * clock ticks; 0: not waiting), set by its DeadlineStream. */
+        std::shared_ptr<std::atomic<Clock::rep>> write_blocked_since =
+          std::make_shared<std::atomic<Clock::rep>>(0);
       };
 
       /** A socket whose reads end at a deadline (the request's). */
       class DeadlineStream : public httplib::Stream
       {
       public:
-        DeadlineStream(const socket_t sock, const Clock::duration write_limit)
+        DeadlineStream(const socket_t                           sock,
+                       const Clock::duration                    write_limit,
+                       std::shared_ptr<std::atomic<Clock::rep>> blocked)
           : sock(sock)
           , write_limit(write_limit)
+          , blocked(std::move(blocked))
         {}
 
         Clock::time_point deadline;
@@ -673,8 +728,17 @@ namespace palpate
         ssize_t
         write(const char *ptr, size_t size) override
         {
-          if (!is_writable())
-            return -1;
+          // Writable at once, as for a client that reads; otherwise the
+          // wait is known to evict_slowest().
+          pollfd now_writable{sock, POLLOUT, 0};
+          if (::poll(&now_writable, 1, 0) <= 0)
+            {
+              blocked->store(Clock::now().time_since_epoch().count());
+              const bool writable = is_writable();
+              blocked->store(0);
+              if (!writable)
+                return -1;
+            }
           ssize_t n;
           do
             n = ::send(sock, ptr, size, MSG_NOSIGNAL);
@@ -701,8 +765,9 @@ namespace palpate
         }
 
       private:
-        const socket_t        sock;
-        const Clock::duration write_limit;
+        const socket_t                           sock;
+        const Clock::duration                    write_limit;
+        std::shared_ptr<std::atomic<Clock::rep>> blocked;
 
         bool
         wait(const short events, const Clock::time_point until) const
@@ -750,16 +815,22 @@ namespace palpate
       bool
       process_and_close_socket(socket_t sock) override
       {
+        std::shared_ptr<std::atomic<Clock::rep>> blocked;
         {
           std::lock_guard<std::mutex> lock(mutex);
-          connections[sock] = {sock, Clock::now(), true, false};
+          Connection                 &c = connections[sock];
+          c                             = Connection();
+          c.socket                      = sock;
+          c.waiting_since               = Clock::now();
+          blocked                       = c.write_blocked_since;
         }
         const auto seconds = [](const time_t s, const time_t us) {
           return std::chrono::duration_cast<Clock::duration>(
             std::chrono::seconds(s) + std::chrono::microseconds(us));
         };
         DeadlineStream stream(sock,
-                              seconds(write_timeout_sec_, write_timeout_usec_));
+                              seconds(write_timeout_sec_, write_timeout_usec_),
+                              blocked);
         const auto read_limit = seconds(read_timeout_sec_, read_timeout_usec_);
         const auto keep_alive = seconds(keep_alive_timeout_sec_, 0);
         bool       result     = false;
@@ -1340,6 +1411,13 @@ namespace palpate
     s.loop->start(HapticLoop::continuous);
     s.loop->start_motion();
     s.http = std::thread([&s] { s.server.listen_after_bind(); });
+    // Listening before the constructor returns: a stop() right after it
+    // (standard output closed, so the view ends at once) found cpp-httplib
+    // not listening yet, stopped nothing, and then waited for ever for the
+    // thread, serving on with every signal ignored; a later Ctrl-C lost
+    // every output (the sixth re-run, issue 26).
+    for (int k = 0; k < 10000 && !s.server.is_running(); ++k)
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
 
 
