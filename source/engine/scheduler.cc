@@ -108,38 +108,50 @@ namespace palpate
 
 
 
-  std::vector<Task>
-  Scheduler::plan(const Utilities::Point3                           &hip,
-                  const Utilities::Point3                           &velocity,
-                  const std::function<PointKnowledge(unsigned int)> &knowledge,
-                  const unsigned int                                 max_tasks,
-                  const bool allow_bridge) const
+  namespace
   {
-    std::vector<Task> candidates;
-    if (max_tasks == 0)
-      return candidates;
+    /** The grid steps to a point's six axis neighbours. */
+    const int axis[6][3] =
+      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
-    // The grid box around the path, widened by the radius (clamped in
-    // floating point before the conversion: the host controls the HIP).
-    const double h = grid.spacing(), n = grid.half_width();
-    GridIndex    low, high;
-    for (unsigned int k = 0; k < 3; ++k)
-      {
-        const double a = hip[k], b = hip[k] + look_ahead * velocity[k];
-        if (!std::isfinite(a) || !std::isfinite(b))
-          return candidates;
-        low[k] = static_cast<int>(
-          std::clamp(std::floor((std::min(a, b) - radius) / h), -n, n));
-        high[k] = static_cast<int>(
-          std::clamp(std::ceil((std::max(a, b) + radius) / h), -n, n));
-      }
+    /**
+     * The grid box around the path from @p hip to @p hip + @p look_ahead
+     * @p velocity, widened by @p radius, in @p low and @p high; false if
+     * the path is not finite.
+     */
+    bool
+    box_around_path(const StateGrid         &grid,
+                    const Utilities::Point3 &hip,
+                    const Utilities::Point3 &velocity,
+                    const double             look_ahead,
+                    const double             radius,
+                    GridIndex               &low,
+                    GridIndex               &high)
+    {
+      // The grid box around the path, widened by the radius (clamped in
+      // floating point before the conversion: the host controls the HIP).
+      const double h = grid.spacing(), n = grid.half_width();
+      for (unsigned int k = 0; k < 3; ++k)
+        {
+          const double a = hip[k], b = hip[k] + look_ahead * velocity[k];
+          if (!std::isfinite(a) || !std::isfinite(b))
+            return false;
+          low[k] = static_cast<int>(
+            std::clamp(std::floor((std::min(a, b) - radius) / h), -n, n));
+          high[k] = static_cast<int>(
+            std::clamp(std::ceil((std::max(a, b) + radius) / h), -n, n));
+        }
+      return true;
+    }
 
-    // The cells the HIP is in and will pass through along its predicted
-    // path: their corners come before everything else, in the order the
-    // HIP will need them.
-    const std::vector<std::pair<unsigned int, double>> needed =
-      path_corners(hip, velocity);
-    const auto needed_at = [&](const unsigned int p) {
+    /**
+     * The arc length at which the path reaches @p p's cells, from
+     * Scheduler::path_corners()'s list @p needed; -1 if it does not.
+     */
+    double
+    arc_to(const std::vector<std::pair<unsigned int, double>> &needed,
+           const unsigned int                                  p)
+    {
       const auto it = std::lower_bound(needed.begin(),
                                        needed.end(),
                                        p,
@@ -147,16 +159,91 @@ namespace palpate
                                          return a.first < q;
                                        });
       return it != needed.end() && it->first == p ? it->second : -1.0;
+    }
+
+    /**
+     * The candidate tasks of one Scheduler::plan(), and the questions its
+     * steps ask about the grid, what is known and the HIP's path.
+     */
+    class Candidates
+    {
+    public:
+      Candidates(const Scheduler                                   &scheduler,
+                 const StateGrid                                   &grid,
+                 const std::function<PointKnowledge(unsigned int)> &knowledge,
+                 const Utilities::Point3                           &hip,
+                 const Utilities::Point3                           &velocity,
+                 const double                                       radius,
+                 std::vector<Task>                                 &tasks)
+        : scheduler(scheduler)
+        , grid(grid)
+        , knowledge(knowledge)
+        , hip(hip)
+        , velocity(velocity)
+        , radius(radius)
+        , tasks(tasks)
+      {}
+
+      /**
+       * Add the cloud's points in the box from @p low to @p high, the
+       * path's corners (@p needed) first.
+       */
+      void
+      add_cloud(const GridIndex                                    &low,
+                const GridIndex                                    &high,
+                const std::vector<std::pair<unsigned int, double>> &needed);
+
+      /** Whether the cloud is cut off from what is held. */
+      bool
+      cut_off() const
+      {
+        return tasks.empty() && unreached > 0 && under_way == 0;
+      }
+
+      /** Add the bridge's points toward the path. */
+      void
+      add_bridge();
+
+    private:
+      /** Distance of @p p from the HIP's predicted path. */
+      double
+      distance(const unsigned int p) const
+      {
+        return scheduler.distance_to_path(grid.position(p), hip, velocity);
+      }
+
+      /**
+       * The axis neighbour of @p g with a held state nearest the HIP (ties:
+       * the lower grid number), among those accepted by @p admissible; -1
+       * if none.
+       */
+      template <typename Admissible>
+      int
+      find_source(const GridIndex &g, const Admissible &admissible) const;
+
+      /** Whether @p g has an unknown axis neighbour accepted by @p wanted. */
+      template <typename Wanted>
+      bool
+      leads_to(const GridIndex &g, const Wanted &wanted) const;
+
+      const Scheduler                                   &scheduler;
+      const StateGrid                                   &grid;
+      const std::function<PointKnowledge(unsigned int)> &knowledge;
+      const Utilities::Point3                           &hip;
+      const Utilities::Point3                           &velocity;
+      const double                                       radius;
+      std::vector<Task>                                 &tasks;
+      unsigned int                                       unreached = 0;
+      unsigned int                                       under_way = 0;
     };
 
-    static const int axis[6][3] = {
-      {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    const auto distance = [&](const unsigned int p) {
-      return distance_to_path(grid.position(p), hip, velocity);
-    };
-    // The axis neighbour of g with a held state nearest the HIP (ties: the
-    // lower grid number), among those accepted by @p admissible; -1 if none.
-    const auto find_source = [&](const GridIndex &g, const auto &admissible) {
+
+
+    template <typename Admissible>
+    int
+    Candidates::find_source(const GridIndex  &g,
+                            const Admissible &admissible) const
+    {
       int    source = -1;
       double best   = 0;
       for (const auto &a : axis)
@@ -172,9 +259,14 @@ namespace palpate
             source = q, best = d;
         }
       return source;
-    };
-    // Whether g has an unknown axis neighbour accepted by @p wanted.
-    const auto leads_to = [&](const GridIndex &g, const auto &wanted) {
+    }
+
+
+
+    template <typename Wanted>
+    bool
+    Candidates::leads_to(const GridIndex &g, const Wanted &wanted) const
+    {
       for (const auto &a : axis)
         {
           const GridIndex n{{g[0] + a[0], g[1] + a[1], g[2] + a[2]}};
@@ -184,54 +276,60 @@ namespace palpate
             return true;
         }
       return false;
-    };
-    const auto any = [](const unsigned int) { return true; };
+    }
 
-    // The cloud: unknown points, and points whose whole state was dropped
-    // (memory budget) where the cloud needs it again as a source.
-    unsigned int unreached = 0, under_way = 0;
-    for (int k = low[2]; k <= high[2]; ++k)
-      for (int j = low[1]; j <= high[1]; ++j)
-        for (int i = low[0]; i <= high[0]; ++i)
-          {
-            const GridIndex      g{{i, j, k}};
-            const unsigned int   p     = grid.linear(g);
-            const PointKnowledge known = knowledge(p);
-            if (known != PointKnowledge::unknown &&
-                known != PointKnowledge::computed &&
-                known != PointKnowledge::in_progress)
-              continue;
-            const double d = distance(p);
-            if (d > radius)
-              continue;
-            if (known == PointKnowledge::in_progress)
-              {
-                ++under_way;
+
+
+    void
+    Candidates::add_cloud(
+      const GridIndex                                    &low,
+      const GridIndex                                    &high,
+      const std::vector<std::pair<unsigned int, double>> &needed)
+    {
+      const auto any = [](const unsigned int) { return true; };
+      // The cloud: unknown points, and points whose whole state was dropped
+      // (memory budget) where the cloud needs it again as a source.
+      for (int k = low[2]; k <= high[2]; ++k)
+        for (int j = low[1]; j <= high[1]; ++j)
+          for (int i = low[0]; i <= high[0]; ++i)
+            {
+              const GridIndex      g{{i, j, k}};
+              const unsigned int   p     = grid.linear(g);
+              const PointKnowledge known = knowledge(p);
+              if (known != PointKnowledge::unknown &&
+                  known != PointKnowledge::computed &&
+                  known != PointKnowledge::in_progress)
                 continue;
-              }
-            if (known == PointKnowledge::computed &&
-                !leads_to(g, [&](const unsigned int q) {
-                  return distance(q) <= radius;
-                }))
-              continue;
-            const int    source = find_source(g, any);
-            const double arc    = needed_at(p);
-            if (source >= 0)
-              candidates.push_back({p,
-                                    static_cast<unsigned int>(source),
-                                    arc >= 0 ? arc : d,
-                                    arc >= 0});
-            else if (known == PointKnowledge::unknown)
-              ++unreached;
-          }
+              const double d = distance(p);
+              if (d > radius)
+                continue;
+              if (known == PointKnowledge::in_progress)
+                {
+                  ++under_way;
+                  continue;
+                }
+              if (known == PointKnowledge::computed &&
+                  !leads_to(g, [&](const unsigned int q) {
+                    return distance(q) <= radius;
+                  }))
+                continue;
+              const int    source = find_source(g, any);
+              const double arc    = arc_to(needed, p);
+              if (source >= 0)
+                tasks.push_back({p,
+                                 static_cast<unsigned int>(source),
+                                 arc >= 0 ? arc : d,
+                                 arc >= 0});
+              else if (known == PointKnowledge::unknown)
+                ++unreached;
+            }
+    }
 
-    // Points of the cloud are unknown, none can be reached from what is
-    // held and none is under way (the HIP jumped, or outran the computed
-    // front): build a bridge, points next to held states that are nearer
-    // to the HIP's path than their source, even outside the cloud. Only
-    // steps toward the path: a bridge ends where the cloud begins, and
-    // cloud points walled off by failure points do not make it grow.
-    if (allow_bridge && candidates.empty() && unreached > 0 && under_way == 0)
+
+
+    void
+    Candidates::add_bridge()
+    {
       for (unsigned int p = 0; p < grid.size(); ++p)
         {
           const PointKnowledge known = knowledge(p);
@@ -249,31 +347,73 @@ namespace palpate
             return d < distance(q) - 1e-12;
           });
           if (source >= 0)
-            candidates.push_back({p, static_cast<unsigned int>(source), d});
+            tasks.push_back({p, static_cast<unsigned int>(source), d});
         }
+    }
 
-    // Most urgent first: the HIP's cell, then the distance from the path
-    // (to the nanometre, so that the order is a strict weak ordering and
-    // does not depend on round-off), then the grid number.
-    const auto order = [](const Task &a, const Task &b) {
-      if (a.corner != b.corner)
-        return a.corner;
-      const long long da = std::llround(a.priority * 1e9),
-                      db = std::llround(b.priority * 1e9);
-      if (da != db)
-        return da < db;
-      return a.target < b.target;
-    };
-    if (candidates.size() > max_tasks)
-      {
-        std::partial_sort(candidates.begin(),
-                          candidates.begin() + max_tasks,
-                          candidates.end(),
-                          order);
-        candidates.resize(max_tasks);
-      }
-    else
-      std::sort(candidates.begin(), candidates.end(), order);
+    /** Keep the @p max_tasks most urgent of @p tasks, most urgent first. */
+    void
+    keep_most_urgent(std::vector<Task> &tasks, const unsigned int max_tasks)
+    {
+      // Most urgent first: the HIP's cell, then the distance from the path
+      // (to the nanometre, so that the order is a strict weak ordering and
+      // does not depend on round-off), then the grid number.
+      const auto order = [](const Task &a, const Task &b) {
+        if (a.corner != b.corner)
+          return a.corner;
+        const long long da = std::llround(a.priority * 1e9),
+                        db = std::llround(b.priority * 1e9);
+        if (da != db)
+          return da < db;
+        return a.target < b.target;
+      };
+      if (tasks.size() > max_tasks)
+        {
+          std::partial_sort(tasks.begin(),
+                            tasks.begin() + max_tasks,
+                            tasks.end(),
+                            order);
+          tasks.resize(max_tasks);
+        }
+      else
+        std::sort(tasks.begin(), tasks.end(), order);
+    }
+  } // namespace
+
+
+
+  std::vector<Task>
+  Scheduler::plan(const Utilities::Point3                           &hip,
+                  const Utilities::Point3                           &velocity,
+                  const std::function<PointKnowledge(unsigned int)> &knowledge,
+                  const unsigned int                                 max_tasks,
+                  const bool allow_bridge) const
+  {
+    std::vector<Task> candidates;
+    if (max_tasks == 0)
+      return candidates;
+    GridIndex low, high;
+    if (!box_around_path(grid, hip, velocity, look_ahead, radius, low, high))
+      return candidates;
+
+    // The cells the HIP is in and will pass through along its predicted
+    // path: their corners come before everything else, in the order the
+    // HIP will need them.
+    const std::vector<std::pair<unsigned int, double>> needed =
+      path_corners(hip, velocity);
+    Candidates steps(*this, grid, knowledge, hip, velocity, radius, candidates);
+    steps.add_cloud(low, high, needed);
+
+    // Points of the cloud are unknown, none can be reached from what is
+    // held and none is under way (the HIP jumped, or outran the computed
+    // front): build a bridge, points next to held states that are nearer
+    // to the HIP's path than their source, even outside the cloud. Only
+    // steps toward the path: a bridge ends where the cloud begins, and
+    // cloud points walled off by failure points do not make it grow.
+    if (allow_bridge && steps.cut_off())
+      steps.add_bridge();
+
+    keep_most_urgent(candidates, max_tasks);
     return candidates;
   }
 } // namespace palpate

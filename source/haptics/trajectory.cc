@@ -7,6 +7,7 @@
 #include <palpate/scene/scene.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -165,13 +166,18 @@ namespace palpate
 
 
 
-  Replay::Replay(const std::string &filename)
-    : file(filename)
+  namespace
   {
-    // A recording is a CSV of at most an hour at 1 kHz (~150 MB at most,
-    // a few MB usually): a device file (/dev/zero) or a huge file is
-    // refused before anything is read, instead of growing without bound.
+    /**
+     * Refuse a replay file that is not a regular file or is too large to
+     * be a recording, before anything is read.
+     */
+    void
+    check_replay_file(const std::string &filename)
     {
+      // A recording is a CSV of at most an hour at 1 kHz (~150 MB at most,
+      // a few MB usually): a device file (/dev/zero) or a huge file is
+      // refused before anything is read, instead of growing without bound.
       constexpr std::uintmax_t max_bytes = std::uintmax_t(256) << 20;
       std::error_code          error;
       const auto status = std::filesystem::status(filename, error);
@@ -194,118 +200,177 @@ namespace palpate
                          "check that this is the recording (t, x, y, z per "
                          "line), or shorten it.");
     }
-    std::ifstream in(filename);
-    if (!in)
-      throw InputError(
-        filename,
-        0,
-        "trajectory replay (Haptics / Trajectory / File name)",
-        "the file cannot be opened",
-        "check Haptics / Trajectory / File name (relative to the scene "
-        "file's directory).");
-    std::string  line;
-    unsigned int number = 0;
-    while (std::getline(in, line))
-      {
-        ++number;
-        // A byte order mark (some editors begin UTF-8 with one) is not
-        // part of the first line; UTF-16 is not a CSV palpate reads.
-        if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
-          line.erase(0, 3);
-        else if (number == 1 && line.size() >= 2 &&
-                 (line.rfind("\xFF\xFE", 0) == 0 ||
-                  line.rfind("\xFE\xFF", 0) == 0))
-          throw InputError(
-            filename,
-            1,
-            "trajectory replay (Haptics / Trajectory / File name)",
-            "the file is UTF-16 text (it begins with a UTF-16 byte order "
-            "mark); a recording is plain text (ASCII or UTF-8)",
-            "save it as UTF-8 or ASCII, or convert it: iconv -f UTF-16 -t "
-            "UTF-8 '" +
-              filename + "' > recording.csv");
-        const std::string t = Utilities::trim(line);
-        // Comments, and a header line before the data: one whose first
-        // field is not a number ("nan" and "inf" are numbers, refused
-        // below, not a header to skip).
-        const auto not_a_number = [](const std::string &field) {
-          char *end = nullptr;
-          std::strtod(field.c_str(), &end);
-          return end == field.c_str();
-        };
-        if (t.empty() || t[0] == '#' ||
-            (times.empty() && std::isalpha(static_cast<unsigned char>(t[0])) &&
-             not_a_number(t.substr(0, t.find(',')))))
-          continue;
-        const auto pieces = Utilities::split(t, ',');
-        double     v[4];
-        bool       ok = pieces.size() == 4;
-        for (unsigned int k = 0; ok && k < 4; ++k)
-          {
-            std::size_t used = 0;
-            try
-              {
-                v[k] = std::stod(pieces[k], &used);
-              }
-            catch (const std::exception &)
-              {
-                used = 0;
-              }
-            ok = used == pieces[k].size() && std::isfinite(v[k]);
-          }
-        if (!ok)
-          throw InputError(
-            filename,
-            number,
-            "trajectory replay (Haptics / Trajectory / File name)",
-            "the line is not four numbers t, x, y, z",
-            "write one timed position per line: t (s), x, y, z (m).");
-        if (!times.empty() && !(v[0] > times.back()))
-          throw InputError(
-            filename,
-            number,
-            "trajectory replay (Haptics / Trajectory / File name)",
-            "the times do not increase",
-            "sort the lines by time; each time must be later than the last.");
-        // A hand on a device stays within reach and moves at most a few
-        // m/s: positions far away or jumps faster than that are a unit
-        // mistake (millimetres, milliseconds), and 1e308 would overflow.
-        constexpr double max_reach = 1;  // m from the first position
-        constexpr double max_speed = 10; // m/s between two lines
-        if (!points.empty())
-          {
-            const Utilities::Point3 x{{v[1], v[2], v[3]}};
-            const double from_first = Utilities::distance(x, points.front());
-            if (!(from_first <= max_reach))
-              throw InputError(
-                filename,
-                number,
-                "trajectory replay (Haptics / Trajectory / File name)",
-                "the position is " +
-                  (std::isfinite(from_first) ?
-                     Utilities::to_string(from_first, 3) + " m" :
-                     std::string("over 1e308 m")) +
-                  " from the first one; a hand on a device moves within "
-                  "about half a metre, and at most " +
-                  Utilities::to_string(max_reach, 3) + " m is accepted",
-                "give the positions in metres (not millimetres).");
-            const double speed =
-              Utilities::distance(x, points.back()) / (v[0] - times.back());
-            if (!(speed <= max_speed))
-              throw InputError(
-                filename,
-                number,
-                "trajectory replay (Haptics / Trajectory / File name)",
-                "from the line before, the probe would move at " +
-                  Utilities::to_string(speed, 3) +
-                  " m/s; a hand moves at most a few m/s, and at most " +
-                  Utilities::to_string(max_speed, 3) + " m/s is accepted",
-                "give the times in seconds and the positions in metres "
-                "(not milliseconds or millimetres).");
-          }
-        times.push_back(v[0]);
-        points.push_back({{v[1], v[2], v[3]}});
-      }
+
+    /** Drop a UTF-8 byte order mark from the first @p line; refuse UTF-16. */
+    void
+    strip_byte_order_mark(std::string       &line,
+                          const unsigned int number,
+                          const std::string &filename)
+    {
+      // A byte order mark (some editors begin UTF-8 with one) is not
+      // part of the first line; UTF-16 is not a CSV palpate reads.
+      if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
+        line.erase(0, 3);
+      else if (number == 1 && line.size() >= 2 &&
+               (line.rfind("\xFF\xFE", 0) == 0 ||
+                line.rfind("\xFE\xFF", 0) == 0))
+        throw InputError(
+          filename,
+          1,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "the file is UTF-16 text (it begins with a UTF-16 byte order "
+          "mark); a recording is plain text (ASCII or UTF-8)",
+          "save it as UTF-8 or ASCII, or convert it: iconv -f UTF-16 -t "
+          "UTF-8 '" +
+            filename + "' > recording.csv");
+    }
+
+    /**
+     * Whether the trimmed line @p t holds no position: empty, a comment, or
+     * (@p before_data) a header line.
+     */
+    bool
+    skipped_line(const std::string &t, const bool before_data)
+    {
+      // Comments, and a header line before the data: one whose first
+      // field is not a number ("nan" and "inf" are numbers, refused
+      // below, not a header to skip).
+      const auto not_a_number = [](const std::string &field) {
+        char *end = nullptr;
+        std::strtod(field.c_str(), &end);
+        return end == field.c_str();
+      };
+      return t.empty() || t[0] == '#' ||
+             (before_data && std::isalpha(static_cast<unsigned char>(t[0])) &&
+              not_a_number(t.substr(0, t.find(','))));
+    }
+
+    /** The four finite numbers t, x, y, z of the trimmed line @p t. */
+    std::array<double, 4>
+    timed_position(const std::string &t,
+                   const unsigned int number,
+                   const std::string &filename)
+    {
+      const auto            pieces = Utilities::split(t, ',');
+      std::array<double, 4> v;
+      bool                  ok = pieces.size() == 4;
+      for (unsigned int k = 0; ok && k < 4; ++k)
+        {
+          std::size_t used = 0;
+          try
+            {
+              v[k] = std::stod(pieces[k], &used);
+            }
+          catch (const std::exception &)
+            {
+              used = 0;
+            }
+          ok = used == pieces[k].size() && std::isfinite(v[k]);
+        }
+      if (!ok)
+        throw InputError(
+          filename,
+          number,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "the line is not four numbers t, x, y, z",
+          "write one timed position per line: t (s), x, y, z (m).");
+      return v;
+    }
+
+    /**
+     * Refuse the timed position @p v of line @p number if its time does not
+     * follow the last one's, or a hand could not have moved so.
+     */
+    void
+    check_motion(const std::array<double, 4>          &v,
+                 const std::vector<double>            &times,
+                 const std::vector<Utilities::Point3> &points,
+                 const unsigned int                    number,
+                 const std::string                    &filename)
+    {
+      if (!times.empty() && !(v[0] > times.back()))
+        throw InputError(
+          filename,
+          number,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "the times do not increase",
+          "sort the lines by time; each time must be later than the last.");
+      // A hand on a device stays within reach and moves at most a few
+      // m/s: positions far away or jumps faster than that are a unit
+      // mistake (millimetres, milliseconds), and 1e308 would overflow.
+      constexpr double max_reach = 1;  // m from the first position
+      constexpr double max_speed = 10; // m/s between two lines
+      if (points.empty())
+        return;
+      const Utilities::Point3 x{{v[1], v[2], v[3]}};
+      const double from_first = Utilities::distance(x, points.front());
+      if (!(from_first <= max_reach))
+        throw InputError(
+          filename,
+          number,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "the position is " +
+            (std::isfinite(from_first) ?
+               Utilities::to_string(from_first, 3) + " m" :
+               std::string("over 1e308 m")) +
+            " from the first one; a hand on a device moves within "
+            "about half a metre, and at most " +
+            Utilities::to_string(max_reach, 3) + " m is accepted",
+          "give the positions in metres (not millimetres).");
+      const double speed =
+        Utilities::distance(x, points.back()) / (v[0] - times.back());
+      if (!(speed <= max_speed))
+        throw InputError(
+          filename,
+          number,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "from the line before, the probe would move at " +
+            Utilities::to_string(speed, 3) +
+            " m/s; a hand moves at most a few m/s, and at most " +
+            Utilities::to_string(max_speed, 3) + " m/s is accepted",
+          "give the times in seconds and the positions in metres "
+          "(not milliseconds or millimetres).");
+    }
+
+    /** Read the timed positions of @p filename into @p times and @p points. */
+    void
+    read_timed_positions(const std::string              &filename,
+                         std::vector<double>            &times,
+                         std::vector<Utilities::Point3> &points)
+    {
+      std::ifstream in(filename);
+      if (!in)
+        throw InputError(
+          filename,
+          0,
+          "trajectory replay (Haptics / Trajectory / File name)",
+          "the file cannot be opened",
+          "check Haptics / Trajectory / File name (relative to the scene "
+          "file's directory).");
+      std::string  line;
+      unsigned int number = 0;
+      while (std::getline(in, line))
+        {
+          ++number;
+          strip_byte_order_mark(line, number, filename);
+          const std::string t = Utilities::trim(line);
+          if (skipped_line(t, times.empty()))
+            continue;
+          const std::array<double, 4> v = timed_position(t, number, filename);
+          check_motion(v, times, points, number, filename);
+          times.push_back(v[0]);
+          points.push_back({{v[1], v[2], v[3]}});
+        }
+    }
+  } // namespace
+
+
+
+  Replay::Replay(const std::string &filename)
+    : file(filename)
+  {
+    check_replay_file(filename);
+    read_timed_positions(filename, times, points);
     if (times.empty())
       throw InputError(
         filename,

@@ -609,123 +609,141 @@ namespace palpate
         }
       return parsed;
     }
-  } // namespace
 
+    /**
+     * Refuse a name that is not a scene file before opening it: a directory
+     * (named with the .prm files in it), or a pipe, a device or a socket.
+     */
+    void
+    check_is_regular_file(const std::string &filename)
+    {
+      namespace fs = std::filesystem;
+      std::error_code ec;
+      if (fs::is_directory(filename, ec))
+        {
+          std::vector<std::string> scenes;
+          for (const auto &e : fs::directory_iterator(filename, ec))
+            if (e.path().extension() == ".prm")
+              scenes.push_back(e.path().string());
+          std::sort(scenes.begin(), scenes.end());
+          throw InputError(
+            filename,
+            0,
+            "(the scene file itself)",
+            "this is a directory, not a scene file",
+            scenes.empty() ?
+              std::string("give a .prm scene file; shipped scenes are in "
+                          "parameters/, e.g. 'palpate "
+                          "parameters/default.prm'.") :
+              "give one of the " + std::to_string(scenes.size()) +
+                " .prm files in it, e.g. 'palpate " + scenes.front() + "'.");
+        }
+      if (const auto status = fs::status(filename, ec);
+          !ec && fs::exists(status) && !fs::is_regular_file(status))
+        throw InputError(filename.substr(0, 300),
+                         0,
+                         "(the scene file itself)",
+                         "this is not a regular file but a pipe, a device or "
+                         "a socket: palpate would wait for it, or read it "
+                         "without end",
+                         "name the scene's .prm file itself.");
+    }
 
+    /**
+     * The error for a scene file that cannot be opened, with the reason the
+     * file system gives.
+     */
+    InputError
+    cannot_open(const std::string &filename)
+    {
+      // Why, as the file system says it: a missing file is not a loop of
+      // links, a name too long or a missing permission.
+      const int  fd   = ::open(filename.c_str(), O_RDONLY);
+      const int  why  = fd < 0 ? errno : 0;
+      const bool none = why == ENOENT || why == ENOTDIR;
+      if (fd >= 0)
+        ::close(fd);
+      return InputError(
+        filename.substr(0, 300),
+        0,
+        "(the scene file itself)",
+        "the file cannot be opened: " +
+          std::string(none          ? "it does not exist" :
+                      why == EACCES ? "it is not readable (permissions)" :
+                      why == ELOOP  ? "it is a loop of symbolic links" :
+                      why == ENAMETOOLONG ?
+                                     "the path is longer than the system "
+                                     "allows" :
+                      why != 0 ? std::strerror(why) :
+                                 "it is not readable"),
+        none ? "check the path; shipped scenes are in parameters/, e.g. "
+               "'palpate parameters/default.prm'." :
+               "name the scene's .prm file itself (check the links on "
+               "the way and the permissions).");
+    }
 
-  Scene::Scene()
-  {
-    dealii::ParameterHandler prm;
-    Parameters::AllParameters::declare_parameters(prm);
-    parameters.parse_parameters(prm);
-  }
+    /**
+     * The scene file's bytes: an error that says why if it cannot be opened
+     * or read, or if it is too large to be a scene.
+     */
+    std::string
+    read_scene_bytes(const std::string &filename)
+    {
+      std::ifstream in(filename, std::ios::binary);
+      if (!in)
+        throw cannot_open(filename);
+      // A scene is a few kB of text: refuse to read gigabytes by mistake.
+      constexpr std::size_t max_bytes = std::size_t(4) << 20;
+      std::string           content(max_bytes + 1, '\0');
+      in.read(content.data(), content.size());
+      if (in.bad())
+        throw InputError(filename,
+                         0,
+                         "(the scene file itself)",
+                         "the file cannot be read (an input/output error)",
+                         "check the disk and the path.");
+      content.resize(in.gcount());
+      if (content.size() > max_bytes)
+        throw InputError(filename,
+                         0,
+                         "(the scene file itself)",
+                         "the file is larger than 4 MiB; a scene file is a "
+                         "few kB of text",
+                         "check that this is the scene (.prm) and not a mesh "
+                         "or an output file.");
+      return content;
+    }
 
+    /**
+     * Drop a UTF-8 byte order mark from @p content; refuse UTF-16 text.
+     */
+    void
+    strip_byte_order_mark(std::string &content, const std::string &filename)
+    {
+      // A byte order mark: some editors (Notepad) begin UTF-8 with one; it
+      // is not part of the text. UTF-16 is not a scene file palpate reads:
+      // named, instead of "a NUL byte" in column 2.
+      if (content.rfind("\xEF\xBB\xBF", 0) == 0)
+        content.erase(0, 3);
+      else if (content.rfind("\xFF\xFE", 0) == 0 ||
+               content.rfind("\xFE\xFF", 0) == 0)
+        throw InputError(filename,
+                         1,
+                         "(the scene file itself)",
+                         "the file is UTF-16 text (it begins with a UTF-16 "
+                         "byte order mark); a scene file is plain text (ASCII "
+                         "or UTF-8)",
+                         "save it as UTF-8 (in Notepad: Save as, Encoding "
+                         "UTF-8), or convert it: iconv -f UTF-16 -t UTF-8 '" +
+                           filename + "' > scene.prm");
+    }
 
-
-  Scene
-  Scene::read(const std::string              &filename,
-              const std::vector<std::string> &command_line)
-  {
-    // The command line's --set entries first: a mistake there is reported
-    // as one, whatever the file holds.
-    const std::vector<CommandLineSetting> overrides =
-      parse_command_line_settings(command_line);
-    namespace fs = std::filesystem;
-    Scene scene{Unparsed()};
-    scene.file_      = filename;
-    scene.directory_ = fs::path(filename).parent_path().string();
-
-    std::error_code ec;
-    if (fs::is_directory(filename, ec))
-      {
-        std::vector<std::string> scenes;
-        for (const auto &e : fs::directory_iterator(filename, ec))
-          if (e.path().extension() == ".prm")
-            scenes.push_back(e.path().string());
-        std::sort(scenes.begin(), scenes.end());
-        throw InputError(
-          filename,
-          0,
-          "(the scene file itself)",
-          "this is a directory, not a scene file",
-          scenes.empty() ?
-            std::string("give a .prm scene file; shipped scenes are in "
-                        "parameters/, e.g. 'palpate parameters/default.prm'.") :
-            "give one of the " + std::to_string(scenes.size()) +
-              " .prm files in it, e.g. 'palpate " + scenes.front() + "'.");
-      }
-    if (const auto status = fs::status(filename, ec);
-        !ec && fs::exists(status) && !fs::is_regular_file(status))
-      throw InputError(filename.substr(0, 300),
-                       0,
-                       "(the scene file itself)",
-                       "this is not a regular file but a pipe, a device or a "
-                       "socket: palpate would wait for it, or read it without "
-                       "end",
-                       "name the scene's .prm file itself.");
-    std::ifstream in(filename, std::ios::binary);
-    if (!in)
-      {
-        // Why, as the file system says it: a missing file is not a loop of
-        // links, a name too long or a missing permission.
-        const int  fd   = ::open(filename.c_str(), O_RDONLY);
-        const int  why  = fd < 0 ? errno : 0;
-        const bool none = why == ENOENT || why == ENOTDIR;
-        if (fd >= 0)
-          ::close(fd);
-        throw InputError(
-          filename.substr(0, 300),
-          0,
-          "(the scene file itself)",
-          "the file cannot be opened: " +
-            std::string(none          ? "it does not exist" :
-                        why == EACCES ? "it is not readable (permissions)" :
-                        why == ELOOP  ? "it is a loop of symbolic links" :
-                        why == ENAMETOOLONG ?
-                                       "the path is longer than the system "
-                                       "allows" :
-                        why != 0 ? std::strerror(why) :
-                                   "it is not readable"),
-          none ? "check the path; shipped scenes are in parameters/, e.g. "
-                 "'palpate parameters/default.prm'." :
-                 "name the scene's .prm file itself (check the links on "
-                 "the way and the permissions).");
-      }
-    // A scene is a few kB of text: refuse to read gigabytes by mistake.
-    constexpr std::size_t max_bytes = std::size_t(4) << 20;
-    std::string           content(max_bytes + 1, '\0');
-    in.read(content.data(), content.size());
-    if (in.bad())
-      throw InputError(filename,
-                       0,
-                       "(the scene file itself)",
-                       "the file cannot be read (an input/output error)",
-                       "check the disk and the path.");
-    content.resize(in.gcount());
-    if (content.size() > max_bytes)
-      throw InputError(filename,
-                       0,
-                       "(the scene file itself)",
-                       "the file is larger than 4 MiB; a scene file is a few "
-                       "kB of text",
-                       "check that this is the scene (.prm) and not a mesh or "
-                       "an output file.");
-    // A byte order mark: some editors (Notepad) begin UTF-8 with one; it
-    // is not part of the text. UTF-16 is not a scene file palpate reads:
-    // named, instead of "a NUL byte" in column 2.
-    if (content.rfind("\xEF\xBB\xBF", 0) == 0)
-      content.erase(0, 3);
-    else if (content.rfind("\xFF\xFE", 0) == 0 ||
-             content.rfind("\xFE\xFF", 0) == 0)
-      throw InputError(filename,
-                       1,
-                       "(the scene file itself)",
-                       "the file is UTF-16 text (it begins with a UTF-16 byte "
-                       "order mark); a scene file is plain text (ASCII or "
-                       "UTF-8)",
-                       "save it as UTF-8 (in Notepad: Save as, Encoding "
-                       "UTF-8), or convert it: iconv -f UTF-16 -t UTF-8 '" +
-                         filename + "' > scene.prm");
+    /**
+     * Refuse NUL bytes and control characters (other than tabs and carriage
+     * returns), naming the line and column of the first.
+     */
+    void
+    check_plain_text(const std::string &content, const std::string &filename)
     {
       unsigned int line = 1, column = 1;
       for (const char c : content)
@@ -753,31 +771,27 @@ namespace palpate
           ++column;
         }
     }
-    const std::vector<std::string> lines = split_lines(content);
-    for (unsigned int l = 1; l <= lines.size(); ++l)
-      {
-        std::string rest;
-        if (starts_with_keyword(without_comment(lines[l - 1]), "include", rest))
-          throw InputError(filename,
-                           l,
-                           without_comment(lines[l - 1]),
-                           "scene files cannot include other files",
-                           "copy the entries you need into this file.");
-      }
 
-    // deal.II's ParameterHandler reads the file. An action on every entry
-    // records what the file sets and on which line (the stream position
-    // tells), so messages can point at the line and an entry set twice is
-    // caught instead of the last one silently winning.
-    if (content.empty() || content.back() != '\n')
-      content += '\n';
-    std::istringstream stream(content);
-    const auto         line_now = [&]() -> unsigned int {
-      const std::streamoff position = stream.tellg();
-      if (position < 0)
-        return lines.size();
-      return std::count(content.begin(), content.begin() + position, '\n');
-    };
+    /** Refuse the first 'include' line: a scene is one file. */
+    void
+    check_no_includes(const std::vector<std::string> &lines,
+                      const std::string              &filename)
+    {
+      for (unsigned int l = 1; l <= lines.size(); ++l)
+        {
+          std::string rest;
+          if (starts_with_keyword(without_comment(lines[l - 1]),
+                                  "include",
+                                  rest))
+            throw InputError(filename,
+                             l,
+                             without_comment(lines[l - 1]),
+                             "scene files cannot include other files",
+                             "copy the entries you need into this file.");
+        }
+    }
+
+    /** One entry set by the scene file or by a --set. */
     struct Setting
     {
       std::string  key;
@@ -785,151 +799,310 @@ namespace palpate
       unsigned int line;
       bool         command_line; // a --set, applied after the file
     };
-    std::vector<Setting> settings;
-    bool                 applying_command_line = false;
-    const std::function<void(const std::string &, const std::string &)> record =
-      [&](const std::string &key, const std::string &value) {
-        settings.push_back({key,
-                            value,
-                            applying_command_line ? 0u : line_now(),
-                            applying_command_line});
-      };
-    dealii::ParameterHandler prm;
-    Parameters::AllParameters::declare_parameters(prm);
+
+    /**
+     * deal.II's ParameterHandler reading a scene's text. An action on every
+     * entry records what the file sets and on which line (the stream
+     * position tells), so messages can point at the line and an entry set
+     * twice is caught instead of the last one silently winning.
+     */
+    class RecordingReader
     {
+    public:
+      /** Declare the parameters and attach the recording actions. */
+      RecordingReader(const std::string              &filename,
+                      std::string                     text,
+                      const std::vector<std::string> &lines);
+
+      RecordingReader(const RecordingReader &) = delete;
+      RecordingReader &
+      operator=(const RecordingReader &) = delete;
+
+      /** Parse the file's text; explain a rejection by its line. */
+      void
+      parse_file();
+
+      /**
+       * Apply the --set entries after the file; return them as
+       * "key=value" strings.
+       */
+      std::vector<std::string>
+      apply_command_line(const std::vector<CommandLineSetting> &overrides);
+
+      /** The entries set, in the order the file and the --set set them. */
+      const std::vector<Setting> &
+      settings() const
+      {
+        return settings_;
+      }
+
+      /** The parameters as read. */
+      dealii::ParameterHandler &
+      handler()
+      {
+        return prm;
+      }
+
+    private:
+      /** The line the stream has reached. */
+      unsigned int
+      line_now();
+
+      const std::string              &filename;
+      const std::string               content;
+      const std::vector<std::string> &lines;
+      std::istringstream              stream;
+      std::vector<Setting>            settings_;
+      bool                            applying_command_line = false;
+      const std::function<void(const std::string &, const std::string &)>
+                               record;
+      dealii::ParameterHandler prm;
+    };
+
+
+
+    RecordingReader::RecordingReader(const std::string              &filename,
+                                     std::string                     text,
+                                     const std::vector<std::string> &lines)
+      : filename(filename)
+      , content(text.empty() || text.back() != '\n' ? text + '\n' : text)
+      , lines(lines)
+      , stream(content)
+      , record([this](const std::string &key, const std::string &value) {
+        settings_.push_back({key,
+                             value,
+                             applying_command_line ? 0u : line_now(),
+                             applying_command_line});
+      })
+    {
+      Parameters::AllParameters::declare_parameters(prm);
       std::vector<std::string> path;
       record_every_entry(prm, declared_tree(), path, record);
+      settings_.clear(); // add_action() ran each action once for the default
     }
-    settings.clear(); // add_action() ran each action once for the default
-    try
-      {
-        prm.parse_input(stream, filename, "", false);
-      }
-    catch (const dealii::ParameterHandler::ExcNoSubsection &e)
-      {
-        throw explain_rejection(filename,
-                                lines,
-                                line_now(),
-                                Rejection::no_subsection,
-                                dealii_message(e));
-      }
-    catch (const dealii::ParameterHandler::ExcCannotParseLine &e)
-      {
-        throw explain_rejection(filename,
-                                lines,
-                                line_now(),
-                                Rejection::cannot_parse,
-                                dealii_message(e));
-      }
-    catch (const dealii::ParameterHandler::ExcInvalidEntryForPattern &e)
-      {
-        throw explain_rejection(filename,
-                                lines,
-                                line_now(),
-                                Rejection::invalid_value,
-                                dealii_message(e));
-      }
-    catch (const dealii::ParameterHandler::ExcUnbalancedSubsections &)
-      {
-        std::vector<unsigned int>      opened;
-        const std::vector<std::string> path =
-          path_before(lines, lines.size() + 1, &opened);
-        if (path.empty())
+
+
+
+    unsigned int
+    RecordingReader::line_now()
+    {
+      const std::streamoff position = stream.tellg();
+      if (position < 0)
+        return lines.size();
+      return std::count(content.begin(), content.begin() + position, '\n');
+    }
+
+
+
+    void
+    RecordingReader::parse_file()
+    {
+      try
+        {
+          prm.parse_input(stream, filename, "", false);
+        }
+      catch (const dealii::ParameterHandler::ExcNoSubsection &e)
+        {
+          throw explain_rejection(filename,
+                                  lines,
+                                  line_now(),
+                                  Rejection::no_subsection,
+                                  dealii_message(e));
+        }
+      catch (const dealii::ParameterHandler::ExcCannotParseLine &e)
+        {
+          throw explain_rejection(filename,
+                                  lines,
+                                  line_now(),
+                                  Rejection::cannot_parse,
+                                  dealii_message(e));
+        }
+      catch (const dealii::ParameterHandler::ExcInvalidEntryForPattern &e)
+        {
+          throw explain_rejection(filename,
+                                  lines,
+                                  line_now(),
+                                  Rejection::invalid_value,
+                                  dealii_message(e));
+        }
+      catch (const dealii::ParameterHandler::ExcUnbalancedSubsections &)
+        {
+          std::vector<unsigned int>      opened;
+          const std::vector<std::string> path =
+            path_before(lines, lines.size() + 1, &opened);
+          if (path.empty())
+            throw InputError(filename,
+                             0,
+                             "(whole file)",
+                             "the numbers of 'subsection' and 'end' lines "
+                             "differ",
+                             "close every subsection with one 'end'.");
+          throw InputError(filename,
+                           opened.back(),
+                           "subsection " + path.back(),
+                           "the subsection opened here is never closed",
+                           "add a line 'end' after its last entry.");
+        }
+      catch (const std::exception &e)
+        {
+          throw explain_rejection(
+            filename, lines, line_now(), Rejection::other, dealii_message(e));
+        }
+    }
+
+
+
+    std::vector<std::string>
+    RecordingReader::apply_command_line(
+      const std::vector<CommandLineSetting> &overrides)
+    {
+      // The --set entries, after the file (whose text they never touch: a
+      // value holding '#' or '\' stays whole, and a file's own mistakes are
+      // reported as before). ParameterHandler::set() runs the same actions
+      // as a line of the file; parse_command_line_settings() checked each
+      // value against its pattern already.
+      std::vector<std::string> applied;
+      applying_command_line = true;
+      for (const CommandLineSetting &o : overrides)
+        {
+          for (const auto &name : o.path)
+            prm.enter_subsection(name);
+          prm.set(o.name, o.value);
+          for (std::size_t i = 0; i < o.path.size(); ++i)
+            prm.leave_subsection();
+          applied.push_back(entry_key(o.path, o.name) + "=" + o.value);
+        }
+      applying_command_line = false;
+      return applied;
+    }
+
+    /**
+     * Keep each entry's value and line (0 for a --set, which replaces the
+     * file's value); refuse an entry the file sets twice.
+     */
+    void
+    keep_entry_lines_and_values(const std::vector<Setting>          &settings,
+                                const std::string                   &filename,
+                                std::map<std::string, unsigned int> &lines,
+                                std::map<std::string, std::string>  &values)
+    {
+      std::map<std::string, const Setting *> first_setting;
+      for (const Setting &s : settings)
+        {
+          if (s.command_line) // a --set: it replaces the file's value
+            {
+              lines[s.key]  = 0;
+              values[s.key] = s.value;
+              continue;
+            }
+          const auto [it, first] = first_setting.emplace(s.key, &s);
+          if (!first)
+            throw InputError(filename,
+                             s.line,
+                             shown_key(s.key) + " = " + s.value,
+                             "the entry is set twice: on line " +
+                               std::to_string(it->second->line) + " (" +
+                               it->second->value + ") and on line " +
+                               std::to_string(s.line) + " (" + s.value +
+                               "); palpate does not guess which one you "
+                               "meant",
+                             "delete one of the two lines.");
+          lines[s.key]  = s.line;
+          values[s.key] = s.value;
+        }
+    }
+
+    /**
+     * Convert the values read into @p parameters; name the entry whose
+     * number is out of range if deal.II's conversion refuses one.
+     */
+    void
+    convert_parameters(Parameters::AllParameters  &parameters,
+                       dealii::ParameterHandler   &prm,
+                       const std::vector<Setting> &settings,
+                       const std::string          &filename)
+    {
+      try
+        {
+          parameters.parse_parameters(prm);
+        }
+      catch (const std::exception &e)
+        {
+          // deal.II's patterns accept numbers that its conversions then
+          // refuse: values out of double range, like 1e-320.
+          for (const Setting &s : settings)
+            for (const std::string &piece : Utilities::split(s.value, ','))
+              {
+                if (piece.empty())
+                  continue;
+                errno            = 0;
+                char        *end = nullptr;
+                const double x   = std::strtod(piece.c_str(), &end);
+                if (end != piece.c_str() && errno == ERANGE)
+                  throw InputError(
+                    s.command_line ? std::string("command line") : filename,
+                    s.command_line ? 0 : s.line,
+                    shown_key(s.key) + " = " + s.value,
+                    "'" + piece + "' is out of the range of numbers palpate " +
+                      "computes with (" +
+                      (std::abs(x) < 1 ? "too close to zero: below 1e-307" :
+                                         "too large: beyond 1e308") +
+                      ")",
+                    "give a value within the entry's physical range; "
+                    "'palpate --print-parameters' shows the default.");
+              }
           throw InputError(filename,
                            0,
                            "(whole file)",
-                           "the numbers of 'subsection' and 'end' lines "
-                           "differ",
-                           "close every subsection with one 'end'.");
-        throw InputError(filename,
-                         opened.back(),
-                         "subsection " + path.back(),
-                         "the subsection opened here is never closed",
-                         "add a line 'end' after its last entry.");
-      }
-    catch (const std::exception &e)
-      {
-        throw explain_rejection(
-          filename, lines, line_now(), Rejection::other, dealii_message(e));
-      }
-    // The --set entries, after the file (whose text they never touch: a
-    // value holding '#' or '\' stays whole, and a file's own mistakes are
-    // reported as before). ParameterHandler::set() runs the same actions as
-    // a line of the file; parse_command_line_settings() checked each value
-    // against its pattern already.
-    applying_command_line = true;
-    for (const CommandLineSetting &o : overrides)
-      {
-        for (const auto &name : o.path)
-          prm.enter_subsection(name);
-        prm.set(o.name, o.value);
-        for (std::size_t i = 0; i < o.path.size(); ++i)
-          prm.leave_subsection();
-        scene.command_line_settings_.push_back(entry_key(o.path, o.name) + "=" +
-                                               o.value);
-      }
-    applying_command_line = false;
+                           "deal.II's ParameterHandler could not convert a "
+                           "value: " +
+                             dealii_message(e),
+                           "fix the entry the message names.");
+        }
+    }
+  } // namespace
 
-    std::map<std::string, const Setting *> first_setting;
-    for (const Setting &s : settings)
-      {
-        if (s.command_line) // a --set: it replaces the file's value
-          {
-            scene.entry_lines_[s.key]  = 0;
-            scene.entry_values_[s.key] = s.value;
-            continue;
-          }
-        const auto [it, first] = first_setting.emplace(s.key, &s);
-        if (!first)
-          throw InputError(filename,
-                           s.line,
-                           shown_key(s.key) + " = " + s.value,
-                           "the entry is set twice: on line " +
-                             std::to_string(it->second->line) + " (" +
-                             it->second->value + ") and on line " +
-                             std::to_string(s.line) + " (" + s.value +
-                             "); palpate does not guess which one you meant",
-                           "delete one of the two lines.");
-        scene.entry_lines_[s.key]  = s.line;
-        scene.entry_values_[s.key] = s.value;
-      }
-    try
-      {
-        scene.parameters.parse_parameters(prm);
-      }
-    catch (const std::exception &e)
-      {
-        // deal.II's patterns accept numbers that its conversions then
-        // refuse: values out of double range, like 1e-320.
-        for (const Setting &s : settings)
-          for (const std::string &piece : Utilities::split(s.value, ','))
-            {
-              if (piece.empty())
-                continue;
-              errno            = 0;
-              char        *end = nullptr;
-              const double x   = std::strtod(piece.c_str(), &end);
-              if (end != piece.c_str() && errno == ERANGE)
-                throw InputError(
-                  s.command_line ? std::string("command line") : filename,
-                  s.command_line ? 0 : s.line,
-                  shown_key(s.key) + " = " + s.value,
-                  "'" + piece + "' is out of the range of numbers palpate " +
-                    "computes with (" +
-                    (std::abs(x) < 1 ? "too close to zero: below 1e-307" :
-                                       "too large: beyond 1e308") +
-                    ")",
-                  "give a value within the entry's physical range; "
-                  "'palpate --print-parameters' shows the default.");
-            }
-        throw InputError(filename,
-                         0,
-                         "(whole file)",
-                         "deal.II's ParameterHandler could not convert a "
-                         "value: " +
-                           dealii_message(e),
-                         "fix the entry the message names.");
-      }
+
+
+  Scene::Scene()
+  {
+    dealii::ParameterHandler prm;
+    Parameters::AllParameters::declare_parameters(prm);
+    parameters.parse_parameters(prm);
+  }
+
+
+
+  Scene
+  Scene::read(const std::string              &filename,
+              const std::vector<std::string> &command_line)
+  {
+    // The command line's --set entries first: a mistake there is reported
+    // as one, whatever the file holds.
+    const std::vector<CommandLineSetting> overrides =
+      parse_command_line_settings(command_line);
+    Scene scene{Unparsed()};
+    scene.file_      = filename;
+    scene.directory_ = std::filesystem::path(filename).parent_path().string();
+
+    check_is_regular_file(filename);
+    std::string content = read_scene_bytes(filename);
+    strip_byte_order_mark(content, filename);
+    check_plain_text(content, filename);
+    const std::vector<std::string> lines = split_lines(content);
+    check_no_includes(lines, filename);
+
+    RecordingReader reader(filename, content, lines);
+    reader.parse_file();
+    scene.command_line_settings_ = reader.apply_command_line(overrides);
+    keep_entry_lines_and_values(reader.settings(),
+                                filename,
+                                scene.entry_lines_,
+                                scene.entry_values_);
+    convert_parameters(scene.parameters,
+                       reader.handler(),
+                       reader.settings(),
+                       filename);
     scene.validate();
     return scene;
   }

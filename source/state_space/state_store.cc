@@ -541,17 +541,14 @@ namespace palpate
     };
 
     /**
-     * Before HDF5 sees @p file: what keeps it from being a store this
-     * process can open for @p writing (or reading), said as such, so that
-     * a file that is fine but not writable is never called damaged.
-     * Returns whether the file exists (a new one is created).
+     * Refuse, for @p writing, a file name too long for the files a writer
+     * makes beside the store.
      */
-    bool
-    check_store_file(const std::string &file, const bool writing)
+    void
+    check_name_length(const std::string           &file,
+                      const std::filesystem::path &path,
+                      const bool                   writing)
     {
-      namespace fs = std::filesystem;
-      std::error_code error;
-      const fs::path  path(file);
       // A writer makes STORE.lock and STORE.creating beside it: their
       // names, 9 characters longer, must fit the file system's limit too
       // (NAME_MAX, 255 on Linux), or the failure looks like a full disk.
@@ -580,50 +577,61 @@ namespace palpate
               std::to_string(NAME_MAX - std::strlen(".creating")) +
               " bytes (as many ASCII characters), e.g. 'liver.h5'.");
         }
-      const fs::file_status status = fs::status(path, error);
-      if (status.type() == fs::file_type::none ||
-          (error && status.type() != fs::file_type::not_found))
+    }
+
+    /**
+     * A store that does not exist yet: a reader has nothing to read; a
+     * writer needs a directory it can make files in.
+     */
+    void
+    check_store_can_be_made(const std::string           &file,
+                            const std::filesystem::path &path,
+                            const bool                   writing)
+    {
+      namespace fs = std::filesystem;
+      if (!writing)
         store_error(file,
-                    "the file system refuses this path: " + error.message(),
-                    "name a store file in a directory you can write, e.g. "
+                    "there is no store at this path",
+                    "name an existing store, or make one with palpate "
+                    "precompute SCENE.prm.");
+      std::error_code error;
+      const fs::path  dir =
+        path.has_parent_path() ? path.parent_path() : fs::path(".");
+      const fs::file_status d = fs::status(dir, error);
+      if (d.type() == fs::file_type::not_found)
+        store_error(file,
+                    "its directory '" + dir.string() +
+                      "' does not exist, so the store cannot be made",
+                    "make the directory (mkdir -p '" + dir.string() +
+                      "') or name a store in one that exists.");
+      if (d.type() != fs::file_type::directory)
+        store_error(file,
+                    "'" + dir.string() + "' is not a directory",
+                    "name a store file in a directory, e.g. "
                     "'liver.h5'.");
-      if (status.type() == fs::file_type::not_found)
+      if (access(dir.c_str(), W_OK | X_OK) != 0)
         {
-          if (!writing)
-            store_error(file,
-                        "there is no store at this path",
-                        "name an existing store, or make one with palpate "
-                        "precompute SCENE.prm.");
-          const fs::path dir =
-            path.has_parent_path() ? path.parent_path() : fs::path(".");
-          const fs::file_status d = fs::status(dir, error);
-          if (d.type() == fs::file_type::not_found)
-            store_error(file,
+          const int e = errno;
+          store_error(file,
+                      e == EROFS ?
                         "its directory '" + dir.string() +
-                          "' does not exist, so the store cannot be made",
-                        "make the directory (mkdir -p '" + dir.string() +
-                          "') or name a store in one that exists.");
-          if (d.type() != fs::file_type::directory)
-            store_error(file,
-                        "'" + dir.string() + "' is not a directory",
-                        "name a store file in a directory, e.g. "
-                        "'liver.h5'.");
-          if (access(dir.c_str(), W_OK | X_OK) != 0)
-            {
-              const int e = errno;
-              store_error(file,
-                          e == EROFS ?
-                            "its directory '" + dir.string() +
-                              "' is on a read-only file system, so the "
-                              "store cannot be made" :
-                            "permission denied: palpate cannot make files "
-                            "in its directory '" +
-                              dir.string() + "' (" + std::strerror(e) + ")",
-                          "name a store in a directory this user can "
-                          "write, or make this one writable.");
-            }
-          return false;
+                          "' is on a read-only file system, so the "
+                          "store cannot be made" :
+                        "permission denied: palpate cannot make files "
+                        "in its directory '" +
+                          dir.string() + "' (" + std::strerror(e) + ")",
+                      "name a store in a directory this user can "
+                      "write, or make this one writable.");
         }
+    }
+
+    /** Refuse a directory, a device, a pipe or a socket as a store. */
+    void
+    check_regular_file(const std::string                 &file,
+                       const std::filesystem::path       &path,
+                       const std::filesystem::file_status status)
+    {
+      namespace fs = std::filesystem;
       if (status.type() == fs::file_type::directory)
         store_error(file,
                     "this is a directory, not a store file",
@@ -646,44 +654,60 @@ namespace palpate
                       "name a store file, e.g. 'liver.h5' (palpate makes "
                       "it if it does not exist).");
         }
+    }
+
+    /**
+     * Open @p file as HDF5 will (read and write if @p writing); say why
+     * this process cannot, without calling the store damaged.
+     */
+    int
+    open_as_hdf5_will(const std::string &file, const bool writing)
+    {
       // Permissions as this process has them: open it as HDF5 will.
       const int fd =
         open(file.c_str(), (writing ? O_RDWR : O_RDONLY) | O_CLOEXEC);
-      if (fd < 0)
-        {
-          const int   e = errno;
-          struct stat st
-          {};
-          stat(file.c_str(), &st);
-          const bool readable = access(file.c_str(), R_OK) == 0;
-          if (e == EROFS)
-            store_error(file,
-                        "the store is on a read-only file system, and "
-                        "palpate appends to it the states it computes",
-                        "copy it to a writable place and name the copy in "
-                        "State space / Store (its states are loaded from "
-                        "there), or mount the file system writable.");
-          if (e == EACCES || e == EPERM)
-            store_error(
-              file,
-              std::string("permission denied: palpate can ") +
-                (writing && readable ? "read this store but not write it" :
-                                       "not read this store") +
-                " (" + describe_mode(st) + "). The store itself is not damaged",
-              (st.st_uid == geteuid() ?
-                 "give yourself permission: chmod u+" +
-                   std::string(writing ? "rw" : "r") + " '" + file + "'" :
-                 "ask its owner (uid " + std::to_string(st.st_uid) + ") for " +
-                   (writing ? "read and write" : "read") +
-                   " permission, or run as that user") +
-                "; to use its states without appending, copy it to a file "
-                "you can write and name the copy in State space / Store. "
-                "Do not delete it: its states are fine.");
-          store_error(file,
-                      std::string("palpate cannot open it: ") +
-                        std::strerror(e),
-                      "check the file and its permissions.");
-        }
+      if (fd >= 0)
+        return fd;
+      const int   e = errno;
+      struct stat st
+      {};
+      stat(file.c_str(), &st);
+      const bool readable = access(file.c_str(), R_OK) == 0;
+      if (e == EROFS)
+        store_error(file,
+                    "the store is on a read-only file system, and "
+                    "palpate appends to it the states it computes",
+                    "copy it to a writable place and name the copy in "
+                    "State space / Store (its states are loaded from "
+                    "there), or mount the file system writable.");
+      if (e == EACCES || e == EPERM)
+        store_error(
+          file,
+          std::string("permission denied: palpate can ") +
+            (writing && readable ? "read this store but not write it" :
+                                   "not read this store") +
+            " (" + describe_mode(st) + "). The store itself is not damaged",
+          (st.st_uid == geteuid() ?
+             "give yourself permission: chmod u+" +
+               std::string(writing ? "rw" : "r") + " '" + file + "'" :
+             "ask its owner (uid " + std::to_string(st.st_uid) + ") for " +
+               (writing ? "read and write" : "read") +
+               " permission, or run as that user") +
+            "; to use its states without appending, copy it to a file "
+            "you can write and name the copy in State space / Store. "
+            "Do not delete it: its states are fine.");
+      store_error(file,
+                  std::string("palpate cannot open it: ") + std::strerror(e),
+                  "check the file and its permissions.");
+    }
+
+    /**
+     * Refuse an empty file and one that is not HDF5 (named as text when it
+     * is); closes @p fd.
+     */
+    void
+    check_hdf5_signature(const std::string &file, const int fd)
+    {
       // An HDF5 file begins with its signature, at byte 0 or after a user
       // block of 512, 1024, 2048, ... bytes.
       struct stat st
@@ -731,6 +755,35 @@ namespace palpate
                       "does not exist); this file is something else: name "
                       "another one.");
         }
+    }
+
+    /**
+     * Before HDF5 sees @p file: what keeps it from being a store this
+     * process can open for @p writing (or reading), said as such, so that
+     * a file that is fine but not writable is never called damaged.
+     * Returns whether the file exists (a new one is created).
+     */
+    bool
+    check_store_file(const std::string &file, const bool writing)
+    {
+      namespace fs = std::filesystem;
+      std::error_code error;
+      const fs::path  path(file);
+      check_name_length(file, path, writing);
+      const fs::file_status status = fs::status(path, error);
+      if (status.type() == fs::file_type::none ||
+          (error && status.type() != fs::file_type::not_found))
+        store_error(file,
+                    "the file system refuses this path: " + error.message(),
+                    "name a store file in a directory you can write, e.g. "
+                    "'liver.h5'.");
+      if (status.type() == fs::file_type::not_found)
+        {
+          check_store_can_be_made(file, path, writing);
+          return false;
+        }
+      check_regular_file(file, path, status);
+      check_hdf5_signature(file, open_as_hdf5_will(file, writing));
       return true;
     }
   } // namespace
