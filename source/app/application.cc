@@ -19,7 +19,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -239,10 +241,13 @@ namespace palpate
           out.flush();
           std::cerr << "\npalpate: " << summary.lost_servers.size()
                     << " MPI solver server(s) lost during the run (LOST in the "
-                       "summary above); the interaction went on with the "
-                       "servers left, and ended when none was left. Exit "
-                       "status "
-                    << ExitStatus::server_lost << ".\n";
+                       "summary above); "
+                    << (summary.stopped_by.find(
+                          "every solver server was lost") != std::string::npos ?
+                          "the interaction went on with the servers left, "
+                          "and ended when none was left" :
+                          "the interaction went on with the servers left")
+                    << ". Exit status " << ExitStatus::server_lost << ".\n";
           return ExitStatus::server_lost;
         }
       const auto &prescribed = scene.parameters.boundary_conditions.active_node
@@ -513,6 +518,21 @@ namespace palpate
         else if (args[i] == "--host" && i + 1 < args.size())
           {
             host = args[++i];
+            // "127.0.0.1:80": a port written into the address (an IPv6
+            // address has several colons, or brackets).
+            if (const auto colon = host.find(':');
+                colon != std::string::npos && colon > 0 &&
+                host.find(':', colon + 1) == std::string::npos &&
+                host.front() != '[')
+              throw InputError("command line",
+                               0,
+                               "--host " + host.substr(0, 80),
+                               "the address has a port in it (':" +
+                                 host.substr(colon + 1, 20) + "')",
+                               "give the port with --port: --host " +
+                                 host.substr(0,
+                                             std::min<std::size_t>(colon, 80)) +
+                                 " --port " + host.substr(colon + 1, 20) + ".");
             // An address or a host name: letters, digits, '.', '-',
             // and ':' '[' ']' for IPv6. An empty one would listen on
             // every interface without saying so.
@@ -655,7 +675,7 @@ namespace palpate
                          0,
                          "--finer-mesh " + options.finer_mesh,
                          "the mesh file '" + options.finer_mesh +
-                           "' cannot be read",
+                           "' cannot be read (" + std::strerror(errno) + ")",
                          "give a finer mesh of the same organ, in the "
                          "scene's file unit (its Scale factor applies).");
       const Scene       scene  = read_and_report(args[1], settings, out);

@@ -61,12 +61,13 @@ namespace palpate
                      "");
       }
     if (!problem.empty())
-      throw scene.error("Output/Directory",
-                        "the scene writes files (shape output, force log "
-                        "or summaries) into '" +
-                          directory + "', but " + problem,
-                        "name a directory you can write, e.g. 'output', or "
-                        "turn those outputs off.");
+      throw scene.error(
+        "Output/Directory",
+        "the scene writes files (shape output, VTU export, force log "
+        "or summaries) into '" +
+          directory + "', but " + problem,
+        "name a directory you can write, e.g. 'output', or "
+        "turn those outputs off.");
   }
 
 

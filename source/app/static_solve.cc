@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/app/application.h>
+#include <palpate/app/interaction_run.h>
 #include <palpate/app/static_solve.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/base/stop_request.h>
@@ -228,6 +229,11 @@ namespace palpate
                    const Utilities::Point3 &target)
   {
     const auto &p = scene.parameters;
+    // A directory that cannot take the outputs is said before the solve,
+    // naming the entry (a loop of links was "the file system refuses the
+    // path" after it).
+    if (p.effects.shape_output || p.effects.vtu_export || p.effects.force_log)
+      check_output_directory(scene);
     StateSolver solver(mesh, nodes, p);
     const auto &system = solver.system();
 

@@ -840,6 +840,19 @@ namespace palpate
         result.csv_file = options.csv_file;
         if (!result.csv_file.empty())
           {
+            // A missing directory is said now, not after the first knob.
+            const auto parent =
+              std::filesystem::path(result.csv_file).parent_path();
+            std::error_code missing;
+            if (!parent.empty() &&
+                !std::filesystem::is_directory(parent, missing))
+              throw InputError("command line",
+                               0,
+                               "--csv " + result.csv_file,
+                               "its directory '" + parent.string() +
+                                 "' does not exist",
+                               "make it (mkdir -p '" + parent.string() +
+                                 "') or name a file in one that exists.");
             // Said before anything runs, not at the first knob's end.
             std::error_code error;
             if (std::filesystem::is_directory(result.csv_file, error))

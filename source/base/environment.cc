@@ -7,6 +7,8 @@
 
 #include <dlfcn.h>
 #include <mpi.h>
+#include <pthread.h>
+#include <signal.h>
 
 #include <atomic>
 #include <cstdlib>
@@ -103,8 +105,20 @@ namespace palpate
     MPI_Initialized(&initialized);
     if (!initialized)
       {
+        // A stop signal during MPI's start-up (a singleton starts Open
+        // MPI's orted and talks to it) killed palpate in the middle of
+        // that talk, and orted printed "ORTE_ERROR_LOG: Broken pipe" (the
+        // sixth re-run). Held until the start-up is done, the signal then
+        // ends palpate as before, with orted no longer waiting for it.
+        sigset_t stops, before;
+        sigemptyset(&stops);
+        sigaddset(&stops, SIGINT);
+        sigaddset(&stops, SIGTERM);
+        sigaddset(&stops, SIGHUP);
+        pthread_sigmask(SIG_BLOCK, &stops, &before);
         int provided = 0;
         MPI_Init_thread(&argc, &argv, MPI_THREAD_MULTIPLE, &provided);
+        pthread_sigmask(SIG_SETMASK, &before, nullptr);
         thread_multiple = (provided >= MPI_THREAD_MULTIPLE);
         finalize_mpi    = true;
       }

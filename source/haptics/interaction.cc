@@ -373,8 +373,14 @@ namespace palpate
     // States late because a solver server stopped answering or was lost
     // (not because the hand is fast) may stay missing for the server
     // timeout and the re-planning after it: held too, not faded.
+    // Once held for that, it stays held until the cell is complete again:
+    // the servers that come back (SIGCONT) still have the late states to
+    // compute, and the force faded from 8 N to 0 in 0.15 s the moment they
+    // were heard again (the sixth re-run).
     const bool server_trouble =
-      cause == MissingCause::not_computed && s.engine->degraded();
+      cause == MissingCause::not_computed &&
+      (s.engine->degraded() ||
+       (s.previous_held && s.previous_cause == MissingCause::not_computed));
     bool held = false;
     // Missing data is an event while in contact; a failure region or the
     // state space's edge also before it (the HIP got there before any cell
@@ -496,7 +502,11 @@ namespace palpate
   Interaction::initial_cloud_complete() const
   {
     Impl &s = *impl;
-    if (!s.initial_done.load() && s.is_attached.load() && s.engine->idle())
+    // Not while a solver server is in trouble (silent, or lost within the
+    // last 3 s): its work is being planned again, and an engine idle for a
+    // moment in between made the motion start on 23 of 81 states.
+    if (!s.initial_done.load() && s.is_attached.load() && s.engine->idle() &&
+        !s.engine->degraded())
       s.initial_done.store(true);
     return s.initial_done.load();
   }

@@ -1061,6 +1061,7 @@ namespace palpate
     // extrapolates it to the first increment's end.
     impl->predictor_from_behind(
       from, target, behind, behind2, n, x, previous, previous_t);
+    const unsigned int                                work_limit = 2000 + 8 * n;
     std::function<bool(double, double, unsigned int)> increment =
       [&](const double t0, const double t1, const unsigned int depth) {
         const std::vector<double> saved     = x;
@@ -1077,6 +1078,25 @@ namespace palpate
                 x.swap(guess);
                 predicted = true;
               }
+          }
+        // All the Newton iterations one solve may take, its increments,
+        // cutbacks and retries together: each limit alone is bounded, but
+        // 1000 increments, 1000 iterations each and 30 cutbacks together
+        // ran for minutes (the sixth re-run). A state takes 4-8 per
+        // increment; this is far beyond any that converges.
+        if (state.newton_iterations >= work_limit)
+          {
+            x = saved; // the last equilibrium, not the predictor's guess
+            failure.status     = SolveStatus::max_iterations;
+            failure.iterations = 0;
+            failure.message    = "gave up after " +
+                              std::to_string(state.newton_iterations) +
+                              " Newton iterations in all (the increments, "
+                              "their cutbacks and retries): a path this hard "
+                              "is a failure point (Nonlinear solver / Maximum "
+                              "Newton iterations, Maximum cutbacks and Number "
+                              "of increments together allow more)";
+            return false;
           }
         ++state.increments;
         const bool    may_cut_back = depth < s.max_cutbacks;

@@ -479,6 +479,56 @@ namespace palpate
             " m (twice that distance), or a mesh finer near the probe (Mesh "
             "/ Source = surface grades it toward the probe), or Polynomial "
             "degree = 2 (the edge midpoints become contact nodes).");
+
+      // Moved along the surface, the sphere meets the triangles around
+      // the anchor, not only its nearest node. Pressed onto a triangle of
+      // circumradius rho it sinks between the nodes to sqrt(R^2 - rho^2)
+      // from them; held by a node it must stay half a radius out
+      // (StateSolver: "sphere through the surface"), so rho <= 0.87 R, and
+      // an edge L (rho >= L / sqrt(3)) at most 1.5 R. A 1 cm sphere on
+      // liver501 (edges up to 2 cm) passed this check near a node and then
+      // every grid point beside rest was a failure point: 0 N for the
+      // whole run, exit 0 (the sixth re-run). The triangles within two
+      // radii of the anchor; with P2 the midpoints halve the edges.
+      const auto       &x = mesh.vertices();
+      const double      R = a.tip_radius;
+      const auto       &n = selection.active_normal;
+      Utilities::Point3 anchor;
+      for (unsigned int d = 0; d < 3; ++d)
+        anchor[d] =
+          selection.sphere_center[d] - (R + selection.sphere_lift) * n[d];
+      const bool midpoints =
+        scene.parameters.discretization.polynomial_degree == 2;
+      double longest = 0;
+      for (const auto &face : mesh.surface_faces())
+        {
+          bool near = false;
+          for (const unsigned int v : face.vertices)
+            near = near || Utilities::distance(x[v], anchor) <= 2 * R;
+          if (!near)
+            continue;
+          for (unsigned int i = 0; i < 3; ++i)
+            longest =
+              std::max(longest,
+                       Utilities::distance(x[face.vertices[i]],
+                                           x[face.vertices[(i + 1) % 3]]) /
+                         (midpoints ? 2 : 1));
+        }
+      if (longest > 1.5 * R)
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "a sphere of " + Utilities::to_string(R, 3) +
+            " m radius is smaller than the surface triangles around where "
+            "it touches (edges up to " +
+            Utilities::to_string(longest, 3) + " m" +
+            (midpoints ? " between contact nodes" : "") +
+            "): moved along the surface it sinks between the nodes, those "
+            "states are failure points, and the haptic loop renders no "
+            "force there",
+          "use a radius of at least " + Utilities::to_string(longest / 1.5, 3) +
+            " m (two thirds of that edge), or a mesh finer near the probe "
+            "(Mesh / Source = surface with Refinement size about a third of "
+            "the radius), or Polynomial degree = 2.");
     }
 
 

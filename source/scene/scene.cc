@@ -1867,6 +1867,20 @@ namespace palpate
                     " N: below, the device renders (nearly) no force at all "
                     "(haptic devices reach 1-40 N)",
                   "set the device's peak force in N, e.g. 8.");
+    // The limit is the device's safety: 1e308 N removed it (the sixth
+    // re-run). No haptic device renders a kilonewton.
+    if (h.force_limit > 1000)
+      throw error("Haptics/Force limit",
+                  "at most 1000 N: the limit protects the hand and the "
+                  "device, and haptic devices reach 1-40 N",
+                  "set the device's peak force in N, e.g. 8.");
+    if (h.max_force_change > h.force_limit)
+      throw error("Haptics/Maximum force change",
+                  "at most the force limit (" +
+                    Utilities::to_string(h.force_limit, 4) +
+                    " N) per tick: a larger change is a jump the filter "
+                    "would never limit",
+                  "use e.g. 0.05 N.");
     if (!(h.max_force_change >= min_force_change))
       throw error("Haptics/Maximum force change",
                   "at least " + Utilities::to_string(min_force_change, 3) +
@@ -1905,6 +1919,15 @@ namespace palpate
       throw error("Haptics/Trajectory/Direction",
                   "the direction is the zero vector",
                   "give a direction, e.g. 0, 0, -1.");
+    // A motion of less than a hundredth of a second is no motion: with 0
+    // (or 1e-300) the run ended at once with 0 N and exit 0.
+    if (t.type != "replay" && !(t.duration >= 0.01))
+      throw error("Haptics/Trajectory/Duration",
+                  "the motion would last " +
+                    Utilities::to_string(t.duration, 3) +
+                    " s: at least 0.01 s (ten ticks of a 1 kHz loop) are "
+                    "needed for any motion",
+                  "give the motion's length in seconds, e.g. 2.");
     if (t.type != "replay" && t.duration > max_motion_duration)
       throw error("Haptics/Trajectory/Duration",
                   "at most " + Utilities::to_string(max_motion_duration, 4) +

@@ -690,6 +690,33 @@ main(int argc, char **argv)
       "precompute good.prm --set 'State space/Store=" + std::string(247, 's') +
         ".h5'");
 
+  // The sixth re-run (issue 26).
+  scene("Haptics / Trajectory / Duration = 0 (no motion, 0 N, exit 0)",
+        "duration-zero.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Duration = 0\n  end\nend\n");
+  scene("Haptics / Force limit = 1e308 N (no limit at all)",
+        "force-limit-huge.prm",
+        beam + "subsection Haptics\n  set Force limit = 1e308\nend\n");
+  scene("Haptics / Maximum force change above the force limit",
+        "force-change-huge.prm",
+        beam + "subsection Haptics\n  set Force limit = 8\n"
+               "  set Maximum force change = 100\nend\n");
+  run("serve --host with a port in it", "serve good.prm --host 127.0.0.1:80");
+  run("a 1 cm sphere on liver501, beside a node but smaller than the "
+      "triangles around it",
+      "solve '" + palpate_source_dir +
+        "/parameters/liver-stvk.prm' --set 'Boundary conditions/Active "
+        "node/Tip=sphere' --set 'Boundary conditions/Active node/Tip "
+        "radius=0.01' --to 0,0,-0.01");
+  std::filesystem::remove("loop-dir");
+  std::filesystem::create_symlink("loop-dir", "loop-dir");
+  run("solve writing its VTU into a loop of links",
+      "solve good.prm --set 'Output/Directory=loop-dir' --set 'Effects/VTU "
+      "export=true' --to 0,0,-0.001");
+  run("study --csv into a directory that does not exist",
+      "study good.prm --quick --csv no-such-dir/study.csv");
+
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;
 }
