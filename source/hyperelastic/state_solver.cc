@@ -248,6 +248,16 @@ namespace palpate
            State                   &state,
            const bool               may_cut_back = false);
 
+    /** The failure of a solve that used up its Newton work. */
+    static Outcome
+    out_of_work(const unsigned int iterations);
+
+    /** How many increments a path of @p length takes: Number of
+     * increments, more if they would be longer than Maximum increment
+     * length or (with a sphere) its radius. */
+    double
+    increments_needed(const double length) const;
+
     /** Whether @p from is a start for a solve to @p target: a finite
      * target, and a converged, finite state of this body. If not, @p state
      * is the failure point that says so. */
@@ -836,6 +846,42 @@ namespace palpate
 
 
 
+  StateSolver::Impl::Outcome
+  StateSolver::Impl::out_of_work(const unsigned int iterations)
+  {
+    Outcome o;
+    o.status  = SolveStatus::max_iterations;
+    o.message = "gave up after " + std::to_string(iterations) +
+                " Newton iterations in all (the increments, their cutbacks "
+                "and retries): a path this hard is a failure point (Nonlinear "
+                "solver / Maximum Newton iterations, Maximum cutbacks and "
+                "Number of increments together allow more)";
+    return o;
+  }
+
+
+
+  double
+  StateSolver::Impl::increments_needed(const double length) const
+  {
+    // A sphere moves at most its radius per increment. A longer jump can
+    // carry it past a surface node without ever touching it (the contact
+    // is node to sphere): a 2 mm sphere pushed 1 cm into the liver in one
+    // increment ended inside the organ, between its nodes, with no node in
+    // contact and a force of 0 N.
+    double max_length = settings.max_increment_length;
+    if (system->has_contact())
+      max_length = max_length > 0 ?
+                     std::min(max_length, system->sphere_radius()) :
+                     system->sphere_radius();
+    const double n = settings.n_increments;
+    return max_length > 0 ?
+             std::max(n, std::ceil(length / max_length - 1e-12)) :
+             n;
+  }
+
+
+
   bool
   StateSolver::Impl::admissible_start(const State             &from,
                                       const Utilities::Point3 &target,
@@ -1013,35 +1059,21 @@ namespace palpate
     std::vector<double> x      = impl->system->from_state(from);
     const auto          a      = from.active_displacement;
     const double        length = Utilities::distance(a, target);
-    unsigned int        n      = s.n_increments;
-    // A sphere moves at most its radius per increment. A longer jump can
-    // carry it past a surface node without ever touching it (the contact
-    // is node to sphere): a 2 mm sphere pushed 1 cm into the liver in one
-    // increment ended inside the organ, between its nodes, with no node in
-    // contact and a force of 0 N.
-    double max_length = s.max_increment_length;
-    if (impl->system->has_contact())
-      max_length = max_length > 0 ?
-                     std::min(max_length, impl->system->sphere_radius()) :
-                     impl->system->sphere_radius();
-    if (max_length > 0)
+    // A path of more than 1000 increments is not a haptic interaction
+    // but a mistake; refuse it rather than work for minutes.
+    const double needed = impl->increments_needed(length);
+    if (needed > 1000)
       {
-        // A path of more than 1000 increments is not a haptic interaction
-        // but a mistake; refuse it rather than work for minutes.
-        const double needed = std::ceil(length / max_length - 1e-12);
-        if (needed > 1000)
-          {
-            impl->system->to_state(x, state);
-            state.converged = false;
-            state.status    = SolveStatus::max_iterations;
-            state.message = "the target is " + Utilities::to_string(length, 3) +
-                            " m away: more than 1000 increments";
-            state.force = {{0, 0, 0}};
-            return state;
-          }
-        n = std::max(n, static_cast<unsigned int>(needed));
+        impl->system->to_state(x, state);
+        state.converged = false;
+        state.status    = SolveStatus::max_iterations;
+        state.message   = "the target is " + Utilities::to_string(length, 3) +
+                        " m away: more than 1000 increments";
+        state.force = {{0, 0, 0}};
+        return state;
       }
-    const auto point = [&](const double t) {
+    const unsigned int n     = static_cast<unsigned int>(needed);
+    const auto         point = [&](const double t) {
       return Utilities::Point3{{a[0] + t * (target[0] - a[0]),
                                 a[1] + t * (target[1] - a[1]),
                                 a[2] + t * (target[2] - a[2])}};
@@ -1086,16 +1118,8 @@ namespace palpate
         // increment; this is far beyond any that converges.
         if (state.newton_iterations >= work_limit)
           {
-            x = saved; // the last equilibrium, not the predictor's guess
-            failure.status     = SolveStatus::max_iterations;
-            failure.iterations = 0;
-            failure.message    = "gave up after " +
-                              std::to_string(state.newton_iterations) +
-                              " Newton iterations in all (the increments, "
-                              "their cutbacks and retries): a path this hard "
-                              "is a failure point (Nonlinear solver / Maximum "
-                              "Newton iterations, Maximum cutbacks and Number "
-                              "of increments together allow more)";
+            x       = saved; // the last equilibrium, not the predictor's guess
+            failure = Impl::out_of_work(state.newton_iterations);
             return false;
           }
         ++state.increments;
