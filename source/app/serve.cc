@@ -1600,6 +1600,34 @@ namespace palpate
               return;
             }
         }
+        // The value in force sent again: nothing changes, and the cached
+        // states are kept (it dropped them and was counted as a change).
+        {
+          std::lock_guard<std::mutex> control(s.control_mutex);
+          const auto                 &material =
+            s.interaction.scene().parameters.material_model;
+          try
+            {
+              const std::string now = material.get(material.model_name, entry);
+              char             *end_now = nullptr, *end_new = nullptr;
+              const double      a = std::strtod(now.c_str(), &end_now);
+              const double      b = std::strtod(value.c_str(), &end_new);
+              if (!now.empty() && !value.empty() &&
+                  end_now == now.c_str() + now.size() &&
+                  end_new == value.c_str() + value.size() && a == b)
+                {
+                  res.set_content(entry + " = " + value +
+                                    ": unchanged (the value in force); the "
+                                    "cached states are kept",
+                                  "text/plain");
+                  return;
+                }
+            }
+          catch (const std::exception &)
+            {
+              // An entry the model does not have: change() says so.
+            }
+        }
         std::string refused, before;
         try
           {

@@ -355,6 +355,21 @@ main(int argc, char **argv)
                 unknown->body.find("its entries are: Poisson's ratio, "
                                    "Young's modulus") != std::string::npos)
           << std::endl;
+  // The value in force sent again (as 200000): nothing changes, the state
+  // computed at the new modulus stays in the cache.
+  {
+    const auto changes = server.changes().size();
+    const auto same    = client.Post("/material",
+                                  "Young's modulus=200000",
+                                  palpate::LiveServer::command_type);
+    deallog << "the modulus in force sent again: answered "
+            << ok(same && same->status == 200 &&
+                  same->body.find("unchanged") != std::string::npos)
+            << ", not a change: " << ok(server.changes().size() == changes)
+            << ", the state kept: "
+            << ok(server.interaction().cache().state(point) != nullptr)
+            << std::endl;
+  }
   const auto picked =
     client.Post("/active", "0.1,0.01,0.01", palpate::LiveServer::command_type);
   const auto last = client.Get("/frame");
