@@ -243,10 +243,14 @@ namespace palpate
                     << " MPI solver server(s) lost during the run (LOST in the "
                        "summary above); "
                     << (summary.stopped_by.find(
-                          "every solver server was lost") != std::string::npos ?
+                          "every solver server was lost") == std::string::npos ?
+                          "the interaction went on with the servers left" :
+                        summary.stopped_by.find("before the motion started") !=
+                            std::string::npos ?
+                          "none was left before the motion started, so the "
+                          "run ended there" :
                           "the interaction went on with the servers left, "
-                          "and ended when none was left" :
-                          "the interaction went on with the servers left")
+                          "and ended when none was left")
                     << ". Exit status " << ExitStatus::server_lost << ".\n";
           return ExitStatus::server_lost;
         }
@@ -518,6 +522,28 @@ namespace palpate
         else if (args[i] == "--host" && i + 1 < args.size())
           {
             host = args[++i];
+            // "http://localhost/": a URL, not an address.
+            if (host.find("://") != std::string::npos ||
+                host.find('/') != std::string::npos)
+              throw InputError("command line",
+                               0,
+                               "--host " + host.substr(0, 80),
+                               "a URL, not an address or a host name",
+                               "give only the address or name, e.g. --host "
+                               "127.0.0.1 (and the port with --port).");
+            // "[::1]:8080": an IPv6 address with a port after it.
+            if (!host.empty() && host.front() == '[')
+              if (const auto close = host.find("]:");
+                  close != std::string::npos)
+                throw InputError(
+                  "command line",
+                  0,
+                  "--host " + host.substr(0, 80),
+                  "the address has a port in it ('" +
+                    host.substr(close + 1, 20) + "')",
+                  "give the port with --port: --host " +
+                    host.substr(0, std::min<std::size_t>(close + 1, 80)) +
+                    " --port " + host.substr(close + 2, 20) + ".");
             // "127.0.0.1:80": a port written into the address (an IPv6
             // address has several colons, or brackets).
             if (const auto colon = host.find(':');

@@ -617,4 +617,9 @@ namespace palpate
     run.note_late_stop(summary);
     return summary;
   }
+  std::shared_ptr<void>
+  lock_outputs(const Scene &scene, const std::string &stem)
+  {
+    return std::make_shared<OutputLock>(scene, stem);
+  }
 } // namespace palpate

@@ -2058,8 +2058,14 @@ namespace palpate
       scene.file().empty() ?
         "default" :
         std::filesystem::path(scene.file()).stem().string();
+    // One live view of a scene per output directory: two overwrote each
+    // other's force log and summary (the seventh re-run).
+    std::shared_ptr<void> output_lock;
     if (p.effects.force_log || !p.output.summary_formats.empty())
-      check_output_directory(scene);
+      {
+        check_output_directory(scene);
+        output_lock = lock_outputs(scene, stem + "-serve");
+      }
     LiveServer server(scene, host, port, 0.05, &out);
     // Listening on every interface: the address to open is this machine's
     // (LiveServer::address()); the others it answers to are listed, since

@@ -499,36 +499,58 @@ namespace palpate
           selection.sphere_center[d] - (R + selection.sphere_lift) * n[d];
       const bool midpoints =
         scene.parameters.discretization.polynomial_degree == 2;
-      double longest = 0;
-      for (const auto &face : mesh.surface_faces())
-        {
-          bool near = false;
-          for (const unsigned int v : face.vertices)
-            near = near || Utilities::distance(x[v], anchor) <= 2 * R;
-          if (!near)
-            continue;
-          for (unsigned int i = 0; i < 3; ++i)
-            longest =
-              std::max(longest,
-                       Utilities::distance(x[face.vertices[i]],
-                                           x[face.vertices[(i + 1) % 3]]) /
-                         (midpoints ? 2 : 1));
-        }
+      // The longest edge (between contact nodes) of the triangles within
+      // @p reach of the anchor.
+      const auto longest_within = [&](const double reach) {
+        double longest = 0;
+        for (const auto &face : mesh.surface_faces())
+          {
+            bool near = false;
+            for (const unsigned int v : face.vertices)
+              near = near || Utilities::distance(x[v], anchor) <= reach;
+            if (!near)
+              continue;
+            for (unsigned int i = 0; i < 3; ++i)
+              longest =
+                std::max(longest,
+                         Utilities::distance(x[face.vertices[i]],
+                                             x[face.vertices[(i + 1) % 3]]) /
+                           (midpoints ? 2 : 1));
+          }
+        return longest;
+      };
+      const double longest = longest_within(2 * R);
       if (longest > 1.5 * R)
-        throw scene.error(
-          "Boundary conditions/Active node/Tip radius",
-          "a sphere of " + Utilities::to_string(R, 3) +
-            " m radius is smaller than the surface triangles around where "
-            "it touches (edges up to " +
-            Utilities::to_string(longest, 3) + " m" +
-            (midpoints ? " between contact nodes" : "") +
-            "): moved along the surface it sinks between the nodes, those "
-            "states are failure points, and the haptic loop renders no "
-            "force there",
-          "use a radius of at least " + Utilities::to_string(longest / 1.5, 3) +
-            " m (two thirds of that edge), or a mesh finer near the probe "
-            "(Mesh / Source = surface with Refinement size about a third of "
-            "the radius), or Polynomial degree = 2.");
+        {
+          // The radius to suggest: one that passes this check itself (a
+          // larger sphere looks at more triangles, and 0.0142 m was
+          // refused again for an edge further out, the seventh re-run).
+          double needed = longest / 1.5;
+          for (unsigned int k = 0; k < 50; ++k)
+            {
+              const double more = longest_within(2 * needed) / 1.5;
+              if (more <= needed)
+                break;
+              needed = more;
+            }
+          // Up to the next 0.1 mm, so that the number printed passes.
+          needed = std::ceil(needed * 1e4) / 1e4;
+          throw scene.error(
+            "Boundary conditions/Active node/Tip radius",
+            "a sphere of " + Utilities::to_string(R, 3) +
+              " m radius is smaller than the surface triangles around where "
+              "it touches (edges up to " +
+              Utilities::to_string(longest, 3) + " m" +
+              (midpoints ? " between contact nodes" : "") +
+              "): moved along the surface it sinks between the nodes, those "
+              "states are failure points, and the haptic loop renders no "
+              "force there",
+            "use a radius of at least " + Utilities::to_string(needed, 4) +
+              " m (two thirds of the longest edge within two radii of the "
+              "contact), or a mesh finer near the probe (Mesh / Source = "
+              "surface with Refinement size about a third of the radius), or "
+              "Polynomial degree = 2.");
+        }
     }
 
 

@@ -703,6 +703,9 @@ main(int argc, char **argv)
         beam + "subsection Haptics\n  set Force limit = 8\n"
                "  set Maximum force change = 100\nend\n");
   run("serve --host with a port in it", "serve good.prm --host 127.0.0.1:80");
+  run("serve --host given as a URL", "serve good.prm --host http://localhost/");
+  run("serve --host: an IPv6 address with a port",
+      "serve good.prm --host '[::1]:8080'");
   run("a 1 cm sphere on liver501, beside a node but smaller than the "
       "triangles around it",
       "solve '" + palpate_source_dir +

@@ -392,6 +392,31 @@ main()
                                     out,
                                     err);
     const bool        listening = wait_for_text(out, "Live view: open");
+    // A second live view of the scene into the same directory, on another
+    // port: refused, naming the first (two overwrote each other's force
+    // log and summary, the seventh re-run).
+    const std::string second_out = dir + "/second-serve.txt";
+    const pid_t       second =
+      start_palpate({"serve",
+                     scene,
+                     "--port",
+                     std::to_string(20000 + (getpid() + 1) % 20000),
+                     "--set",
+                     "Effects/Force log=true",
+                     "--set",
+                     "Output/Summary formats=json",
+                     "--set",
+                     "Output/Directory=" + dir},
+                    second_out,
+                    second_out);
+    const int second_status = wait_status(second);
+    deallog << "a second serve into the same directory: refused (exit 2) "
+            << ok(second_status == 2) << ", naming the first "
+            << ok(read_file(second_out)
+                    .find("another palpate (process " + std::to_string(pid) +
+                          ") is running this scene with its outputs") !=
+                  std::string::npos)
+            << std::endl;
     std::this_thread::sleep_for(std::chrono::milliseconds(2000));
     kill(pid, SIGINT);
     const int         status = wait_status(pid);

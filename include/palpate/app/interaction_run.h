@@ -7,6 +7,8 @@
 #include <palpate/haptics/run_summary.h>
 
 #include <iosfwd>
+#include <memory>
+#include <string>
 
 namespace palpate
 {
@@ -29,6 +31,16 @@ namespace palpate
    */
   void
   check_output_directory(const Scene &scene);
+
+  /**
+   * One writer per output: holds DIRECTORY/STEM.lock (an flock, released
+   * however the process ends) for as long as the returned handle lives. A
+   * second run of the scene writing the same files into the same Output /
+   * Directory is refused with an InputError naming the first (two live
+   * views overwrote each other's force log and summary).
+   */
+  std::shared_ptr<void>
+  lock_outputs(const Scene &scene, const std::string &stem);
 } // namespace palpate
 
 #endif
