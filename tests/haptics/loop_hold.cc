@@ -105,7 +105,10 @@ main(int argc, char **argv)
   rows += loop.drain_force_log(csv);
 
   // The rows: times one period apart (a held tick is not logged: one gap
-  // of about 0.1 s), finite, as many as drained.
+  // of about 0.1 s), finite, as many as drained. The gap's upper bound is
+  // what this thread held plus 0.5 s: CI's loaded machine delays the loop's
+  // first tick after the release by more than 50 ms (the check failed there
+  // once at + 0.05 s); a loop that did not come back fails "goes on" above.
   std::istringstream in(csv.str());
   std::string        line;
   double             previous = -1, largest_gap = 0;
@@ -133,7 +136,7 @@ main(int argc, char **argv)
           << ", all finite: " << ok(finite == read)
           << ", most one period apart: " << ok(one_period > 0.9 * read)
           << ", the hold's gap (0.1 s or what it was held): "
-          << ok(largest_gap > 0.09 && largest_gap < held_for + 0.05)
+          << ok(largest_gap > 0.09 && largest_gap < held_for + 0.5)
           << ", none dropped: " << ok(loop.force_log_dropped() == 0)
           << std::endl;
 
