@@ -718,6 +718,22 @@ namespace palpate
         if (size >= Limits::min_body_size && size <= Limits::max_body_size)
           return;
         const double factor = scene.parameters.mesh.scale_factor;
+        // The power of ten (a unit: millimetres, centimetres, metres) that
+        // makes it closest to a liver's 0.25 m: a scene's points and boxes
+        // are written in such a unit, and an odd factor that makes the body
+        // exactly 0.25 m across then missed its fixed nodes (the eighth
+        // re-run suggested 0.02743).
+        double best = factor;
+        for (int k = -9; k <= 9; ++k)
+          {
+            const double scaled = size * std::pow(10.0, k);
+            if (scaled >= Limits::min_body_size &&
+                scaled <= Limits::max_body_size &&
+                (best == factor ||
+                 std::abs(std::log(scaled / 0.25)) <
+                   std::abs(std::log(size * best / factor / 0.25))))
+              best = factor * std::pow(10.0, k);
+          }
         throw scene.error(
           "Mesh/Scale factor",
           "with this scale factor the body is " +
@@ -726,9 +742,12 @@ namespace palpate
             "is between 0.002 and 2 m: the mesh file's unit is not the one "
             "the scale factor assumes",
           "set Scale factor to the metres per mesh-file unit: 0.001 for "
-          "millimetres, 0.01 for centimetres; for this mesh to be 0.25 m "
-          "across (a liver), " +
-            Utilities::to_string(factor * 0.25 / size, 4) + ".");
+          "millimetres, 0.01 for centimetres; here " +
+            Utilities::to_string(best, 6) + " makes the body " +
+            Utilities::to_string(size * best / factor, 3) + " m across, and " +
+            Utilities::to_string(factor * 0.25 / size, 4) +
+            " makes it 0.25 m (a liver); the scene's points and boxes (fixed "
+            "nodes, probe) are in the metres this factor gives.");
       };
       const auto &p = scene.parameters.mesh;
       if (p.source == "beam")

@@ -465,29 +465,15 @@ namespace palpate
       // nearest node 4.3 mm away), a 6 mm sphere pushed 1 cm still
       // passed between the nodes (0 N) and 1 cm rendered 0.27 N: twice
       // the distance makes the first node touch within a quarter of it.
-      if (a.tip_radius < 2 * hole)
-        throw scene.error(
-          "Boundary conditions/Active node/Tip radius",
-          "a sphere of " + Utilities::to_string(a.tip_radius, 3) +
-            " m radius is too small for the gaps between the surface nodes "
-            "where it touches (the nearest is " +
-            Utilities::to_string(hole, 3) +
-            " m away across the surface): the contact acts at nodes, so "
-            "pushed in, the sphere passes between them and renders no "
-            "force",
-          "use a radius of at least " + Utilities::to_string(2 * hole, 3) +
-            " m (twice that distance), or a mesh finer near the probe (Mesh "
-            "/ Source = surface grades it toward the probe), or Polynomial "
-            "degree = 2 (the edge midpoints become contact nodes).");
-
+      //
       // Moved along the surface, the sphere meets the triangles around
       // the anchor, not only its nearest node. Pressed onto a triangle of
       // circumradius rho it sinks between the nodes to sqrt(R^2 - rho^2)
       // from them; held by a node it must stay half a radius out
       // (StateSolver: "sphere through the surface"), so rho <= 0.87 R, and
       // an edge L (rho >= L / sqrt(3)) at most 1.5 R. A 1 cm sphere on
-      // liver501 (edges up to 2 cm) passed this check near a node and then
-      // every grid point beside rest was a failure point: 0 N for the
+      // liver501 (edges up to 2 cm) passed the first check near a node and
+      // then every grid point beside rest was a failure point: 0 N for the
       // whole run, exit 0 (the sixth re-run). The triangles within two
       // radii of the anchor; with P2 the midpoints halve the edges.
       const auto       &x = mesh.vertices();
@@ -519,38 +505,64 @@ namespace palpate
           }
         return longest;
       };
+      // The radius both messages suggest: the smallest, up to the next 0.1
+      // mm, that passes both checks itself. A larger sphere looks at more
+      // triangles (0.0142 m was refused again for an edge further out, the
+      // seventh re-run), and the first check's "twice that distance" once
+      // printed 0.00347 for 0.003468 and refused it again (the eighth).
+      const auto passing_radius = [&]() {
+        const auto needed_for = [&](const double r) {
+          return std::ceil(std::max(2 * hole, longest_within(2 * r) / 1.5) *
+                           1e4) /
+                 1e4;
+        };
+        double needed = needed_for(R);
+        for (unsigned int k = 0; k < 50; ++k)
+          {
+            const double more = needed_for(needed);
+            if (more <= needed)
+              break;
+            needed = more;
+          }
+        return needed;
+      };
+
+      if (R < 2 * hole)
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "a sphere of " + Utilities::to_string(R, 3) +
+            " m radius is too small for the gaps between the surface nodes "
+            "where it touches (the nearest is " +
+            Utilities::to_string(hole, 3) +
+            " m away across the surface): the contact acts at nodes, so "
+            "pushed in, the sphere passes between them and renders no "
+            "force",
+          "use a radius of at least " +
+            Utilities::to_string(passing_radius(), 6) +
+            " m (at least twice that distance, and two thirds of the "
+            "longest surface edge within two radii), or a mesh finer near "
+            "the probe (Mesh / Source = surface grades it toward the probe), "
+            "or Polynomial degree = 2 (the edge midpoints become contact "
+            "nodes).");
+
       const double longest = longest_within(2 * R);
       if (longest > 1.5 * R)
-        {
-          // The radius to suggest: one that passes this check itself (a
-          // larger sphere looks at more triangles, and 0.0142 m was
-          // refused again for an edge further out, the seventh re-run).
-          double needed = longest / 1.5;
-          for (unsigned int k = 0; k < 50; ++k)
-            {
-              const double more = longest_within(2 * needed) / 1.5;
-              if (more <= needed)
-                break;
-              needed = more;
-            }
-          // Up to the next 0.1 mm, so that the number printed passes.
-          needed = std::ceil(needed * 1e4) / 1e4;
-          throw scene.error(
-            "Boundary conditions/Active node/Tip radius",
-            "a sphere of " + Utilities::to_string(R, 3) +
-              " m radius is smaller than the surface triangles around where "
-              "it touches (edges up to " +
-              Utilities::to_string(longest, 3) + " m" +
-              (midpoints ? " between contact nodes" : "") +
-              "): moved along the surface it sinks between the nodes, those "
-              "states are failure points, and the haptic loop renders no "
-              "force there",
-            "use a radius of at least " + Utilities::to_string(needed, 4) +
-              " m (two thirds of the longest edge within two radii of the "
-              "contact), or a mesh finer near the probe (Mesh / Source = "
-              "surface with Refinement size about a third of the radius), or "
-              "Polynomial degree = 2.");
-        }
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "a sphere of " + Utilities::to_string(R, 3) +
+            " m radius is smaller than the surface triangles around where "
+            "it touches (edges up to " +
+            Utilities::to_string(longest, 3) + " m" +
+            (midpoints ? " between contact nodes" : "") +
+            "): moved along the surface it sinks between the nodes, those "
+            "states are failure points, and the haptic loop renders no "
+            "force there",
+          "use a radius of at least " +
+            Utilities::to_string(passing_radius(), 6) +
+            " m (two thirds of the longest edge within two radii of the "
+            "contact), or a mesh finer near the probe (Mesh / Source = "
+            "surface with Refinement size about a third of the radius), or "
+            "Polynomial degree = 2.");
     }
 
 

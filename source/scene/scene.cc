@@ -1943,6 +1943,24 @@ namespace palpate
                     "computed in time",
                   "give the speed in m/s: 0.01 is 1 cm/s, a careful "
                   "palpation; 0.03 m/s is fast.");
+    // A motion that moves the probe less than 0.1 mm is no motion: with
+    // Speed = 0 (or 1e-300) the run held the probe at rest, rendered 0 N
+    // and ended with exit 0 (the eighth re-run).
+    if ((t.type == "straight line" || t.type == "circle" ||
+         t.type == "smooth random") &&
+        !(t.speed * t.duration >= min_motion_length))
+      throw error("Haptics/Trajectory/Speed",
+                  "at " + Utilities::to_string(t.speed, 3) + " m/s for " +
+                    Utilities::to_string(t.duration, 3) +
+                    " s the probe moves " +
+                    Utilities::to_string(t.speed * t.duration, 3) +
+                    " m: at least " +
+                    Utilities::to_string(min_motion_length, 3) +
+                    " m (0.1 mm) of motion are needed for the force to "
+                    "change",
+                  "give the speed in m/s: 0.01 is 1 cm/s, a careful "
+                  "palpation.",
+                  {"Haptics/Trajectory/Duration"});
     if (t.type == "replay" && t.file_name.empty())
       throw error("Haptics/Trajectory/File name",
                   "Type = replay, but no CSV file is named",
@@ -1960,6 +1978,18 @@ namespace palpate
                     "left out as if over the limit)",
                   "give the most disk space the frames may take in MiB, "
                   "e.g. 1000.");
+    // Below one megabyte not even a dozen frames of a small liver fit:
+    // with 0 the run wrote no frame and said nothing was wrong (the eighth
+    // re-run).
+    if (p.effects.shape_output &&
+        !(p.effects.shape_output_limit >= min_shape_output_limit))
+      throw error("Effects/Shape output limit",
+                  "at least " +
+                    Utilities::to_string(min_shape_output_limit, 3) +
+                    " MiB: a frame of a 500-node liver is about 85 KiB, so "
+                    "a smaller limit writes no frame",
+                  "give the most disk space the frames may take in MiB, "
+                  "e.g. 1000; to write no frames, set Shape output = false.");
     if (p.effects.shape_output && p.effects.shape_output_rate < 1.0 / 3600)
       throw error("Effects/Shape output rate",
                   "at least one frame an hour (" +

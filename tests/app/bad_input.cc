@@ -695,6 +695,19 @@ main(int argc, char **argv)
         "duration-zero.prm",
         beam + "subsection Haptics\n  subsection Trajectory\n"
                "    set Duration = 0\n  end\nend\n");
+  // The eighth re-run (issue 26).
+  scene("Haptics / Trajectory / Speed = 0 (the probe held at rest, 0 N)",
+        "speed-zero.prm",
+        beam + "subsection Haptics\n  subsection Trajectory\n"
+               "    set Speed = 0\n  end\nend\n");
+  scene("Effects / Shape output limit = 0 MiB (no frame written, exit 0)",
+        "shape-limit-zero.prm",
+        beam + "subsection Effects\n  set Shape output = true\n"
+               "  set Shape output limit = 0\nend\n");
+  run("the shipped liver with a scale factor 1000 times too large (the "
+      "suggestion must be the factor that fits the scene)",
+      palpate_source_dir +
+        "/parameters/liver-stvk.prm --set 'Mesh/Scale factor=39.146'");
   scene("Haptics / Force limit = 1e308 N (no limit at all)",
         "force-limit-huge.prm",
         beam + "subsection Haptics\n  set Force limit = 1e308\nend\n");

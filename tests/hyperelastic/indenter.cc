@@ -207,25 +207,57 @@ main(int argc, char **argv)
   // rest was a failure point and an interaction rendered 0 N with exit 0
   // (the sixth re-run). Such a sphere is now refused when the scene is
   // read, with the radius the triangles around the contact need.
+  // Each refusal names a radius; that radius must then pass both checks
+  // (the nearest node's distance and the triangles around the contact): a
+  // suggestion rounded down, or passing one check only, was refused again
+  // (the seventh and eighth re-runs).
+  const auto refusal = [](const palpate::Scene &scene) -> std::string {
+    try
+      {
+        const Body body(scene);
+      }
+    catch (const palpate::InputError &e)
+      {
+        return e.problem() + " / " + e.fix();
+      }
+    return "";
+  };
+  const auto suggested = [](const std::string &refused) {
+    const std::string key = "use a radius of at least ";
+    const auto        at  = refused.find(key);
+    return at == std::string::npos ? 0.0 :
+                                     std::stod(refused.substr(at + key.size()));
+  };
   {
     palpate::Scene liver = shipped_scene("liver-stvk.prm");
     liver.parameters.boundary_conditions.active_node.tip =
       palpate::Parameters::ActiveNode::Tip::sphere;
     liver.parameters.boundary_conditions.active_node.tip_radius = 0.002;
-    std::string refused;
-    try
-      {
-        const Body liver_body(liver);
-      }
-    catch (const palpate::InputError &e)
-      {
-        refused = e.problem() + " / " + e.fix();
-      }
+    const std::string refused = refusal(liver);
     deallog << "a 2 mm sphere on the liver: refused when read: "
             << ok(refused.find("smaller than the surface triangles") !=
                   std::string::npos)
             << ", names the radius needed: "
             << ok(refused.find("use a radius of at least") != std::string::npos)
+            << std::endl;
+    liver.parameters.boundary_conditions.active_node.tip_radius =
+      suggested(refused);
+    deallog << "  the radius it names is accepted: "
+            << ok(suggested(refused) > 0 && refusal(liver).empty())
+            << std::endl;
+  }
+  // The graded liver of liver-indenter.prm: a 3 mm sphere is refused by
+  // the nearest-node check (it once suggested 0.00347 for 0.003468).
+  {
+    palpate::Scene liver = shipped_scene("liver-indenter.prm");
+    liver.parameters.boundary_conditions.active_node.tip_radius = 0.003;
+    const std::string refused = refusal(liver);
+    deallog << "a 3 mm sphere on the graded liver: refused when read: "
+            << ok(!refused.empty());
+    liver.parameters.boundary_conditions.active_node.tip_radius =
+      suggested(refused);
+    deallog << ", the radius it names is accepted: "
+            << ok(suggested(refused) > 0 && refusal(liver).empty())
             << std::endl;
   }
 }

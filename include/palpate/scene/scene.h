@@ -26,10 +26,14 @@ namespace palpate
     constexpr double max_motion_duration = 3600;
     /** Trajectory speed (m/s): a hand moves at most about 2 m/s. */
     constexpr double max_hip_speed = 10;
+    /** Trajectory speed times duration (m): a shorter motion is none. */
+    constexpr double min_motion_length = 1e-4;
     /** Scheduler / Rate (Hz). */
     constexpr double max_scheduler_rate = 1000;
     /** Effects / Shape output rate (Hz): one VTU file per frame. */
     constexpr double max_shape_output_rate = 240;
+    /** Effects / Shape output limit (MiB): below, no frame fits. */
+    constexpr double min_shape_output_limit = 1;
     /** Elastic moduli (Pa): diamond's Young's modulus is 1.2e12 Pa. */
     constexpr double max_modulus = 1e13;
     /** Nodes of a generated mesh (beam). */
