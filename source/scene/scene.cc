@@ -1287,6 +1287,7 @@ namespace palpate
     check_state_space();
     check_newton_counts();
     check_haptics();
+    check_shape_output();
   }
 
 
@@ -1965,6 +1966,15 @@ namespace palpate
       throw error("Haptics/Trajectory/File name",
                   "Type = replay, but no CSV file is named",
                   "name a CSV file with columns t, x, y, z.");
+  }
+
+
+
+  void
+  Scene::check_shape_output() const
+  {
+    using namespace Limits;
+    const auto &p = parameters;
     if (p.effects.shape_output && p.effects.shape_output_rate <= 0)
       throw error("Effects/Shape output rate",
                   "the rate must be positive",

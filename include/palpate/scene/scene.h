@@ -186,6 +186,10 @@ namespace palpate
     void
     check_haptics() const;
 
+    /** validate(): the shape interpolator's frames (rate and disk limit). */
+    void
+    check_shape_output() const;
+
     /** A scene whose parameters are not parsed yet (for read()). */
     struct Unparsed
     {};
