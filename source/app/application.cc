@@ -672,18 +672,9 @@ namespace palpate
             }
           else if (args[i] == "--samples" && has_value)
             {
-              const std::string v   = args[++i];
-              std::size_t       end = 0;
-              long              n   = 0;
-              try
-                {
-                  n = std::stol(v, &end);
-                }
-              catch (const std::exception &)
-                {
-                  end = 0;
-                }
-              if (end != v.size() || n < 8 || n > 5000)
+              const std::string v = args[++i];
+              long              n = 0;
+              if (!Utilities::parse_whole_number(v, n) || n < 8 || n > 5000)
                 throw InputError("command line",
                                  0,
                                  "--samples " + v,

@@ -1699,17 +1699,8 @@ namespace palpate
                 // The whole rest must be the number: "node 3x" is refused,
                 // not read as node 3.
                 const std::string number = Utilities::trim(body.substr(4));
-                std::size_t       used   = 0;
                 long              id     = 0;
-                try
-                  {
-                    id = std::stol(number, &used);
-                  }
-                catch (const std::exception &)
-                  {
-                    used = 0;
-                  }
-                if (used == 0 || used != number.size())
+                if (!Utilities::parse_whole_number(number, id))
                   throw std::invalid_argument("'" + number +
                                               "' is not a node number");
                 refused = s.change(

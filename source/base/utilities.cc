@@ -28,6 +28,23 @@ namespace palpate
 
 
 
+    bool
+    parse_whole_number(const std::string &s, long &value)
+    {
+      std::size_t used = 0;
+      try
+        {
+          value = std::stol(s, &used);
+        }
+      catch (const std::exception &)
+        {
+          return false;
+        }
+      return used > 0 && used == s.size();
+    }
+
+
+
     std::vector<std::string>
     split(const std::string &s, const char separator)
     {

@@ -695,6 +695,10 @@ main(int argc, char **argv)
         "duration-zero.prm",
         beam + "subsection Haptics\n  subsection Trajectory\n"
                "    set Duration = 0\n  end\nend\n");
+  // One parser for every whole number on the command line and in the
+  // live view (Utilities::parse_whole_number).
+  run("study --samples 12x (not a whole number)",
+      "study good.prm --samples 12x");
   // The eighth re-run (issue 26).
   scene("Haptics / Trajectory / Speed = 0 (the probe held at rest, 0 N)",
         "speed-zero.prm",

@@ -34,6 +34,11 @@ namespace palpate
     std::string
     trim(const std::string &s);
 
+    /** Whether the whole of @p s is a base-10 whole number that fits a
+     * long (then in @p value): "3x", "", "3.0" and 1e30 are not. */
+    bool
+    parse_whole_number(const std::string &s, long &value);
+
     /** @p s split at @p separator, each piece trimmed; empty pieces kept. */
     std::vector<std::string>
     split(const std::string &s, const char separator);
