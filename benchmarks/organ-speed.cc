@@ -567,6 +567,7 @@ main(int argc, char **argv)
             if (l == amg_lever && !named)
               continue;
             const Lever lever = configuration(l);
+            ml_lever::setups = ml_lever::applications = ml_lever::failures = 0;
             all.push_back(measure(mesh,
                                   sel,
                                   scene.parameters,
