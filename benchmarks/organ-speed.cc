@@ -237,14 +237,27 @@ namespace
     return m;
   }
 
+  /** The stroke's grid (--spacing, --hermite): 0 and false keep the
+   * scene's (trilinear, 5 mm). What accuracy costs in time: a coarser
+   * Hermite grid needs fewer states per millimetre of stroke. */
+  struct StrokeGrid
+  {
+    double spacing = 0; // m
+    bool   hermite = false;
+  } stroke_grid;
+
   /** The stroke's settings: the best lever configuration, the engine. */
   Scene
   stroke_scene(const double       fine_size,
                const std::string &material,
                const std::string &engine)
   {
-    Scene scene                             = organ_scene(fine_size, material);
-    auto &p                                 = scene.parameters;
+    Scene scene = organ_scene(fine_size, material);
+    auto &p     = scene.parameters;
+    if (stroke_grid.spacing > 0)
+      p.state_space.grid_spacing = stroke_grid.spacing;
+    if (stroke_grid.hermite)
+      p.state_space.interpolation = "tricubic Hermite";
     p.nonlinear_solver.max_increment_length = p.state_space.grid_spacing;
     // The accuracy study's residual tolerance (part 1's last lever).
     p.nonlinear_solver.residual_tolerance = 1e-3;
@@ -287,7 +300,8 @@ namespace
       {
         std::ostringstream a;
         a << std::setprecision(17) << "--child " << fine_size << " " << material
-          << " " << speed;
+          << " " << speed << " " << stroke_grid.spacing << " "
+          << stroke_grid.hermite;
         const auto v = mpi_child::run(mpi_child::command(3, a.str()));
         Trial      t;
         t.speed           = speed;
@@ -370,6 +384,8 @@ namespace
   child(const std::vector<std::string> &a)
   {
     const double fine_size = std::stod(a[0]);
+    stroke_grid.spacing    = std::stod(a[3]);
+    stroke_grid.hermite    = a[4] == "1";
     if (mpi_rank() > 0)
       {
         const Scene         scene = stroke_scene(fine_size, a[1], "mpi");
@@ -395,7 +411,7 @@ int
 main(int argc, char **argv)
 {
   Environment env(argc, argv);
-  if (argc == 5 && std::string(argv[1]) == "--child")
+  if (argc == 7 && std::string(argv[1]) == "--child")
     return child(std::vector<std::string>(argv + 2, argv + argc));
   Options o;
   for (int i = 1; i < argc; ++i)
@@ -436,6 +452,10 @@ main(int argc, char **argv)
         }
       else if (a == "--csv" && i + 1 < argc)
         o.csv = argv[++i];
+      else if (a == "--spacing" && i + 1 < argc)
+        stroke_grid.spacing = 1e-3 * std::stod(argv[++i]);
+      else if (a == "--hermite")
+        stroke_grid.hermite = true;
       else if (a == "--cores" && i + 1 < argc)
         {
           o.cores  = std::stoul(argv[++i]);
@@ -447,7 +467,7 @@ main(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K]\n";
+               "[--cores K] [--spacing MM] [--hermite]\n";
           return 2;
         }
     }
@@ -648,6 +668,11 @@ main(int argc, char **argv)
                     << " nodes=" << mesh.n_vertices()
                     << " material=" << material << " engine=" << engine
                     << " workers=2"
+                    << " grid="
+                    << (stroke_grid.hermite ? "hermite" : "trilinear") << "_"
+                    << 1e3 *
+                         (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
+                    << "mm"
                     << " state_ms=" << state_ms
                     << " speed_mm_s=" << (best.passed ? 1e3 * best.speed : 0)
                     << " deadline_misses=" << shown.deadline_misses
