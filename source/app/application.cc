@@ -450,6 +450,9 @@ namespace palpate
       out << "palpate mesh: " << args[1] << " -> " << args[2] << " (about "
           << nodes << " nodes, " << Utilities::to_string(scale, 6)
           << " m per file unit)\n";
+      // A stop signal ends the meshing child and removes its files
+      // (StoppedError); without it the child outlived palpate.
+      const StopRequest       stop;
       const SurfaceMeshReport report = mesh_surface_file(
         args[1], scale, "--scale", nodes, time_limit, args[2], grading);
       for (const auto &line : report.lines())
@@ -862,6 +865,12 @@ namespace palpate
         out.flush();
         err << "\npalpate: " << e.what() << "\n";
         return ExitStatus::not_available;
+      }
+    catch (const StoppedError &e)
+      {
+        out.flush();
+        err << "\npalpate: " << e.what() << "\n";
+        return e.exit_status;
       }
     catch (const std::exception &e)
       {

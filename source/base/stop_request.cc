@@ -27,6 +27,9 @@ namespace palpate
     std::atomic<long long> received_at{0};
     static_assert(std::atomic<long long>::is_always_lock_free);
 
+    // Whether a StopRequest lives (its handlers are installed).
+    std::atomic<bool> alive{false};
+
     long long
     now_ns() noexcept
     {
@@ -65,6 +68,7 @@ namespace palpate
   StopRequest::StopRequest()
   {
     received.store(0);
+    alive.store(true);
     struct sigaction action
     {};
     action.sa_handler = on_stop_signal;
@@ -85,6 +89,7 @@ namespace palpate
 
   StopRequest::~StopRequest()
   {
+    alive.store(false);
     for (unsigned int i = 0; i < 3; ++i)
       sigaction(stop_signals[i], &previous[i], nullptr);
   }
@@ -96,6 +101,26 @@ namespace palpate
   {
     return received.load() != 0;
   }
+
+
+
+  bool
+  StopRequest::pending() noexcept
+  {
+    return alive.load() && received.load() != 0;
+  }
+
+
+
+  StoppedError::StoppedError(const std::string &what)
+    : std::runtime_error(what + " was stopped by " +
+                         (received.load() == SIGINT  ? "SIGINT (Ctrl-C)" :
+                          received.load() == SIGTERM ? "SIGTERM" :
+                          received.load() == SIGHUP  ? "SIGHUP" :
+                                                       "a stop signal") +
+                         "; nothing was written")
+    , exit_status(128 + received.load())
+  {}
 
 
 

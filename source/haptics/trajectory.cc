@@ -380,14 +380,43 @@ namespace palpate
         "write one timed position per line: t (s), x, y, z (m).");
 
     // Count from the first row: the replay starts at rest at t = 0.
-    const double            t0 = times.front();
-    const Utilities::Point3 x0 = points.front();
+    const double            t0       = times.front();
+    const Utilities::Point3 x0       = points.front();
+    double                  farthest = 0;
     for (std::size_t k = 0; k < times.size(); ++k)
       {
         times[k] -= t0;
         for (unsigned int d = 0; d < 3; ++d)
           points[k][d] -= x0[d];
+        farthest = std::max(farthest, Utilities::norm(points[k]));
       }
+    // A recording that does not move is no motion, as Speed = 0 is not
+    // (Scene::check_haptics): a single line, 2,000 lines at one position,
+    // or 2,000 lines within 0.2 ms ran with 0 N and exit 0 (the ninth
+    // re-run).
+    if (times.back() < Limits::min_replay_duration)
+      throw InputError(filename,
+                       0,
+                       "trajectory replay (Haptics / Trajectory / File name)",
+                       "the recording lasts " +
+                         Utilities::to_string(times.back(), 3) + " s (" +
+                         std::to_string(times.size()) +
+                         (times.size() == 1 ? " position" : " positions") +
+                         "): at least 0.01 s (ten ticks of a 1 kHz "
+                         "loop) are needed for any motion",
+                       "record at least two timed positions, with the times "
+                       "in seconds.");
+    if (farthest < Limits::min_motion_length)
+      throw InputError(filename,
+                       0,
+                       "trajectory replay (Haptics / Trajectory / File name)",
+                       "every position is within " +
+                         Utilities::to_string(farthest, 3) +
+                         " m of the first: at least " +
+                         Utilities::to_string(Limits::min_motion_length, 3) +
+                         " m (0.1 mm) of motion are needed for the force to "
+                         "change",
+                       "record a motion, with the positions in metres.");
   }
 
 

@@ -53,6 +53,12 @@ namespace palpate
 
 
 
+  /** The Poisson's ratios a compressible model takes (check_poissons_ratio
+   * says why). */
+  constexpr double max_compressible_nu = 0.4999, min_compressible_nu = -0.9;
+
+
+
   void
   check_poissons_ratio(const std::string &entry, const double nu)
   {
@@ -67,6 +73,30 @@ namespace palpate
         entry,
         "nu = -1 makes the shear modulus E/(2(1+nu)) infinite",
         "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
+    // Linear and quadratic displacement elements lock as nu nears 0.5: at
+    // 0.4999 the liver's 1 cm push already renders 4.5 N instead of 1.6 N
+    // (tests/hyperelastic/hard_cases), at 0.4999999 3,817 N with exit 0
+    // (the ninth re-run): the force is then the locking's, not the
+    // tissue's.
+    if (nu > max_compressible_nu)
+      throw Plugins::EntryError(
+        entry,
+        "nu = " + Utilities::to_string_exact(nu) +
+          " is too close to 0.5 for a compressible model: its elements "
+          "lock, and the force is the locking's (0.4999999 rendered 3,817 N "
+          "for a push that gives 1.6 N at 0.49)",
+        "use nu <= 0.4999 (0.49 is the paper's value), or Mooney-Rivlin, "
+        "whose mixed formulation keeps the volume without locking.");
+    // Near -1 the shear modulus E/(2(1+nu)) dwarfs the bulk modulus by
+    // many orders: with -0.9999999 every state of an interaction failed
+    // and the run rendered 0 N with exit 0 (the ninth re-run).
+    if (nu < min_compressible_nu)
+      throw Plugins::EntryError(
+        entry,
+        "nu = " + Utilities::to_string_exact(nu) +
+          " is below -0.9: the shear modulus E/(2(1+nu)) is then more "
+          "than five times E and the states fail to converge",
+        "use -0.9 <= nu <= 0.4999; soft tissue has nu close to 0.5.");
   }
 
 

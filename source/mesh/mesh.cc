@@ -705,6 +705,99 @@ namespace palpate
 
   namespace
   {
+    /** A scale factor to suggest for a mesh read in the wrong unit. */
+    struct ScaleSuggestion
+    {
+      double       factor = 0;
+      unsigned int fits = 0, of = 0;
+    };
+
+    /**
+     * The factor to suggest when the body is not 2 mm - 2 m across: one
+     * with which the scene's places meet the body (the probe's point near
+     * a node; the fixed nodes' box or half-space holding some nodes but
+     * not all), a unit (a power of ten) or the scene's factor times one if
+     * such a factor does it, else any (to three digits); of those the one
+     * that makes the body closest to a liver's 0.25 m. The eighth re-run
+     * was told 0.02743 (0.25 m exactly), the ninth 0.00039146 (the scene's
+     * factor over 100); both missed the fixed nodes of a millimetre mesh,
+     * which only 0.001 fits.
+     */
+    ScaleSuggestion
+    suggest_scale_factor(const Scene &scene, const Mesh &mesh)
+    {
+      const double factor = scene.parameters.mesh.scale_factor;
+      const double size   = mesh.diameter();
+      const auto  &x      = mesh.vertices();
+      const auto  &bc     = scene.parameters.boundary_conditions;
+      const auto  &fixed  = bc.fixed_nodes;
+      // Whether 0 < k < n vertices at scale s lie in the fixed region.
+      const auto splits = [&](const double s, const auto &in_region) {
+        std::size_t k = 0;
+        for (const auto &v : x)
+          k += in_region(Utilities::scaled(v, s));
+        return k > 0 && k < x.size();
+      };
+      const auto fits = [&](const double f) {
+        const double s = f / factor;
+        unsigned int n = 0;
+        if (bc.active_node.selection != "node id")
+          {
+            double nearest = std::numeric_limits<double>::infinity();
+            for (const auto &v : x)
+              nearest = std::min(nearest,
+                                 Utilities::distance(Utilities::scaled(v, s),
+                                                     bc.active_node.point));
+            n += nearest <= 0.05 * size * s;
+          }
+        if (fixed.selection == "box")
+          n += splits(s, [&](const Utilities::Point3 &v) {
+            for (unsigned int d = 0; d < 3; ++d)
+              if (v[d] < fixed.box_lower_corner[d] ||
+                  v[d] > fixed.box_upper_corner[d])
+                return false;
+            return true;
+          });
+        if (fixed.selection == "half-space")
+          n += splits(s, [&](const Utilities::Point3 &v) {
+            double dot = 0;
+            for (unsigned int d = 0; d < 3; ++d)
+              dot +=
+                (v[d] - fixed.half_space_point[d]) * fixed.half_space_normal[d];
+            return dot >= 0;
+          });
+        return n;
+      };
+      ScaleSuggestion best;
+      best.of = (bc.active_node.selection != "node id") +
+                (fixed.selection == "box" || fixed.selection == "half-space");
+      const auto consider = [&](const double f) {
+        const double scaled = size * f / factor;
+        if (!(scaled >= Limits::min_body_size &&
+              scaled <= Limits::max_body_size))
+          return;
+        const unsigned int n = fits(f);
+        if (best.factor == 0 || n > best.fits ||
+            (n == best.fits &&
+             std::abs(std::log(scaled / 0.25)) <
+               std::abs(std::log(size * best.factor / factor / 0.25))))
+          best = {f, n, best.of};
+      };
+      for (int k = -9; k <= 9; ++k)
+        {
+          consider(factor * std::pow(10.0, k));
+          consider(std::pow(10.0, k));
+        }
+      // A file in no unit (the SOFA liver): any factor, to three digits.
+      if (best.fits < best.of)
+        for (int k = -900; k <= 900; ++k)
+          consider(std::stod(
+            Utilities::to_string(factor * std::pow(10.0, k / 100.0), 3)));
+      return best;
+    }
+
+
+
     /** The mesh a scene describes, before the memory check. */
     Mesh
     create_unchecked(const Scene &scene)
@@ -717,23 +810,9 @@ namespace palpate
         const double size = mesh.diameter();
         if (size >= Limits::min_body_size && size <= Limits::max_body_size)
           return;
-        const double factor = scene.parameters.mesh.scale_factor;
-        // The power of ten (a unit: millimetres, centimetres, metres) that
-        // makes it closest to a liver's 0.25 m: a scene's points and boxes
-        // are written in such a unit, and an odd factor that makes the body
-        // exactly 0.25 m across then missed its fixed nodes (the eighth
-        // re-run suggested 0.02743).
-        double best = factor;
-        for (int k = -9; k <= 9; ++k)
-          {
-            const double scaled = size * std::pow(10.0, k);
-            if (scaled >= Limits::min_body_size &&
-                scaled <= Limits::max_body_size &&
-                (best == factor ||
-                 std::abs(std::log(scaled / 0.25)) <
-                   std::abs(std::log(size * best / factor / 0.25))))
-              best = factor * std::pow(10.0, k);
-          }
+        const double factor    = scene.parameters.mesh.scale_factor;
+        const auto   suggested = suggest_scale_factor(scene, mesh);
+        const double best      = suggested.factor;
         throw scene.error(
           "Mesh/Scale factor",
           "with this scale factor the body is " +
@@ -744,10 +823,15 @@ namespace palpate
           "set Scale factor to the metres per mesh-file unit: 0.001 for "
           "millimetres, 0.01 for centimetres; here " +
             Utilities::to_string(best, 6) + " makes the body " +
-            Utilities::to_string(size * best / factor, 3) + " m across, and " +
-            Utilities::to_string(factor * 0.25 / size, 4) +
-            " makes it 0.25 m (a liver); the scene's points and boxes (fixed "
-            "nodes, probe) are in the metres this factor gives.");
+            Utilities::to_string(size * best / factor, 3) + " m across" +
+            (suggested.of == 0 ?
+               std::string() :
+               ", where " + std::to_string(suggested.fits) +
+                 " of the scene's " + std::to_string(suggested.of) +
+                 " places (the probe's point, the fixed nodes' region) "
+                 "meet it") +
+            ", and " + Utilities::to_string(factor * 0.25 / size, 4) +
+            " makes it 0.25 m (a liver).");
       };
       const auto &p = scene.parameters.mesh;
       if (p.source == "beam")

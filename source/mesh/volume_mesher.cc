@@ -2,11 +2,13 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/base/exceptions.h>
+#include <palpate/base/stop_request.h>
 #include <palpate/mesh/mesh_file.h>
 #include <palpate/mesh/volume_mesher.h>
 
 #include <gmsh.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -389,13 +391,18 @@ namespace palpate
     if (::pipe(channel) != 0)
       throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
     std::fflush(nullptr);
-    const pid_t child = ::fork();
+    const pid_t parent = ::getpid();
+    const pid_t child  = ::fork();
     if (child < 0)
       throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
     if (child == 0)
       {
         // The child: mesh, report through the pipe, leave without running
-        // the parent's atexit handlers (MPI, deal.II).
+        // the parent's atexit handlers (MPI, deal.II). It dies with the
+        // parent, however the parent ends.
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (::getppid() != parent)
+          ::_exit(1);
         ::close(channel[0]);
         std::string report;
         try
@@ -444,6 +451,19 @@ namespace palpate
             ::kill(child, SIGKILL);
             ::waitpid(child, &status, 0);
             break;
+          }
+        // Ctrl-C or kill: the child goes, and its files with it (SIGTERM
+        // on `palpate mesh` left the child meshing for 18 s and a 14.7 MB
+        // temporary file, the ninth re-run).
+        if (StopRequest::pending())
+          {
+            ::kill(child, SIGKILL);
+            ::waitpid(child, &status, 0);
+            ::close(channel[0]);
+            std::error_code ec;
+            std::filesystem::remove(tmp, ec);
+            std::filesystem::remove(tmp + ".pass.msh", ec);
+            throw StoppedError("meshing '" + surface_name + "'");
           }
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
       }
@@ -531,8 +551,16 @@ namespace palpate
         return std::string("it looks like ") + name + ": set " +
                Utilities::to_string(unit, 3) + " (the body is then " +
                Utilities::to_string(file_size * unit, 3) + " m across)";
+    // A factor --scale takes, or none: the ninth re-run was told "set inf"
+    // for a surface of zero extent and 1.443e-151 for one at 1e150.
+    const double liver = factor * 0.25 / size;
+    if (!(liver >= 1e-9 && liver <= 1e9))
+      return "no scale factor from 1e-9 to 1e9 makes it an organ (the "
+             "surface spans " +
+             Utilities::to_string(file_size, 3) +
+             " file units): check that the file holds the organ's surface";
     return "for the body to be 0.25 m across (a liver), set " +
-           Utilities::to_string(factor * 0.25 / size, 4);
+           Utilities::to_string(liver, 4);
   }
 
 
@@ -624,6 +652,19 @@ namespace palpate
     report.diameter     = s.diameter();
     report.box          = s.bounding_box();
     report.area         = s.area();
+    // Coordinates so large that their distances overflow (every one
+    // times 1e300): no vertex is the outlier, and the one named was a
+    // healthy one (the ninth re-run).
+    if (!std::isfinite(report.diameter))
+      throw InputError(
+        surface_file,
+        0,
+        scale_entry + " = " + Utilities::to_string(scale, 6),
+        "the surface's coordinates reach " +
+          Utilities::to_string(Utilities::scaled(report.box[1], 1 / scale), 3) +
+          " (file units): the distances between them overflow",
+        "check the file: it is corrupted or in a unit no "
+        "scale factor from 1e-9 to 1e9 can make an organ of.");
     // One wild vertex (1e308) is not a unit mistake: name it, rather than
     // advise a scale factor of 0.
     if (const long far = far_outlier(s.vertices); far >= 0)
@@ -681,6 +722,20 @@ namespace palpate
       }
     report.repairs = repair_surface(s, surface_file);
     report.volume  = s.volume();
+    // A closed surface that encloses (next to) nothing: a flat or folded
+    // shell. The mesher tried for the whole time limit and blamed the node
+    // count (the ninth re-run).
+    if (!(std::abs(report.volume) >= 1e-6 * std::pow(report.diameter, 3)))
+      throw InputError(surface_file,
+                       0,
+                       "surface",
+                       "the surface encloses " +
+                         Utilities::to_string(std::abs(report.volume), 3) +
+                         " m^3, nothing next to a body " +
+                         Utilities::to_string(report.diameter, 3) +
+                         " m across: it is flat or folded onto itself",
+                       "export the organ's closed outer surface (a solid, "
+                       "not a sheet).");
     report.self_intersections =
       count_self_intersections(s, report.intersection);
     report.meshing =

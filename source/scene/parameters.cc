@@ -1127,19 +1127,21 @@ namespace palpate
           "the states its shape output fetched). Beyond it, the "
           "states farthest from the HIP are dropped; their forces "
           "stay.");
+        // At most an hour: with 1e308 servers whose client (rank 0) was
+        // killed kept running (the ninth re-run).
         prm.declare_entry("Server timeout",
                           "5",
-                          Patterns::Double(0.5),
+                          Patterns::Double(0.5, 3600),
                           "Type = mpi: a solver server that has sent "
                           "nothing (it sends a heartbeat every 0.1 s) for "
                           "this long is lost: it gets no more work and its "
                           "task is planned again. The other way round, a "
                           "server that has heard nothing from the client "
                           "(rank 0, also every 0.1 s) for this long ends, "
-                          "saying so (s).");
+                          "saying so (s; at most 3600).");
         prm.declare_entry("Task timeout",
                           "60",
-                          Patterns::Double(0.1),
+                          Patterns::Double(0.1, 86400),
                           "Type = mpi: a server whose task has run this "
                           "long is treated as hung and lost (s).");
       }

@@ -695,6 +695,78 @@ main(int argc, char **argv)
         "duration-zero.prm",
         beam + "subsection Haptics\n  subsection Trajectory\n"
                "    set Duration = 0\n  end\nend\n");
+  // The ninth re-run (issue 26).
+  scene("St.Venant-Kirchhoff nu = 0.4999999 (3,817 N for a 1.6 N push)",
+        "nu-locking.prm",
+        beam + "subsection Material model\n  subsection St.Venant-Kirchhoff\n"
+               "    set Poisson's ratio = 0.4999999\n  end\nend\n");
+  scene("Neo-Hookean nu = -0.9999999 (every state failed, 0 N)",
+        "nu-auxetic.prm",
+        beam + "subsection Material model\n  set Model name = Neo-Hookean\n"
+               "  subsection Neo-Hookean\n"
+               "    set Poisson's ratio = -0.9999999\n  end\nend\n");
+  write_file("one-line.csv", "t, x, y, z\n0, 0, 0, 0\n");
+  scene("a replay recording of one line (no motion, 0 N)",
+        "replay-one-line.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = one-line.csv\n"
+          "  end\nend\n");
+  {
+    std::ofstream still("still.csv"), instant("instant.csv");
+    for (unsigned int k = 0; k < 2000; ++k)
+      {
+        still << 0.001 * k << ", 0.01, 0.02, 0.03\n";
+        instant << 1e-7 * k << ", 0, 0, " << -1e-7 * k << "\n";
+      }
+  }
+  scene("a replay recording of 2,000 lines at one position",
+        "replay-still.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = still.csv\n"
+          "  end\nend\n");
+  scene("a replay recording of 2,000 lines within 0.2 ms",
+        "replay-instant.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = instant.csv\n"
+          "  end\nend\n");
+  scene("Engine / Server timeout = 1e308 s (servers outlived a killed rank 0)",
+        "server-timeout.prm",
+        beam + "subsection Engine\n  set Server timeout = 1e308\nend\n");
+  write_file("flat.obj",
+             "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0.1 0.1 0\n"
+             "f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n");
+  run("a closed surface that encloses no volume (a flat tetrahedron)",
+      "mesh flat.obj out.msh");
+  write_file("point.obj",
+             "v 0 0 0\nv 0 0 0\nv 0 0 0\nv 0 0 0\n"
+             "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
+  run("a surface of zero extent (the scale suggestion was inf)",
+      "mesh point.obj out.msh");
+  {
+    std::ifstream in(palpate_meshes_dir + "/liver-tetgen/liver501-surface.obj");
+    std::ofstream out("huge-units.obj");
+    std::string   line;
+    while (std::getline(in, line))
+      {
+        if (line.rfind("v ", 0) == 0)
+          {
+            std::istringstream v(line.substr(2));
+            double             x, y, z;
+            v >> x >> y >> z;
+            out << "v " << x * 1e300 << " " << y * 1e300 << " " << z * 1e300
+                << "\n";
+          }
+        else
+          out << line << "\n";
+      }
+  }
+  run("a surface with every coordinate times 1e300 (a healthy vertex was "
+      "blamed)",
+      "mesh huge-units.obj out.msh");
+
   // One parser for every whole number on the command line and in the
   // live view (Utilities::parse_whole_number).
   run("study --samples 12x (not a whole number)",

@@ -68,7 +68,15 @@ main(int argc, char **argv)
     interaction, device, 1000, palpate::HapticLoop::continuous, true);
   loop.start(palpate::HapticLoop::continuous);
   loop.start_motion();
-  std::this_thread::sleep_for(100ms);
+  // Until the loop has run 100 ticks of motion (about 0.1 s; on a loaded
+  // machine the thread may start late, and a hold before the first logged
+  // tick leaves no gap in the log: the fresh-clone CI's ctest -j2 saw
+  // that once).
+  const auto waited = [&](const unsigned long n) {
+    for (unsigned int k = 0; k < 1000 && device.calls.load() < n; ++k)
+      std::this_thread::sleep_for(10ms);
+  };
+  waited(100);
 
   loop.hold();
   const auto          held_since = std::chrono::steady_clock::now();
@@ -82,6 +90,7 @@ main(int argc, char **argv)
       .count();
   loop.release();
   std::this_thread::sleep_for(100ms);
+  waited(held_at + while_held + 51);
   const unsigned long after = device.calls.load() - held_at - while_held;
   deallog << "positions read while held: " << while_held
           << "; after the release, the loop goes on: " << ok(after > 50)

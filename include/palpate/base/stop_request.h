@@ -4,6 +4,7 @@
 #ifndef palpate_base_stop_request_h
 #define palpate_base_stop_request_h
 
+#include <stdexcept>
 #include <string>
 
 namespace palpate
@@ -47,6 +48,12 @@ namespace palpate
     bool
     requested() const noexcept;
 
+    /** Whether a StopRequest lives and a stop signal arrived: for work
+     * deep below the driver that must end early (meshing in a child
+     * process), without the driver's object at hand. */
+    static bool
+    pending() noexcept;
+
     /** The signal that asked for the stop (0 if none). */
     int
     signal_number() const noexcept;
@@ -73,6 +80,21 @@ namespace palpate
    */
   void
   ignore_broken_pipes() noexcept;
+
+  /**
+   * Work that a stop signal (StopRequest) ended before it could produce
+   * anything, with nothing left behind (meshing: the child killed, its
+   * temporary files removed). The driver reports it and returns
+   * exit_status, 128 + the signal's number.
+   */
+  class StoppedError : public std::runtime_error
+  {
+  public:
+    /** @p what: what was stopped, e.g. "meshing 'liver.stl'". */
+    explicit StoppedError(const std::string &what);
+
+    int exit_status;
+  };
 } // namespace palpate
 
 #endif

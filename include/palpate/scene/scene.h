@@ -26,8 +26,11 @@ namespace palpate
     constexpr double max_motion_duration = 3600;
     /** Trajectory speed (m/s): a hand moves at most about 2 m/s. */
     constexpr double max_hip_speed = 10;
-    /** Trajectory speed times duration (m): a shorter motion is none. */
+    /** Trajectory speed times duration, or a replay's farthest position
+     * (m): a shorter motion is none. */
     constexpr double min_motion_length = 1e-4;
+    /** A replay recording's length (s): ten ticks of a 1 kHz loop. */
+    constexpr double min_replay_duration = 0.01;
     /** Scheduler / Rate (Hz). */
     constexpr double max_scheduler_rate = 1000;
     /** Effects / Shape output rate (Hz): one VTU file per frame. */
