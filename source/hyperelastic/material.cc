@@ -73,9 +73,9 @@ namespace palpate
         entry,
         "nu = -1 makes the shear modulus E/(2(1+nu)) infinite",
         "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
-    // Linear and quadratic displacement elements lock as nu nears 0.5: at
-    // 0.4999 the liver's 1 cm push already renders 4.5 N instead of 1.6 N
-    // (tests/hyperelastic/hard_cases), at 0.4999999 3,817 N with exit 0
+    // Linear and quadratic displacement elements lock as nu nears 0.5:
+    // on liver-stvk.prm's 1 cm push (solve) 0.49 renders 3.43 N, 0.4999
+    // 26.3 N; 0.4999999 rendered 3,817 N with exit 0 in an interaction
     // (the ninth re-run): the force is then the locking's, not the
     // tissue's.
     if (nu > max_compressible_nu)
@@ -83,8 +83,9 @@ namespace palpate
         entry,
         "nu = " + Utilities::to_string_exact(nu) +
           " is too close to 0.5 for a compressible model: its elements "
-          "lock, and the force is the locking's (0.4999999 rendered 3,817 N "
-          "for a push that gives 1.6 N at 0.49)",
+          "lock, and the force is the locking's, not the tissue's (on "
+          "liver-stvk.prm's 1 cm push nu = 0.49 renders 3.4 N, 0.4999 "
+          "already 26 N, 0.4999999 thousands)",
         "use nu <= 0.4999 (0.49 is the paper's value), or Mooney-Rivlin, "
         "whose mixed formulation keeps the volume without locking.");
     // Near -1 the shear modulus E/(2(1+nu)) dwarfs the bulk modulus by
@@ -437,6 +438,23 @@ namespace palpate
   NeoHookean::create(const dealii::ParameterHandler &prm)
   {
     const auto [E, nu] = parse_young_poisson(prm);
+    // W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2: with nu < 0 lambda
+    // is negative, and the last term, quadratic in ln J, outgrows the
+    // others as an element is crushed (J -> 0): the energy falls without
+    // bound and a deep enough push has no equilibrium. On liver-stvk.prm's
+    // 1 cm push nu = -0.6 still converged, -0.7 to -0.9 were failure
+    // points (the tenth re-run; St.Venant-Kirchhoff solves at -0.9).
+    if (nu < 0)
+      throw Plugins::EntryError(
+        "Poisson's ratio",
+        "nu = " + Utilities::to_string_exact(nu) +
+          " < 0 makes lambda negative, and this Neo-Hookean energy (mu/2 "
+          "(I1 - 3) - mu ln J + lambda/2 (ln J)^2) then falls without bound "
+          "as an element is crushed: pushed deep enough, there is no "
+          "equilibrium (on the shipped liver's 1 cm push nu <= -0.7 were "
+          "failure points)",
+        "use 0 <= nu <= 0.4999 (soft tissue has nu close to 0.5), or "
+        "St.Venant-Kirchhoff for an auxetic (nu < 0) material.");
     return std::make_unique<NeoHookean>(E, nu);
   }
 

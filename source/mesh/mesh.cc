@@ -906,9 +906,8 @@ namespace palpate
     void
     check_memory(const Scene &scene, const Mesh &mesh)
     {
-      const unsigned int degree =
-        scene.parameters.discretization.polynomial_degree;
-      const double nodes     = mesh.n_vertices();
+      const unsigned int degree = scene.displacement_degree();
+      const double       nodes  = mesh.n_vertices();
       const double dof_nodes = degree >= 2 ? 2 * nodes + mesh.n_cells() : nodes;
       const double unknowns  = 3 * dof_nodes;
       const double bytes     = 170e6 + 500 * std::pow(unknowns, 4.0 / 3.0);

@@ -1307,6 +1307,17 @@ namespace palpate
 
 
 
+  unsigned int
+  Scene::displacement_degree() const
+  {
+    const unsigned int fixed = Material::create(parameters.material_model)
+                                 ->formulation()
+                                 .displacement_degree;
+    return fixed > 0 ? fixed : parameters.discretization.polynomial_degree;
+  }
+
+
+
   void
   Scene::check_material() const
   {

@@ -705,6 +705,12 @@ main(int argc, char **argv)
         beam + "subsection Material model\n  set Model name = Neo-Hookean\n"
                "  subsection Neo-Hookean\n"
                "    set Poisson's ratio = -0.9999999\n  end\nend\n");
+  // The tenth re-run: -0.9 to -0.7 passed that bound and Newton failed.
+  scene("Neo-Hookean nu = -0.8 (failure points: no energy minimum)",
+        "nu-neo-hookean-negative.prm",
+        beam + "subsection Material model\n  set Model name = Neo-Hookean\n"
+               "  subsection Neo-Hookean\n"
+               "    set Poisson's ratio = -0.8\n  end\nend\n");
   write_file("one-line.csv", "t, x, y, z\n0, 0, 0, 0\n");
   scene("a replay recording of one line (no motion, 0 N)",
         "replay-one-line.prm",

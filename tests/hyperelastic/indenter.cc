@@ -260,4 +260,46 @@ main(int argc, char **argv)
             << ok(suggested(refused) > 0 && refusal(liver).empty())
             << std::endl;
   }
+  // Between the two: 4 - 5.5 mm passed both checks on the graded liver,
+  // and its 1 cm push was then a failure point (the tenth re-run). Pushed
+  // deeper than its radius a sphere must clear them by the margin; pushed
+  // less deep (4 mm) the same sphere is accepted.
+  {
+    palpate::Scene liver = shipped_scene("liver-indenter.prm");
+    liver.parameters.boundary_conditions.active_node.tip_radius = 0.005;
+    const std::string refused = refusal(liver);
+    deallog << "a 5 mm sphere pushed 1 cm into the graded liver: refused "
+            << ok(refused.find("pushed deeper than its radius") !=
+                  std::string::npos);
+    liver.parameters.boundary_conditions.active_node.tip_radius =
+      suggested(refused);
+    deallog << ", the radius it names is accepted: "
+            << ok(suggested(refused) > 0 && refusal(liver).empty());
+    liver.parameters.boundary_conditions.active_node.tip_radius = 0.005;
+    liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
+      {0, 0, -0.004}};
+    deallog << "; pushed 4 mm: accepted " << ok(refusal(liver).empty())
+            << std::endl;
+  }
+  // Taylor-Hood has quadratic displacements whatever Polynomial degree
+  // says: its edge midpoints are contact nodes, and the refusal must not
+  // advise "Polynomial degree = 2" (the tenth re-run).
+  {
+    palpate::Scene liver = shipped_scene("liver-indenter.prm");
+    liver.parameters.material_model.models["Mooney-Rivlin"]["Element"] =
+      "Taylor-Hood";
+    liver.parameters.boundary_conditions.active_node.tip_radius = 0.002;
+    const std::string refused = refusal(liver);
+    deallog << "a 2 mm sphere on the graded liver with Taylor-Hood: refused "
+            << ok(!refused.empty()) << ", measured between contact nodes "
+            << ok(refused.find("between contact nodes") != std::string::npos ||
+                  refused.find("nearest is") != std::string::npos)
+            << ", no advice to raise the degree "
+            << ok(refused.find("Polynomial degree = 2") == std::string::npos);
+    liver.parameters.boundary_conditions.active_node.tip_radius =
+      suggested(refused);
+    deallog << ", the radius it names is accepted: "
+            << ok(suggested(refused) > 0 && refusal(liver).empty())
+            << std::endl;
+  }
 }

@@ -142,6 +142,16 @@ namespace palpate
     void
     validate() const;
 
+    /**
+     * The degree of the displacements: the one the material's element
+     * pair fixes (Taylor-Hood: 2, P1-P1: 1), else Discretization /
+     * Polynomial degree. It sizes the problem and makes the edge
+     * midpoints contact nodes (Polynomial degree alone said 1 for a
+     * Taylor-Hood scene, and the sphere's check measured P1 edges).
+     */
+    unsigned int
+    displacement_degree() const;
+
   private:
     /** Whether the scene file or the command line (--set) sets @p entry. */
     bool
