@@ -61,6 +61,25 @@ namespace palpate
           raise(signal);
         }
     }
+
+    /** A stop signal's name for messages ("" for none). */
+    std::string
+    describe(const int signal)
+    {
+      switch (signal)
+        {
+          case 0:
+            return "";
+          case SIGINT:
+            return "SIGINT (Ctrl-C)";
+          case SIGTERM:
+            return "SIGTERM";
+          case SIGHUP:
+            return "SIGHUP (the terminal closed)";
+          default:
+            return "signal " + std::to_string(signal);
+        }
+    }
   } // namespace
 
 
@@ -113,11 +132,7 @@ namespace palpate
 
 
   StoppedError::StoppedError(const std::string &what)
-    : std::runtime_error(what + " was stopped by " +
-                         (received.load() == SIGINT  ? "SIGINT (Ctrl-C)" :
-                          received.load() == SIGTERM ? "SIGTERM" :
-                          received.load() == SIGHUP  ? "SIGHUP" :
-                                                       "a stop signal") +
+    : std::runtime_error(what + " was stopped by " + describe(received.load()) +
                          "; nothing was written")
     , exit_status(128 + received.load())
   {}
@@ -135,19 +150,7 @@ namespace palpate
   std::string
   StopRequest::description() const
   {
-    switch (received.load())
-      {
-        case 0:
-          return "";
-        case SIGINT:
-          return "SIGINT (Ctrl-C)";
-        case SIGTERM:
-          return "SIGTERM";
-        case SIGHUP:
-          return "SIGHUP (the terminal closed)";
-        default:
-          return "signal " + std::to_string(received.load());
-      }
+    return describe(received.load());
   }
 
 
