@@ -35,6 +35,7 @@
 #include <memory>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <thread>
 
 namespace palpate
@@ -671,27 +672,30 @@ namespace palpate
       const double silent = seconds_since(last_from_client);
       if (silent <= (heard_from_client ? p.engine.server_timeout : 600.0))
         return false;
+      // One write for the whole message: two servers that end at once
+      // wrote theirs piece by piece through mpirun, and the pieces mixed
+      // (engine/mpi_client_loss counted one message of two).
+      std::ostringstream message;
       if (stalled_for >= 0.5 * silent)
         // This process stood still (SIGSTOP, a frozen machine): the client
         // is fine, and has declared this server lost meanwhile.
-        std::cerr << "\npalpate (solver server, MPI rank " << messenger.rank()
-                  << "): this server stood still for "
-                  << Utilities::to_string(stalled_for, 3)
-                  << " s (stopped with SIGSTOP, or frozen), longer than "
-                     "Engine / Server timeout: the client has declared it "
-                     "lost meanwhile, and it ends.\n"
-                  << std::flush;
+        message << "\npalpate (solver server, MPI rank " << messenger.rank()
+                << "): this server stood still for "
+                << Utilities::to_string(stalled_for, 3)
+                << " s (stopped with SIGSTOP, or frozen), longer than "
+                   "Engine / Server timeout: the client has declared it "
+                   "lost meanwhile, and it ends.\n";
       else
-        std::cerr << "\npalpate (solver server, MPI rank " << messenger.rank()
-                  << "): the client (rank " << client_rank
-                  << ") sent nothing for " << Utilities::to_string(silent, 3)
-                  << " s ("
-                  << (heard_from_client ?
-                        "Engine / Server timeout" :
-                        "since this server was ready; it has 600 s")
-                  << "): it is lost (killed, or cut off), and this server "
-                     "ends.\n"
-                  << std::flush;
+        message << "\npalpate (solver server, MPI rank " << messenger.rank()
+                << "): the client (rank " << client_rank
+                << ") sent nothing for " << Utilities::to_string(silent, 3)
+                << " s ("
+                << (heard_from_client ?
+                      "Engine / Server timeout" :
+                      "since this server was ready; it has 600 s")
+                << "): it is lost (killed, or cut off), and this server "
+                   "ends.\n";
+      std::cerr << message.str() << std::flush;
       Environment::peer_lost();
       return true;
     }

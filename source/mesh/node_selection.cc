@@ -442,6 +442,38 @@ namespace palpate
 
 
     /**
+     * The longest edge (between contact nodes: @p midpoints halve the
+     * edges) of the surface triangles with a vertex within @p reach of
+     * @p anchor.
+     */
+    double
+    longest_edge_near(const Mesh              &mesh,
+                      const Utilities::Point3 &anchor,
+                      const double             reach,
+                      const bool               midpoints)
+    {
+      const auto &x       = mesh.vertices();
+      double      longest = 0;
+      for (const auto &face : mesh.surface_faces())
+        {
+          bool near = false;
+          for (const unsigned int v : face.vertices)
+            near = near || Utilities::distance(x[v], anchor) <= reach;
+          if (!near)
+            continue;
+          for (unsigned int i = 0; i < 3; ++i)
+            longest =
+              std::max(longest,
+                       Utilities::distance(x[face.vertices[i]],
+                                           x[face.vertices[(i + 1) % 3]]) /
+                         (midpoints ? 2 : 1));
+        }
+      return longest;
+    }
+
+
+
+    /**
      * Place the sphere (Tip = sphere), and check that it is large enough
      * to meet a node.
      */
@@ -487,32 +519,14 @@ namespace palpate
       // then every grid point beside rest was a failure point: 0 N for the
       // whole run, exit 0 (the sixth re-run). The triangles within two
       // radii of the anchor; with P2 the midpoints halve the edges.
-      const auto       &x = mesh.vertices();
       const double      R = a.tip_radius;
       const auto       &n = selection.active_normal;
       Utilities::Point3 anchor;
       for (unsigned int d = 0; d < 3; ++d)
         anchor[d] =
           selection.sphere_center[d] - (R + selection.sphere_lift) * n[d];
-      // The longest edge (between contact nodes) of the triangles within
-      // @p reach of the anchor.
       const auto longest_within = [&](const double reach) {
-        double longest = 0;
-        for (const auto &face : mesh.surface_faces())
-          {
-            bool near = false;
-            for (const unsigned int v : face.vertices)
-              near = near || Utilities::distance(x[v], anchor) <= reach;
-            if (!near)
-              continue;
-            for (unsigned int i = 0; i < 3; ++i)
-              longest =
-                std::max(longest,
-                         Utilities::distance(x[face.vertices[i]],
-                                             x[face.vertices[(i + 1) % 3]]) /
-                           (midpoints ? 2 : 1));
-          }
-        return longest;
+        return longest_edge_near(mesh, anchor, reach, midpoints);
       };
       // Both checks are what a sphere needs to meet nodes at all. Pushed
       // in deeper than its radius, a sphere that just passes them still
