@@ -789,10 +789,17 @@ namespace palpate
           consider(std::pow(10.0, k));
         }
       // A file in no unit (the SOFA liver): any factor, to three digits.
+      // (A power of ten up to 1e22 is exact, and so is dividing the
+      // rounded digits by it: the double a user gets by typing the three
+      // digits.)
+      const auto three_digits = [](const double v) {
+        const int e = static_cast<int>(std::floor(std::log10(v))) - 2;
+        return e < 0 ? std::round(v * std::pow(10.0, -e)) / std::pow(10.0, -e) :
+                       std::round(v / std::pow(10.0, e)) * std::pow(10.0, e);
+      };
       if (best.fits < best.of)
         for (int k = -900; k <= 900; ++k)
-          consider(std::stod(
-            Utilities::to_string(factor * std::pow(10.0, k / 100.0), 3)));
+          consider(three_digits(factor * std::pow(10.0, k / 100.0)));
       return best;
     }
 
