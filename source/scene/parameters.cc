@@ -450,7 +450,13 @@ namespace palpate
           "0",
           Patterns::Double(0.),
           "Radius (m) of the glued tip (Tip = glued nodes) or of the "
-          "sphere (Tip = sphere). Must be 0 for Tip = point.");
+          "sphere (Tip = sphere). Must be 0 for Tip = point. The contact "
+          "acts at nodes, so a sphere's radius must be at least twice the "
+          "distance to the nearest surface node and two thirds of the "
+          "longest surface edge within two radii (with quadratic elements "
+          "the edge midpoints count), both by a margin of 1.7 (and on the "
+          "vertices) when Prescribed displacement is longer than the "
+          "radius; a refusal names the radius that passes.");
       }
       prm.leave_subsection();
     }
