@@ -237,9 +237,10 @@ namespace
     return m;
   }
 
-  /** The stroke's grid (--spacing, --hermite): 0 and false keep the
-   * scene's (trilinear, 5 mm). What accuracy costs in time: a coarser
-   * Hermite grid needs fewer states per millimetre of stroke. */
+  /** The stroke's grid (--spacing, --hermite): 0 keeps the scene's 5 mm,
+   * false is trilinear interpolation (the rounds' stroke). What accuracy costs
+   * in time: a coarser Hermite grid needs fewer states per millimetre of
+   * stroke. */
   struct StrokeGrid
   {
     double spacing = 0; // m
@@ -256,8 +257,10 @@ namespace
     auto &p     = scene.parameters;
     if (stroke_grid.spacing > 0)
       p.state_space.grid_spacing = stroke_grid.spacing;
-    if (stroke_grid.hermite)
-      p.state_space.interpolation = "tricubic Hermite";
+    // Named in the RESULT line, so set either way (the scene's own is
+    // Hermite since 2026-11-27).
+    p.state_space.interpolation =
+      stroke_grid.hermite ? "tricubic Hermite" : "trilinear";
     p.nonlinear_solver.max_increment_length = p.state_space.grid_spacing;
     // The accuracy study's residual tolerance (part 1's last lever).
     p.nonlinear_solver.residual_tolerance = 1e-3;
