@@ -190,6 +190,43 @@ namespace palpate
     }
 
     /**
+     * A static solve's push longer than the body is across is a typing
+     * mistake (mm for m), not a failure point after 1000 increments:
+     * refused before anything is set up (the sphere's check would
+     * otherwise blame the radius). @p from_command_line: given by --to.
+     */
+    void
+    check_push_length(const Scene             &scene,
+                      const Mesh              &mesh,
+                      const Utilities::Point3 &push,
+                      const bool               from_command_line)
+    {
+      // (hypot: a push of 1e300 m is said to be that, not 'inf').
+      const double length = std::hypot(push[0], push[1], push[2]);
+      if (!(length > mesh.diameter()))
+        return;
+      const std::string size = Utilities::to_string(mesh.diameter(), 3);
+      const std::string what = "the probe would move " +
+                               Utilities::to_string(length, 3) +
+                               " m, more than the body is across (" + size +
+                               " m, its bounding box's diagonal)";
+      if (from_command_line)
+        throw InputError("command line",
+                         0,
+                         "--to " + Utilities::to_string(push, 6),
+                         what,
+                         "give the displacement in metres, e.g. --to "
+                         "0,0,-0.01 for 1 cm down.");
+      throw scene.error("Boundary conditions/Active node/Prescribed "
+                        "displacement",
+                        what,
+                        "give the displacement in metres, e.g. 0, 0, "
+                        "-0.01 for 1 cm down.");
+    }
+
+
+
+    /**
      * Set up a scene (read it, build the mesh, select the nodes), report
      * it, and do what its Run / Mode says: an interaction, a static solve
      * for the active node's prescribed displacement, or nothing more.
@@ -203,10 +240,24 @@ namespace palpate
               const bool                       solve,
               std::ostream                    &out)
     {
-      const Scene         scene = Scene::read(filename, settings);
-      const Mesh          mesh  = Mesh::create(scene);
+      Scene scene = Scene::read(filename, settings);
+      // The push as the scene has it (before --to replaces it below).
+      const Utilities::Point3 prescribed =
+        scene.parameters.boundary_conditions.active_node
+          .prescribed_displacement;
+      // `solve --to` is the push: the sphere's check (NodeSelection) weighs
+      // its depth against the radius, as it does the scene's push.
+      if (solve && target)
+        scene.parameters.boundary_conditions.active_node
+          .prescribed_displacement = *target;
+      const Mesh  mesh = Mesh::create(scene);
+      const auto &mode = scene.parameters.run.mode;
+      if (solve || (mode != "set-up only" && mode != "interaction"))
+        check_push_length(scene,
+                          mesh,
+                          target ? *target : prescribed,
+                          target.has_value());
       const NodeSelection nodes = NodeSelection::create(scene, mesh);
-      const auto         &mode  = scene.parameters.run.mode;
       // Under mpirun the other ranks got this far too; with the MPI
       // engine they now wait as solver servers, and are released whatever
       // happens here (the engine releases them itself when it ends).
@@ -254,8 +305,6 @@ namespace palpate
                     << ". Exit status " << ExitStatus::server_lost << ".\n";
           return ExitStatus::server_lost;
         }
-      const auto &prescribed = scene.parameters.boundary_conditions.active_node
-                                 .prescribed_displacement;
       if (!target && Utilities::norm(prescribed) > 0)
         target = prescribed;
       if (!target)
@@ -263,32 +312,6 @@ namespace palpate
           out << "\nThe active node's prescribed displacement is zero: nothing "
                  "to solve.\n";
           return ExitStatus::success;
-        }
-      // A push longer than the body is across is a typing mistake (mm for
-      // m), not a failure point after 1000 increments.
-      // (hypot: a push of 1e300 m is said to be that, not 'inf').
-      const double length =
-        std::hypot((*target)[0], (*target)[1], (*target)[2]);
-      if (length > mesh.diameter())
-        {
-          const std::string size = Utilities::to_string(mesh.diameter(), 3);
-          const std::string push = Utilities::to_string(length, 3);
-          if (target != prescribed)
-            throw InputError("command line",
-                             0,
-                             "--to " + Utilities::to_string(*target, 6),
-                             "the probe would move " + push +
-                               " m, more than the body is across (" + size +
-                               " m, its bounding box's diagonal)",
-                             "give the displacement in metres, e.g. --to "
-                             "0,0,-0.01 for 1 cm down.");
-          throw scene.error("Boundary conditions/Active node/Prescribed "
-                            "displacement",
-                            "the probe would move " + push +
-                              " m, more than the body is across (" + size +
-                              " m, its bounding box's diagonal)",
-                            "give the displacement in metres, e.g. 0, 0, "
-                            "-0.01 for 1 cm down.");
         }
       out << "\n";
       const int status = run_static_solve(out, scene, mesh, nodes, *target);

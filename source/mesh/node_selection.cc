@@ -574,7 +574,8 @@ namespace palpate
       std::string problem;
       if (only_deep)
         problem =
-          "is pushed deeper than its radius (Prescribed displacement, " +
+          "is pushed deeper than its radius (Prescribed displacement or "
+          "solve's --to, " +
           Utilities::to_string(depth, 3) +
           " m) and clears the surface's node spacing where it "
           "touches (the nearest node " +
@@ -611,8 +612,8 @@ namespace palpate
           "than its radius), or a mesh finer "
           "near the probe (Mesh / Source = surface with Refinement size "
           "about a third of the radius)" +
-          (only_deep ? ", or a Prescribed displacement no longer than the "
-                       "radius" :
+          (only_deep ? ", or a push (Prescribed displacement, --to) no "
+                       "longer than the radius" :
                        "") +
           (scene.displacement_degree() == 2 || deep ?
              std::string(".") :

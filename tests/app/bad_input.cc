@@ -807,6 +807,13 @@ main(int argc, char **argv)
         "/parameters/liver-stvk.prm' --set 'Boundary conditions/Active "
         "node/Tip=sphere' --set 'Boundary conditions/Active node/Tip "
         "radius=0.01' --to 0,0,-0.01");
+  // The eleventh re-run: the depth check weighed the scene's push, not
+  // solve's --to (a 5 mm sphere pushed 2 cm was accepted, then failed).
+  run("a 5 mm sphere on the graded liver, pushed 2 cm by solve --to",
+      "solve '" + palpate_source_dir +
+        "/parameters/liver-indenter.prm' --set 'Boundary conditions/Active "
+        "node/Tip radius=0.005' --set 'Boundary conditions/Active "
+        "node/Prescribed displacement=0,0,-0.004' --to 0,0,-0.02");
   std::filesystem::remove("loop-dir");
   std::filesystem::create_symlink("loop-dir", "loop-dir");
   run("solve writing its VTU into a loop of links",
