@@ -82,6 +82,28 @@ namespace palpate
 
 
 
+  std::unique_ptr<Epetra_CrsMatrix>
+  epetra_matrix(const SparsityCSR &pattern, const Epetra_Map &map)
+  {
+    std::vector<int> per_row(pattern.n_rows);
+    for (unsigned int i = 0; i < pattern.n_rows; ++i)
+      per_row[i] = pattern.row_start[i + 1] - pattern.row_start[i];
+    auto matrix =
+      std::make_unique<Epetra_CrsMatrix>(Copy, map, map, per_row.data(), true);
+    for (unsigned int i = 0; i < pattern.n_rows; ++i)
+      {
+        std::vector<int>    cols(pattern.column.begin() + pattern.row_start[i],
+                              pattern.column.begin() +
+                                pattern.row_start[i + 1]);
+        std::vector<double> zeros(cols.size(), 0.0);
+        matrix->InsertMyValues(i, cols.size(), zeros.data(), cols.data());
+      }
+    matrix->FillComplete();
+    return matrix;
+  }
+
+
+
   namespace
   {
     template <typename Real>
@@ -669,24 +691,10 @@ namespace palpate
           const auto lock = mumps_guard();
           solver.reset();
         }
-        map = std::make_unique<Epetra_Map>(static_cast<int>(pattern.n_rows),
+        map     = std::make_unique<Epetra_Map>(static_cast<int>(pattern.n_rows),
                                            0,
                                            comm);
-        std::vector<int> per_row(pattern.n_rows);
-        for (unsigned int i = 0; i < pattern.n_rows; ++i)
-          per_row[i] = pattern.row_start[i + 1] - pattern.row_start[i];
-        // Column map = row map, so local column indices are ours.
-        matrix = std::make_unique<Epetra_CrsMatrix>(
-          Copy, *map, *map, per_row.data(), true);
-        for (unsigned int i = 0; i < pattern.n_rows; ++i)
-          {
-            std::vector<int> cols(pattern.column.begin() + pattern.row_start[i],
-                                  pattern.column.begin() +
-                                    pattern.row_start[i + 1]);
-            std::vector<double> zeros(cols.size(), 0.0);
-            matrix->InsertMyValues(i, cols.size(), zeros.data(), cols.data());
-          }
-        matrix->FillComplete();
+        matrix  = epetra_matrix(pattern, *map);
         x       = std::make_unique<Epetra_Vector>(*map);
         b       = std::make_unique<Epetra_Vector>(*map);
         problem = std::make_unique<Epetra_LinearProblem>(matrix.get(),

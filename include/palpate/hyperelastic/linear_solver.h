@@ -10,6 +10,9 @@
 #include <string>
 #include <vector>
 
+class Epetra_CrsMatrix;
+class Epetra_Map;
+
 namespace palpate
 {
   namespace Parameters
@@ -138,6 +141,16 @@ namespace palpate
    */
   using LinearSolverRegistry =
     Plugins::Registry<LinearSolver, Parameters::LinearSolver>;
+
+  /**
+   * For solvers built on Trilinos (Amesos; the benchmarks' multigrid): an
+   * Epetra matrix on @p map holding @p pattern's entries, all zero, filled
+   * complete. Its column map is its row map, so the local column indices
+   * are the pattern's, and a value array in the pattern's order is copied
+   * in row by row.
+   */
+  std::unique_ptr<Epetra_CrsMatrix>
+  epetra_matrix(const SparsityCSR &pattern, const Epetra_Map &map);
   extern template class Plugins::Registry<LinearSolver,
                                           Parameters::LinearSolver>;
 
