@@ -74,7 +74,7 @@ namespace palpate
         "nu = -1 makes the shear modulus E/(2(1+nu)) infinite",
         "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
     // Linear and quadratic displacement elements lock as nu nears 0.5:
-    // on liver-stvk.prm's 1 cm push (solve) 0.49 renders 3.43 N, 0.4999
+    // on liver-stvk.prm's 3 cm push (solve) 0.49 renders 3.43 N, 0.4999
     // 26.3 N; 0.4999999 rendered 3,817 N with exit 0 in an interaction
     // (the ninth re-run): the force is then the locking's, not the
     // tissue's.
@@ -84,7 +84,7 @@ namespace palpate
         "nu = " + Utilities::to_string_exact(nu) +
           " is too close to 0.5 for a compressible model: its elements "
           "lock, and the force is the locking's, not the tissue's (on "
-          "liver-stvk.prm's 1 cm push nu = 0.49 renders 3.4 N, 0.4999 "
+          "liver-stvk.prm's 3 cm push nu = 0.49 renders 3.4 N, 0.4999 "
           "already 26 N, 0.4999999 thousands)",
         "use nu <= 0.4999 (0.49 is the paper's value), or Mooney-Rivlin, "
         "whose mixed formulation keeps the volume without locking.");
@@ -442,7 +442,7 @@ namespace palpate
     // is negative, and the last term, quadratic in ln J, outgrows the
     // others as an element is crushed (J -> 0): the energy falls without
     // bound and a deep enough push has no equilibrium. On liver-stvk.prm's
-    // 1 cm push nu = -0.6 still converged, -0.7 to -0.9 were failure
+    // 3 cm push nu = -0.6 still converged, -0.7 to -0.9 were failure
     // points (the tenth re-run; St.Venant-Kirchhoff solves at -0.9).
     if (nu < 0)
       throw Plugins::EntryError(
@@ -451,7 +451,7 @@ namespace palpate
           " < 0 makes lambda negative, and this Neo-Hookean energy (mu/2 "
           "(I1 - 3) - mu ln J + lambda/2 (ln J)^2) then falls without bound "
           "as an element is crushed: pushed deep enough, there is no "
-          "equilibrium (on the shipped liver's 1 cm push nu <= -0.7 were "
+          "equilibrium (on liver-stvk.prm's 3 cm push nu <= -0.7 were "
           "failure points)",
         "use 0 <= nu <= 0.4999 (soft tissue has nu close to 0.5), or "
         "St.Venant-Kirchhoff for an auxetic (nu < 0) material.");

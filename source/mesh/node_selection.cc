@@ -529,17 +529,12 @@ namespace palpate
         return longest_edge_near(mesh, anchor, reach, midpoints);
       };
       // Both checks are what a sphere needs to meet nodes at all. Pushed
-      // in deeper than its radius, a sphere that just passes them still
-      // slipped between the nodes (the ninth and tenth re-runs): on the
-      // graded liver of liver-indenter.prm (a 1 cm push) 3.6 mm passed
-      // both, 4 - 5.5 mm were failure points and 6 mm converged; on
-      // liver-stvk.prm with P2 (a 3 cm push) 7.1 mm passed, 8.5 mm failed
-      // and 10 mm converged. So a scene that pushes the sphere deeper
-      // than its radius (Prescribed displacement) must clear both by this
-      // margin; a shallower push needs only the checks (a 1 cm sphere
-      // pressed 2 mm into the beam's flat face, between 14 mm edges,
-      // renders Hertz's force). The radius a refusal suggests always
-      // clears them by the margin, so that it holds deep pushes too.
+      // deeper than its radius, one that just passes them still slipped
+      // between the nodes (ninth and tenth re-runs; graded liver, 1 cm: 3.6
+      // mm passed, 4 - 5.5 mm failed, 6 mm converged; liver-stvk P2, 3 cm:
+      // 7.1 passed, 8.5 failed, 10 converged): such a push needs this
+      // margin, a shallower one only the checks (a 1 cm sphere pressed 2 mm
+      // between the beam's 14 mm edges renders Hertz's force).
       constexpr double margin   = 1.7;
       const double     required = deep ? margin : 1.0;
       // The radius to suggest: the smallest, up to the next 0.1 mm, that
@@ -549,9 +544,11 @@ namespace palpate
       // printed 0.00347 for 0.003468 and refused it again (the eighth).
       const auto passing_radius = [&]() {
         const auto needed_for = [&](const double r) {
-          return std::ceil(margin *
-                           std::max(2 * hole, longest_within(2 * r) / 1.5) *
-                           1e4) /
+          return std::ceil(
+                   std::max(margin *
+                              std::max(2 * hole, longest_within(2 * r) / 1.5),
+                            depth / 2) *
+                   1e4) /
                  1e4;
         };
         double needed = needed_for(R);
@@ -564,15 +561,40 @@ namespace palpate
           }
         return needed;
       };
-      const double longest = longest_within(2 * R);
-      if (R >= required * 2 * hole && required * longest <= 1.5 * R)
+      // And at most a diameter deep: 6.1 mm (suggested for the graded
+      // liver's 1 cm push) failed at 1.5 - 5 cm, 8 mm held 1.5 cm and 10 mm
+      // 2 cm (the eleventh re-run): the tissue closes over the sphere.
+      const bool   engulfed = depth > 2 * R;
+      const double longest  = longest_within(2 * R);
+      if (!engulfed && R >= required * 2 * hole &&
+          required * longest <= 1.5 * R)
         return;
 
-      // Whether only the depth makes it fail: then a shallower push is a
-      // way out too.
+      // Only the depth fails: a shallower push is a way out too.
       const bool  only_deep = R >= 2 * hole && longest <= 1.5 * R;
       std::string problem;
-      if (only_deep)
+      if (R < 2 * hole)
+        problem = "is too small for the gaps between the surface nodes where "
+                  "it touches (the nearest is " +
+                  Utilities::to_string(hole, 3) +
+                  " m away across the surface): the contact acts at nodes, "
+                  "so pushed in, the sphere passes between them and renders "
+                  "no force";
+      else if (!only_deep)
+        problem = "is smaller than the surface triangles around where it "
+                  "touches (edges up to " +
+                  Utilities::to_string(longest, 3) + " m" +
+                  (midpoints ? " between contact nodes" : "") +
+                  "): moved along the surface it sinks between the nodes, "
+                  "those states are failure points, and the haptic loop "
+                  "renders no force there";
+      else if (engulfed)
+        problem = "is pushed " + Utilities::to_string(depth, 3) +
+                  " m deep (Prescribed displacement or solve's --to), more "
+                  "than its diameter: the tissue closes over the sphere, "
+                  "its nodes pass behind it and the state is a failure "
+                  "point (\"sphere through the surface\")";
+      else
         problem =
           "is pushed deeper than its radius (Prescribed displacement or "
           "solve's --to, " +
@@ -585,36 +607,25 @@ namespace palpate
           Utilities::to_string(margin, 2) +
           " times: pushed that deep, such a sphere slips between "
           "the nodes and the state is a failure point";
-      else if (R < 2 * hole)
-        problem = "is too small for the gaps between the surface nodes where "
-                  "it touches (the nearest is " +
-                  Utilities::to_string(hole, 3) +
-                  " m away across the surface): the contact acts at nodes, "
-                  "so pushed in, the sphere passes between them and renders "
-                  "no force";
-      else
-        problem = "is smaller than the surface triangles around where it "
-                  "touches (edges up to " +
-                  Utilities::to_string(longest, 3) + " m" +
-                  (midpoints ? " between contact nodes" : "") +
-                  "): moved along the surface it sinks between the nodes, "
-                  "those states are failure points, and the haptic loop "
-                  "renders no force there";
       throw scene.error(
         "Boundary conditions/Active node/Tip radius",
         "a sphere of " + Utilities::to_string(R, 3) + " m radius " + problem,
         "use a radius of at least " +
-          Utilities::to_string(passing_radius(), 6) + " m (" +
+          Utilities::to_string(passing_radius(), 6) +
+          " m (the larger of half the push and " +
           Utilities::to_string(margin, 2) +
           " times the larger of twice the nearest node's distance and two "
           "thirds of the longest edge within two radii: a sphere that just "
           "clears them still slips between the nodes when pushed deeper "
-          "than its radius), or a mesh finer "
+          "than its radius, and one pushed deeper than its diameter goes "
+          "through the surface), or a mesh finer "
           "near the probe (Mesh / Source = surface with Refinement size "
           "about a third of the radius)" +
-          (only_deep ? ", or a push (Prescribed displacement, --to) no "
-                       "longer than the radius" :
-                       "") +
+          (!only_deep ? "" :
+           engulfed   ? ", or a push (Prescribed displacement, --to) no "
+                        "longer than the sphere's diameter" :
+                        ", or a push (Prescribed displacement, --to) no "
+                        "longer than the radius") +
           (scene.displacement_degree() == 2 || deep ?
              std::string(".") :
              std::string(", or Polynomial degree = 2 (the edge "
