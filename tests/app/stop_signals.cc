@@ -147,12 +147,23 @@ main()
     const pid_t pid     = start_palpate(interaction, out, err);
     const bool  started = wait_for_text(out, "; motion starts");
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    const auto first = std::chrono::steady_clock::now();
     kill(pid, SIGTERM);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     kill(pid, SIGTERM);
+    // Under CI's load (a browser test beside it) the 5 ms sleep once took
+    // longer than the 0.5 s that make two signals one stop: the second was
+    // then a second Ctrl-C, as documented, and ended the process after it
+    // had written everything. What this case checks holds only when the
+    // two came within that time.
+    const double gap =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - first)
+        .count();
     const int status = wait_status(pid);
     deallog << "SIGTERM twice within 5 ms: motion started " << ok(started)
-            << ", exit status 143 " << ok(status == 143) << ", summary printed "
+            << ", exit status 143 "
+            << ok(status == 143 || (gap >= 0.45 && status == 1000 + SIGTERM))
+            << ", summary printed "
             << ok(read_file(out).find("Run summary") != std::string::npos)
             << ", force log and JSON written "
             << ok(force_log(dir + "/paper-stvk-forces.csv").second > 500 &&
