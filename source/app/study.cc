@@ -854,8 +854,32 @@ namespace palpate
                                "make it (mkdir -p '" + parent.string() +
                                  "') or name a file in one that exists.");
             // Said before anything runs, not at the first knob's end.
-            std::error_code error;
-            if (std::filesystem::is_directory(result.csv_file, error))
+            std::error_code                    error;
+            const std::filesystem::file_status status =
+              std::filesystem::status(result.csv_file, error);
+            if (error && status.type() != std::filesystem::file_type::not_found)
+              throw InputError("command line",
+                               0,
+                               "--csv " + result.csv_file,
+                               "the file system refuses the path (" +
+                                 error.message() + ")",
+                               "check the links on the way (a loop of "
+                               "symbolic links?) and the permissions, or "
+                               "name another file.");
+            // A device or a pipe (/dev/zero, a FIFO) is no table: the
+            // Pareto plot would read it without end.
+            if (std::filesystem::exists(status) &&
+                !std::filesystem::is_directory(status) &&
+                !std::filesystem::is_regular_file(status))
+              throw InputError("command line",
+                               0,
+                               "--csv " + result.csv_file,
+                               "'" + result.csv_file +
+                                 "' is a device, a pipe or a socket, not a "
+                                 "file: the study writes its table there "
+                                 "and the Pareto plot reads it back",
+                               "name a regular file, e.g. --csv study.csv.");
+            if (std::filesystem::is_directory(status))
               throw InputError(
                 "command line",
                 0,
@@ -1464,7 +1488,12 @@ namespace palpate
 
         // --- The Pareto plot, by the plotting script of the source tree
         // (matplotlib), next to the CSV.
-        if (options.plot)
+        // After a stop signal the user wants the run to end: no plot.
+        if (options.plot &&
+            (result.stop_signal != 0 || stop->signal_number() != 0))
+          out << "No Pareto plot: the study was stopped (plot the CSV with "
+                 "doc/images/accuracy_pareto.py).\n";
+        else if (options.plot)
           {
             const std::filesystem::path script =
               std::filesystem::path(PALPATE_SOURCE_DIR) / "doc" / "images" /
@@ -1474,8 +1503,12 @@ namespace palpate
             const std::string command = "/usr/bin/python3 '" + script.string() +
                                         "' '" + result.csv_file + "' '" +
                                         png.string() + "'";
+            // A time limit: a plot that hangs (a stalled display back end,
+            // a file on a dead mount) must not keep the study from ending.
             if (std::filesystem::exists(script) &&
-                std::system((command + " > /dev/null 2>&1").c_str()) == 0)
+                std::system(
+                  ("timeout 120 " + command + " < /dev/null > /dev/null 2>&1")
+                    .c_str()) == 0)
               {
                 result.plot_file = png.string();
                 out << "The Pareto plot (force error against speed): "

@@ -3,6 +3,11 @@
 
 #include <palpate/base/exceptions.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 
@@ -86,5 +91,27 @@ namespace palpate
                        "nodes than a few hundred thousand cannot be solved "
                        "at haptic rates: make a coarser mesh (palpate mesh "
                        "SURFACE OUT.msh --nodes 4000).");
+  }
+
+
+
+  std::string
+  why_cannot_open(const std::string &file, bool *missing)
+  {
+    // O_NONBLOCK: a named pipe must not wait here for a writer.
+    const int fd  = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    const int why = fd < 0 ? errno : 0;
+    if (fd >= 0)
+      ::close(fd);
+    const bool none = why == ENOENT || why == ENOTDIR;
+    if (missing != nullptr)
+      *missing = none;
+    if (fd >= 0)
+      return "";
+    return none                ? "it does not exist" :
+           why == EACCES       ? "it is not readable (permissions)" :
+           why == ELOOP        ? "it is a loop of symbolic links" :
+           why == ENAMETOOLONG ? "the path is longer than the system allows" :
+                                 std::strerror(why);
   }
 } // namespace palpate

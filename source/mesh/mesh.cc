@@ -162,21 +162,28 @@ namespace palpate
             throw scene.error("Mesh/File name", e.problem(), e.fix());
           }
         std::ifstream in(path, std::ios::binary);
-        // error_code: a name the file system refuses (too long, a loop of
-        // links) is a missing file, not an internal error.
-        std::error_code exists_error;
         if (!in)
-          throw scene.error(
-            "Mesh/File name",
-            fs::exists(path, exists_error) ?
-              "the surface file '" + path + "' cannot be read" :
+          {
+            // A name the file system refuses (a loop of links, too long,
+            // no permission) is said as such, not as a missing file.
+            bool              missing = false;
+            const std::string why     = why_cannot_open(path, &missing);
+            if (!missing && !why.empty())
+              throw scene.error("Mesh/File name",
+                                "the surface file '" + path +
+                                  "' cannot be read: " + why,
+                                "check the path, the links on the way and "
+                                "the permissions.");
+            throw scene.error(
+              "Mesh/File name",
               "the surface file '" + p.file_name +
                 "' was not found: looked for " +
                 scene.where_looked(p.file_name),
-            "a relative path is relative to the scene file's directory; "
-            "the example organs are in the project's meshes/ (its "
-            "README), e.g. '../meshes/liver-tetgen/liver2k-surface.obj' "
-            "from parameters/.");
+              "a relative path is relative to the scene file's directory; "
+              "the example organs are in the project's meshes/ (its "
+              "README), e.g. '../meshes/liver-tetgen/liver2k-surface.obj' "
+              "from parameters/.");
+          }
         std::ostringstream s;
         s << in.rdbuf();
         bytes = s.str();

@@ -143,13 +143,16 @@ namespace palpate
                       "5 MiB");
       std::ifstream in(filename, std::ios::binary);
       if (!in)
-        throw bad(filename,
-                  0,
-                  std::filesystem::exists(filename) ?
-                    "the file cannot be read (" +
-                      std::string(std::strerror(errno)) + ")" :
-                    "the file does not exist",
-                  "check the path and the permissions.");
+        {
+          const std::string why = why_cannot_open(filename);
+          throw bad(filename,
+                    0,
+                    "the file cannot be read: " +
+                      (why.empty() ? std::string("the system refused it") :
+                                     why),
+                    "check the path, the links on the way and the "
+                    "permissions.");
+        }
       std::ostringstream s;
       s << in.rdbuf();
       return s.str();

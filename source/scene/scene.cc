@@ -11,9 +11,6 @@
 #include <boost/property_tree/ptree.hpp>
 #include <boost/property_tree/xml_parser.hpp>
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -656,26 +653,14 @@ namespace palpate
     InputError
     cannot_open(const std::string &filename)
     {
-      // Why, as the file system says it: a missing file is not a loop of
-      // links, a name too long or a missing permission.
-      const int  fd   = ::open(filename.c_str(), O_RDONLY);
-      const int  why  = fd < 0 ? errno : 0;
-      const bool none = why == ENOENT || why == ENOTDIR;
-      if (fd >= 0)
-        ::close(fd);
+      bool              none = false;
+      const std::string why  = why_cannot_open(filename, &none);
       return InputError(
         filename.substr(0, 300),
         0,
         "(the scene file itself)",
         "the file cannot be opened: " +
-          std::string(none          ? "it does not exist" :
-                      why == EACCES ? "it is not readable (permissions)" :
-                      why == ELOOP  ? "it is a loop of symbolic links" :
-                      why == ENAMETOOLONG ?
-                                     "the path is longer than the system "
-                                     "allows" :
-                      why != 0 ? std::strerror(why) :
-                                 "it is not readable"),
+          (why.empty() ? std::string("it is not readable") : why),
         none ? "check the path; shipped scenes are in parameters/, e.g. "
                "'palpate parameters/default.prm'." :
                "name the scene's .prm file itself (check the links on "

@@ -547,6 +547,19 @@ main(int argc, char **argv)
         "store-loop.prm",
         interaction + beam_body +
           "subsection State space\n  set Store = loop\nend\n");
+  std::filesystem::remove("loop.obj");
+  std::filesystem::create_symlink("loop.obj", "loop.obj");
+  scene("a surface file that is a loop of links (Source = surface)",
+        "surface-loop.prm",
+        interaction + "subsection Mesh\n  set Source = surface\n"
+                      "  set File name = loop.obj\nend\n");
+  run("a surface file that is a loop of links (palpate mesh)",
+      "mesh loop.obj out.msh");
+  // The study's table is read back by its plot: a device would be read
+  // without end (the study hung after a stop).
+  run("a study CSV that is a device", "study good.prm --quick --csv /dev/zero");
+  run("a study CSV that is a loop of links",
+      "study good.prm --quick --csv loop");
   run("'solve' without a scene", "solve");
   run("'solve --to' with two numbers", "solve good.prm --to 0,0");
   run("an unexpected second argument", "good.prm other.prm");

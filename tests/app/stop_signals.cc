@@ -537,6 +537,10 @@ main()
             << ok(text.find("The study ended early: stopped by SIGINT") !=
                   std::string::npos)
             << ", rows printed = rows in the CSV " << ok(printed == in_csv)
+            << ", no plot drawn after the stop "
+            << ok(text.find("No Pareto plot: the study was stopped") !=
+                    std::string::npos ||
+                  printed == 0)
             << std::endl;
   }
 

@@ -106,6 +106,18 @@ namespace palpate
                   const std::string   &typical);
 
   /**
+   * Why @p file cannot be opened for reading, as the file system says it
+   * ("it does not exist", "it is a loop of symbolic links", "the path is
+   * longer than the system allows", "it is not readable (permissions)"),
+   * or an empty string if it can. @p missing, if given, is set when the
+   * file does not exist (so the caller can say where it looked). Every
+   * reader of a user's file reports a refused path through this, so a loop
+   * of links is never called a missing file.
+   */
+  std::string
+  why_cannot_open(const std::string &file, bool *missing = nullptr);
+
+  /**
    * A capability that a scene asks for but that this version of palpate
    * does not have yet. Reported like an InputError, but it is not the
    * user's fault, so the message says which capability and where it is
