@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -337,6 +338,43 @@ namespace palpate
                         "run 'palpate --help' for the usage.");
     }
 
+    /**
+     * Before a command reads its options (from args[@p first] on): each
+     * option that takes a value is given at most once, and has its value. @p values
+     * maps the options that take a value to an example ("--to 0,0,-0.02").
+     * Without this, "--to" at the end was an "unexpected argument" and a
+     * second "--port" silently won.
+     */
+    void
+    check_options(const std::vector<std::string>           &args,
+                  const unsigned int                        first,
+                  const std::map<std::string, std::string> &values)
+    {
+      std::set<std::string> seen;
+      for (unsigned int i = first; i < args.size(); ++i)
+        {
+          const auto value = values.find(args[i]);
+          if (value == values.end())
+            continue; // a flag, or what the command refuses itself
+          const std::string &option = args[i];
+          if (!seen.insert(option).second)
+            throw InputError("command line",
+                             0,
+                             option,
+                             "'" + option +
+                               "' is given twice: one of the two values "
+                               "would be used without a word",
+                             "give it once, e.g. " + value->second + ".");
+          if (i + 1 == args.size())
+            throw InputError("command line",
+                             0,
+                             option,
+                             "'" + option + "' needs a value after it",
+                             "e.g. " + value->second + ".");
+          ++i;
+        }
+    }
+
     /** Read the scene @p file, build its mesh and nodes, and print its
      * report: what precompute, serve and study show first. */
     Scene
@@ -392,6 +430,14 @@ namespace palpate
                          "'mesh' needs a surface file and an output file",
                          "run 'palpate mesh SURFACE.stl OUT.msh --scale "
                          "0.001' (for a surface in millimetres).");
+      check_options(args,
+                    3,
+                    {{"--nodes", "--nodes 1500"},
+                     {"--scale", "--scale 0.001"},
+                     {"--time-limit", "--time-limit 60"},
+                     {"--refine", "--refine -0.0936,0.1107,0.0994"},
+                     {"--fine-size", "--fine-size 0.003"},
+                     {"--fine-radius", "--fine-radius 0.02"}});
       double       scale = 1, time_limit = 60;
       unsigned int nodes = 1500;
       MeshGrading  grading;
@@ -498,6 +544,7 @@ namespace palpate
                          "solve",
                          "'solve' needs a scene file",
                          "run 'palpate solve SCENE.prm [--to X,Y,Z]'.");
+      check_options(args, 2, {{"--to", "--to 0,0,-0.02"}});
       std::optional<Utilities::Point3> target;
       for (unsigned int i = 2; i < args.size(); ++i)
         if (args[i] == "--to" && i + 1 < args.size())
@@ -539,6 +586,8 @@ namespace palpate
       // its engine: released however this ends, a bad option included.
       const auto release =
         release_servers_at_end(Scene::read(args[1], settings));
+      check_options(
+        args, 2, {{"--port", "--port 8080"}, {"--host", "--host 127.0.0.1"}});
       int         port = 8080;
       std::string host = "127.0.0.1";
       for (unsigned int i = 2; i < args.size(); ++i)
@@ -635,6 +684,7 @@ namespace palpate
       // its engine: released however this ends, a bad option included.
       const auto release =
         release_servers_at_end(Scene::read(args[1], settings));
+      check_options(args, 2, {{"--radius", "--radius 0.05"}});
       double radius = 0;
       for (unsigned int i = 2; i < args.size(); ++i)
         if (args[i] == "--radius" && i + 1 < args.size())
@@ -659,6 +709,13 @@ namespace palpate
                          "study",
                          "'study' needs a scene file",
                          "run 'palpate study SCENE.prm [--quick]'.");
+      check_options(args,
+                    2,
+                    {{"--finer-mesh", "--finer-mesh finer.msh"},
+                     {"--csv", "--csv study.csv"},
+                     {"--time-limit", "--time-limit 600"},
+                     {"--skip", "--skip element,mesh"},
+                     {"--samples", "--samples 240"}});
       StudyOptions options;
       for (unsigned int i = 2; i < args.size(); ++i)
         {

@@ -1219,12 +1219,9 @@ namespace palpate
               m.set(m.model_name, "Element", "Taylor-Hood");
             else
               p2.parameters.discretization.polynomial_degree = 2;
-            const std::string  low    = pair ? "P1-P1" : "P1";
-            const std::string  high   = pair ? "Taylor-Hood P2-P1" : "P2";
-            const unsigned int degree = f.displacement_degree > 0 ?
-                                          f.displacement_degree :
-                                          p0.discretization.polynomial_degree;
-            if (degree == 1)
+            const std::string low  = pair ? "P1-P1" : "P1";
+            const std::string high = pair ? "Taylor-Hood P2-P1" : "P2";
+            if (f.degree(p0.discretization.polynomial_degree) == 1)
               discretisation("element", {scene, p2}, {low, high}, {1, p2_cost});
           }
       }

@@ -240,9 +240,7 @@ namespace palpate
                       0.0)
     , stabilize(mixed && !taylor_hood && formulation.stabilization)
     , alpha(formulation.stabilization_factor)
-    , degree(formulation.displacement_degree > 0 ?
-               formulation.displacement_degree :
-               p.discretization.polynomial_degree)
+    , degree(formulation.degree(p.discretization.polynomial_degree))
     , fe(make_fe(degree, mixed))
     , mapping(FE_SimplexP<3>(1))
     , quadrature(p.discretization.quadrature_order > 0 ?

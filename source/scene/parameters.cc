@@ -422,8 +422,10 @@ namespace palpate
           "0, 0, 0",
           point_pattern(),
           "Displacement of the active node from its rest position for a "
-          "static solve (`palpate solve`, or `palpate scene.prm` when it is "
-          "non-zero), in metres; `palpate solve --to x,y,z` overrides it.");
+          "static solve (`palpate solve`, or `palpate scene.prm` with Run / "
+          "Mode = static solve), in metres; `palpate solve --to x,y,z` "
+          "overrides it. An interaction does not use it (the device moves "
+          "the probe), but a sphere's size is checked against it.");
         prm.declare_entry(
           "Tip",
           "point",

@@ -1295,10 +1295,9 @@ namespace palpate
   unsigned int
   Scene::displacement_degree() const
   {
-    const unsigned int fixed = Material::create(parameters.material_model)
-                                 ->formulation()
-                                 .displacement_degree;
-    return fixed > 0 ? fixed : parameters.discretization.polynomial_degree;
+    return Material::create(parameters.material_model)
+      ->formulation()
+      .degree(parameters.discretization.polynomial_degree);
   }
 
 

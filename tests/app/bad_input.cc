@@ -562,6 +562,10 @@ main(int argc, char **argv)
       "study good.prm --quick --csv loop");
   run("'solve' without a scene", "solve");
   run("'solve --to' with two numbers", "solve good.prm --to 0,0");
+  run("'solve --to' without its value", "solve good.prm --to");
+  run("'solve --to' given twice",
+      "solve good.prm --to 0,0,-0.01 --to 0,0,-0.02");
+  run("'serve --port' given twice", "serve good.prm --port 8080 --port 8081");
   run("an unexpected second argument", "good.prm other.prm");
   // Scene variants on the command line (--set): checked like a line of
   // the file, and named in the message.

@@ -39,6 +39,15 @@ namespace palpate
     /** The displacement degree the element pair fixes (1 for P1-P1, 2 for
      * Taylor-Hood), or 0: Discretization / Polynomial degree decides. */
     unsigned int displacement_degree = 0;
+    /** The displacement field's degree: the element pair's, else the
+     * scene's Discretization / Polynomial degree (@p polynomial_degree).
+     * The one statement of this rule: the FE system, the sphere's checks
+     * and the study's element knob all ask it. */
+    unsigned int
+    degree(const unsigned int polynomial_degree) const
+    {
+      return displacement_degree > 0 ? displacement_degree : polynomial_degree;
+    }
     /** The element pair's name for reports ("P1-P1", "Taylor-Hood"). */
     std::string element;
     /** The Brezzi-Pitkaranta pressure stabilisation of P1-P1 and its
