@@ -10,6 +10,7 @@
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state.h>
+#include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
@@ -181,6 +182,11 @@ namespace palpate
       void
       report() const;
 
+      /** The report's warning when the trajectory pushes a sphere deeper
+       * than its set-up checks allow. */
+      void
+      warn_if_sphere_too_small_for_the_motion() const;
+
       /** Attach, start the loop, wait for the initial cloud and run the
        * motion, reporting events as they happen, until its end or a stop
        * signal. */
@@ -313,7 +319,42 @@ namespace palpate
             << " mm: there the force fades to zero. Enlarge State space / "
                "Extent to at least "
             << 1000 * reach << " mm.\n";
+      warn_if_sphere_too_small_for_the_motion();
       out << std::flush;
+    }
+
+
+
+    void
+    InteractionRun::warn_if_sphere_too_small_for_the_motion() const
+    {
+      // The sphere's set-up checks weighed the scene's Prescribed
+      // displacement; the trajectory may push deeper. They are asked
+      // again at its farthest point: where they fail, the sphere may go
+      // between the surface nodes, those states are failure points and
+      // the force is held there (the summary counts it).
+      const auto &a        = p.boundary_conditions.active_node;
+      const auto  farthest = device->planned_farthest();
+      if (a.tip != Parameters::ActiveNode::Tip::sphere ||
+          !(Utilities::norm(farthest) >
+            std::max(Utilities::norm(a.prescribed_displacement), a.tip_radius)))
+        return;
+      Scene deeper = scene;
+      deeper.parameters.boundary_conditions.active_node
+        .prescribed_displacement = farthest;
+      try
+        {
+          NodeSelection::create(deeper, interaction->mesh());
+        }
+      catch (const InputError &e)
+        {
+          out << "  warning:       the trajectory takes the sphere "
+              << 1000 * Utilities::norm(farthest)
+              << " mm from rest, deeper than the set-up checks weighed: "
+              << e.problem()
+              << "; the force is held at such states. To avoid it: " << e.fix()
+              << "\n";
+        }
     }
 
 

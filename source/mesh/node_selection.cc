@@ -590,14 +590,15 @@ namespace palpate
                   "renders no force there";
       else if (engulfed)
         problem = "is pushed " + Utilities::to_string(depth, 3) +
-                  " m deep (Prescribed displacement or solve's --to), more "
+                  " m deep (the push: Prescribed displacement, solve's --to or "
+                  "a trajectory's farthest point), more "
                   "than its diameter: the tissue closes over the sphere, "
                   "its nodes pass behind it and the state is a failure "
                   "point (\"sphere through the surface\")";
       else
         problem =
-          "is pushed deeper than its radius (Prescribed displacement or "
-          "solve's --to, " +
+          "is pushed deeper than its radius (the push: Prescribed "
+          "displacement, solve's --to or a trajectory's farthest point, " +
           Utilities::to_string(depth, 3) +
           " m) and clears the surface's node spacing where it "
           "touches (the nearest node " +
@@ -622,10 +623,10 @@ namespace palpate
           "near the probe (Mesh / Source = surface with Refinement size "
           "about a third of the radius)" +
           (!only_deep ? "" :
-           engulfed   ? ", or a push (Prescribed displacement, --to) no "
-                        "longer than the sphere's diameter" :
-                        ", or a push (Prescribed displacement, --to) no "
-                        "longer than the radius") +
+           engulfed   ? ", or a push (Prescribed displacement, --to, the "
+                        "trajectory) no longer than the sphere's diameter" :
+                        ", or a push (Prescribed displacement, --to, the "
+                        "trajectory) no longer than the radius") +
           (scene.displacement_degree() == 2 || deep ?
              std::string(".") :
              std::string(", or Polynomial degree = 2 (the edge "

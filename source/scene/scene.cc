@@ -1255,6 +1255,10 @@ namespace palpate
     /** Material model / Density (kg/m^3): five times the densest element's
      * (osmium, 22,590); tissue is about 1,000-1,100. */
     constexpr double max_density = 1e5;
+    /** Material model / Density (kg/m^3), unless 0: lighter than any
+     * tissue (fat is about 900, lung about 300): 1.06 is liver in g/cm^3,
+     * and its gravity would be a thousand times too weak. */
+    constexpr double min_density = 100;
   } // namespace Limits
 
 
@@ -1690,6 +1694,18 @@ namespace palpate
                     "22,590): the density is in kg/m^3, and tissue's is "
                     "about 1,000-1,100",
                   "use 1060 (liver) or your tissue's density in kg/m^3.");
+    if (p.material_model.density > 0 && p.material_model.density < min_density)
+      throw error("Material model/Density",
+                  "0 (weightless) or at least " +
+                    Utilities::to_string(min_density, 3) +
+                    " kg/m^3: the density is in kg/m^3 and tissue's is "
+                    "about 1,000-1,100 (lung about 300); " +
+                    Utilities::to_string(p.material_model.density, 4) +
+                    " looks like g/cm^3, which would make gravity a "
+                    "thousand times too weak",
+                  "use " +
+                    Utilities::to_string(1000 * p.material_model.density, 4) +
+                    " if you meant g/cm^3 (1060 is liver).");
   }
 
 

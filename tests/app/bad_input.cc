@@ -519,6 +519,9 @@ main(int argc, char **argv)
         beam + "subsection Material model\n  set Model name = Mooney-Rivlin\n"
                "  subsection Mooney-Rivlin\n"
                "    set Stabilization factor = 1e308\n  end\nend\n");
+  scene("a density in g/cm^3 (1.06)",
+        "density-g-cm3.prm",
+        beam + "subsection Material model\n  set Density = 1.06\nend\n");
   scene("an unstable Yeoh law (C20 = -1e9 Pa)",
         "yeoh-unstable.prm",
         beam + "subsection Material model\n  set Model name = Yeoh\n"

@@ -12,6 +12,8 @@
 //   surface;
 // - a trajectory that leaves the state space: a warning with the extent
 //   to set;
+// - a trajectory that pushes a sphere deeper than its set-up checks
+//   weighed: a warning with their problem and fix;
 // - palpate mesh on a surface in millimetres with the default scale: an
 //   input error that says "millimetres: set 0.001".
 
@@ -106,6 +108,34 @@ end
   r = run_palpate("reach.prm");
   deallog << "a trajectory beyond the state space: "
           << line_with(r.output, "the trajectory goes") << std::endl;
+
+  // A sphere whose set-up checks weighed a 2 mm push, moved 25 mm by the
+  // trajectory: deeper than its diameter, said before the motion.
+  write_file("deep-sphere.prm",
+             replaced(beam,
+                      "set Prescribed displacement = 0, 0, -0.01",
+                      "set Prescribed displacement = 0, 0, -0.002\n"
+                      "    set Tip = sphere\n"
+                      "    set Tip radius = 0.01") +
+               R"(
+subsection State space
+  set Grid spacing = 0.005
+  set Extent       = 0.03
+end
+subsection Haptics
+  subsection Trajectory
+    set Type      = straight line
+    set Direction = 0, 0, -1
+    set Speed     = 0.1
+    set Duration  = 0.25
+  end
+end
+)");
+  r = run_palpate("deep-sphere.prm");
+  deallog
+    << "a trajectory deeper than the sphere's checks: "
+    << line_with(r.output, "the trajectory takes the sphere").substr(0, 160)
+    << std::endl;
 
   // A 10 cm cube's surface in millimetres, read as metres.
   palpate::Surface cube;

@@ -71,6 +71,15 @@ namespace palpate
       return 0;
     }
 
+    /** The planned displacement from rest farthest from it (m), where the
+     * motion is known in advance (a trajectory); zero if not. A sphere's
+     * set-up checks weigh the push this is. */
+    virtual Utilities::Point3
+    planned_farthest() const
+    {
+      return {{0, 0, 0}};
+    }
+
     /** One line for reports. */
     virtual std::string
     description() const = 0;

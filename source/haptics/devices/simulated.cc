@@ -27,11 +27,17 @@ namespace palpate
       explicit SimulatedDevice(std::unique_ptr<Trajectory> trajectory)
         : trajectory(std::move(trajectory))
       {
-        // How far it goes from rest along any axis, for the report.
+        // How far it goes from rest along any axis, for the report, and
+        // its farthest point.
         const double T = this->trajectory->duration();
         for (unsigned int k = 0; k <= 1000; ++k)
-          for (const double x : this->trajectory->position(T * k / 1000))
-            reach = std::max(reach, std::abs(x));
+          {
+            const auto x = this->trajectory->position(T * k / 1000);
+            for (const double c : x)
+              reach = std::max(reach, std::abs(c));
+            if (Utilities::norm(x) > Utilities::norm(farthest))
+              farthest = x;
+          }
       }
 
       /** No entries of its own: the trajectory has them. */
@@ -89,6 +95,12 @@ namespace palpate
         return reach;
       }
 
+      Utilities::Point3
+      planned_farthest() const override
+      {
+        return farthest;
+      }
+
       std::string
       description() const override
       {
@@ -97,7 +109,8 @@ namespace palpate
 
     private:
       std::unique_ptr<Trajectory> trajectory;
-      double                      reach = 0;
+      double                      reach    = 0;
+      Utilities::Point3           farthest = {{0, 0, 0}};
     };
   } // namespace
 
