@@ -619,8 +619,18 @@ namespace palpate
                                    "_" + std::to_string(g[1]) + "_" +
                                    std::to_string(g[2]) + ".vtu";
           const std::string path = p.output.directory + "/" + file;
-          system.write_vtu(*state, path + ".part");
-          std::filesystem::rename(path + ".part", path);
+          try
+            {
+              system.write_vtu(*state, path + ".part");
+              std::filesystem::rename(path + ".part", path);
+            }
+          catch (...)
+            {
+              // A full disk: no partial file left behind either.
+              std::error_code ignored;
+              std::filesystem::remove(path + ".part", ignored);
+              throw;
+            }
           csv << point << "," << g[0] << "," << g[1] << "," << g[2] << ","
               << state->active_displacement[0] << ","
               << state->active_displacement[1] << ","
