@@ -15,9 +15,13 @@
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -33,11 +37,48 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 namespace palpate
 {
   namespace
   {
+    /**
+     * python3 SCRIPT CSV PNG, without a shell (a quote in a file name is
+     * only a name), with its input and output /dev/null, for at most
+     * 120 s: a plot that hangs (a stalled back end, a file on a dead
+     * mount, a CSV that is a device) must not keep the study from ending.
+     * Whether it succeeded.
+     */
+    bool
+    run_plot_script(const std::string &script,
+                    const std::string &csv,
+                    const std::string &png)
+    {
+      std::vector<std::string> words = {
+        "timeout", "120", "/usr/bin/python3", script, csv, png};
+      std::vector<char *> argv;
+      for (auto &w : words)
+        argv.push_back(w.data());
+      argv.push_back(nullptr);
+      posix_spawn_file_actions_t actions;
+      posix_spawn_file_actions_init(&actions);
+      posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+      posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+      posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+      pid_t     child   = 0;
+      const int spawned = posix_spawnp(
+        &child, "timeout", &actions, nullptr, argv.data(), environ);
+      posix_spawn_file_actions_destroy(&actions);
+      if (spawned != 0)
+        return false;
+      int status = 0;
+      while (waitpid(child, &status, 0) < 0)
+        if (errno != EINTR)
+          return false;
+      return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    }
+
     using Point3 = Utilities::Point3;
     using Clock  = std::chrono::steady_clock;
 
@@ -1485,38 +1526,31 @@ namespace palpate
 
         // --- The Pareto plot, by the plotting script of the source tree
         // (matplotlib), next to the CSV.
+        if (!options.plot)
+          return;
+        const std::filesystem::path script =
+          std::filesystem::path(PALPATE_SOURCE_DIR) / "doc" / "images" /
+          "accuracy_pareto.py";
+        std::filesystem::path png(result.csv_file);
+        png.replace_extension(".png");
+        const std::string by_hand = "python3 '" + script.string() + "' '" +
+                                    result.csv_file + "' '" + png.string() +
+                                    "'";
         // After a stop signal the user wants the run to end: no plot.
-        if (options.plot &&
-            (result.stop_signal != 0 || stop->signal_number() != 0))
-          out << "No Pareto plot: the study was stopped (plot the CSV with "
-                 "doc/images/accuracy_pareto.py).\n";
-        else if (options.plot)
+        if (result.stop_signal != 0 || stop->signal_number() != 0)
+          out << "No Pareto plot: the study was stopped; to draw it, run "
+              << by_hand << "\n";
+        else if (std::filesystem::exists(script) &&
+                 run_plot_script(script.string(), result.csv_file, png))
           {
-            const std::filesystem::path script =
-              std::filesystem::path(PALPATE_SOURCE_DIR) / "doc" / "images" /
-              "accuracy_pareto.py";
-            std::filesystem::path png(result.csv_file);
-            png.replace_extension(".png");
-            const std::string command = "/usr/bin/python3 '" + script.string() +
-                                        "' '" + result.csv_file + "' '" +
-                                        png.string() + "'";
-            // A time limit: a plot that hangs (a stalled display back end,
-            // a file on a dead mount) must not keep the study from ending.
-            if (std::filesystem::exists(script) &&
-                std::system(
-                  ("timeout 120 " + command + " < /dev/null > /dev/null 2>&1")
-                    .c_str()) == 0)
-              {
-                result.plot_file = png.string();
-                out << "The Pareto plot (force error against speed): "
-                    << result.plot_file << "\n";
-              }
-            else
-              out
-                << "No Pareto plot: it needs python3 with matplotlib (Debian: "
-                   "apt install python3-matplotlib); then run "
-                << command << "\n";
+            result.plot_file = png.string();
+            out << "The Pareto plot (force error against speed): "
+                << result.plot_file << "\n";
           }
+        else
+          out << "No Pareto plot: it needs python3 with matplotlib (Debian: "
+                 "apt install python3-matplotlib); then run "
+              << by_hand << "\n";
       }
 
       std::ostream                    &out;
