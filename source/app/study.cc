@@ -24,6 +24,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -46,14 +47,15 @@ namespace palpate
     /**
      * python3 SCRIPT CSV PNG, without a shell (a quote in a file name is
      * only a name), with its input and output /dev/null, for at most
-     * 120 s: a plot that hangs (a stalled back end, a file on a dead
-     * mount, a CSV that is a device) must not keep the study from ending.
-     * Whether it succeeded.
+     * 120 s and until @p stop is asked for: a plot that hangs (a stalled
+     * back end, a file on a dead mount) must not keep the study from
+     * ending. Whether it succeeded.
      */
     bool
     run_plot_script(const std::string &script,
                     const std::string &csv,
-                    const std::string &png)
+                    const std::string &png,
+                    const StopRequest &stop)
     {
       std::vector<std::string> words = {
         "timeout", "120", "/usr/bin/python3", script, csv, png};
@@ -72,10 +74,25 @@ namespace palpate
       posix_spawn_file_actions_destroy(&actions);
       if (spawned != 0)
         return false;
+      // A stop signal meanwhile ends the plot (timeout passes SIGTERM on
+      // to python) instead of waiting out its time limit.
       int status = 0;
-      while (waitpid(child, &status, 0) < 0)
-        if (errno != EINTR)
-          return false;
+      for (;;)
+        {
+          const pid_t done = waitpid(child, &status, WNOHANG);
+          if (done == child)
+            break;
+          if (done < 0 && errno != EINTR)
+            return false;
+          if (stop.signal_number() != 0)
+            {
+              ::kill(child, SIGTERM);
+              while (waitpid(child, &status, 0) < 0 && errno == EINTR)
+                {}
+              return false;
+            }
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
       return WIFEXITED(status) && WEXITSTATUS(status) == 0;
     }
 
@@ -881,19 +898,41 @@ namespace palpate
         result.csv_file = options.csv_file;
         if (!result.csv_file.empty())
           {
-            // A missing directory is said now, not after the first knob.
-            const auto parent =
-              std::filesystem::path(result.csv_file).parent_path();
-            std::error_code missing;
-            if (!parent.empty() &&
-                !std::filesystem::is_directory(parent, missing))
-              throw InputError("command line",
-                               0,
-                               "--csv " + result.csv_file,
-                               "its directory '" + parent.string() +
-                                 "' does not exist",
-                               "make it (mkdir -p '" + parent.string() +
-                                 "') or name a file in one that exists.");
+            namespace fs      = std::filesystem;
+            const auto refuse = [&](const std::string &problem,
+                                    const std::string &fix) {
+              throw InputError(
+                "command line", 0, "--csv " + result.csv_file, problem, fix);
+            };
+            // The plot is written beside the CSV, its name ending in .png.
+            if (fs::path(result.csv_file).extension() == ".png")
+              refuse("the Pareto plot is written beside the table under the "
+                     "table's name ending in .png: it would overwrite the "
+                     "table",
+                     "name the CSV with .csv, e.g. --csv study.csv.");
+            // Its directory, now, not after the first knob.
+            const auto parent = fs::path(result.csv_file).parent_path();
+            if (!parent.empty())
+              {
+                std::error_code error;
+                const auto      status = fs::status(parent, error);
+                if (status.type() == fs::file_type::not_found)
+                  refuse("its directory '" + parent.string() +
+                           "' does not exist",
+                         "make it (mkdir -p '" + parent.string() +
+                           "') or name a file in one that exists.");
+                if (error)
+                  refuse("the file system refuses its directory '" +
+                           parent.string().substr(0, 300) + "' (" +
+                           error.message() + ")",
+                         "check the links on the way (a loop of symbolic "
+                         "links?), the path's length and the permissions, "
+                         "or name another file.");
+                if (!fs::is_directory(status))
+                  refuse("'" + parent.string() + "' is not a directory",
+                         "name a file in a directory, e.g. --csv "
+                         "study.csv.");
+              }
             // Said before anything runs, not at the first knob's end.
             std::error_code                    error;
             const std::filesystem::file_status status =
@@ -1541,11 +1580,20 @@ namespace palpate
           out << "No Pareto plot: the study was stopped; to draw it, run "
               << by_hand << "\n";
         else if (std::filesystem::exists(script) &&
-                 run_plot_script(script.string(), result.csv_file, png))
+                 run_plot_script(script.string(), result.csv_file, png, *stop))
           {
             result.plot_file = png.string();
             out << "The Pareto plot (force error against speed): "
                 << result.plot_file << "\n";
+          }
+        else if (stop->signal_number() != 0)
+          {
+            // Stopped while drawing: the study ends as stopped.
+            result.stopped     = "stopped by " + stop->description();
+            result.stop_signal = stop->signal_number();
+            out << "No Pareto plot: the study was stopped while drawing it; "
+                   "to draw it, run "
+                << by_hand << "\n";
           }
         else
           out << "No Pareto plot: it needs python3 with matplotlib (Debian: "

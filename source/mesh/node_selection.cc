@@ -474,6 +474,57 @@ namespace palpate
 
 
     /**
+     * Why a sphere of radius @p R fails place_sphere_tip()'s checks, in
+     * words: the nearest node @p hole away, edges up to @p longest near it,
+     * pushed @p depth into the body, needing @p margin when deeper than R.
+     */
+    std::string
+    sphere_problem(const double R,
+                   const double hole,
+                   const double longest,
+                   const double depth,
+                   const double margin,
+                   const bool   midpoints)
+    {
+      const bool only_deep = R >= 2 * hole && longest <= 1.5 * R;
+      if (R < 2 * hole)
+        return "is too small for the gaps between the surface nodes where "
+               "it touches (the nearest is " +
+               Utilities::to_string(hole, 3) +
+               " m away across the surface): the contact acts at nodes, "
+               "so pushed in, the sphere passes between them and renders "
+               "no force";
+      if (!only_deep)
+        return "is smaller than the surface triangles around where it "
+               "touches (edges up to " +
+               Utilities::to_string(longest, 3) + " m" +
+               (midpoints ? " between contact nodes" : "") +
+               "): moved along the surface it sinks between the nodes, "
+               "those states are failure points, and the haptic loop "
+               "renders no force there";
+      if (depth > 2 * R)
+        return "is pushed " + Utilities::to_string(depth, 3) +
+               " m deep (the push: Prescribed displacement, solve's --to or "
+               "a trajectory's farthest point), more "
+               "than its diameter: the tissue closes over the sphere, "
+               "its nodes pass behind it and the state is a failure "
+               "point (\"sphere through the surface\")";
+      return "is pushed deeper than its radius (the push: Prescribed "
+             "displacement, solve's --to or a trajectory's farthest point, " +
+             Utilities::to_string(depth, 3) +
+             " m) and clears the surface's node spacing where it "
+             "touches (the nearest node " +
+             Utilities::to_string(hole, 3) + " m away, edges up to " +
+             Utilities::to_string(longest, 3) + " m" +
+             (midpoints ? " between contact nodes" : "") + ") by less than " +
+             Utilities::to_string(margin, 2) +
+             " times: pushed that deep, such a sphere slips between "
+             "the nodes and the state is a failure point";
+    }
+
+
+
+    /**
      * Place the sphere (Tip = sphere), and check that it is large enough
      * to meet a node.
      */
@@ -485,23 +536,33 @@ namespace palpate
       const auto &a = scene.parameters.boundary_conditions.active_node;
       // A scene that pushes the sphere deeper than its radius (Prescribed
       // displacement) must clear the checks below by a margin.
-      const double depth = std::hypot(a.prescribed_displacement[0],
-                                      a.prescribed_displacement[1],
-                                      a.prescribed_displacement[2]);
-      const bool   deep  = depth > a.tip_radius;
+      const auto  &push   = a.prescribed_displacement;
+      const double length = std::hypot(push[0], push[1], push[2]);
+      const bool   p2     = scene.displacement_degree() == 2;
+      const auto   place  = [&](const bool midpoints) {
+        return place_sphere(mesh,
+                            a.tip_radius,
+                            a.selection == "node id" ? nullptr : &a.point,
+                            midpoints,
+                            selection);
+      };
       // With quadratic elements the edge midpoints are contact nodes too,
       // and halve the spacing the checks measure; but not for a deep
       // push: with Taylor-Hood on the graded liver of liver-indenter.prm
       // (a 1 cm push), 3 and 4 mm spheres, which clear the midpoints'
       // figures by 1.7 and 2.3 times, were failure points, and 6 mm,
       // which clears the vertices' by 1.7, converged (the tenth re-run).
-      const bool   midpoints = scene.displacement_degree() == 2 && !deep;
-      const double hole =
-        place_sphere(mesh,
-                     a.tip_radius,
-                     a.selection == "node id" ? nullptr : &a.point,
-                     midpoints,
-                     selection);
+      bool   midpoints = p2 && !(length > a.tip_radius);
+      double hole      = place(midpoints);
+      // A pull, or a move along the surface, presses the sphere no deeper
+      // (the twelfth re-run's 3 cm pull was refused as "pushed 0.03 m
+      // deep"); a push into the body is weighed by its length, as far as
+      // it drags the sphere through the tissue.
+      const double depth =
+        Utilities::dot(push, selection.active_normal) < 0 ? length : 0;
+      const bool deep = depth > a.tip_radius;
+      if (p2 && !deep && !midpoints)
+        hole = place(midpoints = true);
       // Pushed in by a depth d, the sphere cuts the surface in a circle of
       // radius sqrt(2 R d - d^2), at most R (at d = R): a sphere smaller
       // than the distance never meets a node. Measured on liver501 (the
@@ -571,43 +632,9 @@ namespace palpate
         return;
 
       // Only the depth fails: a shallower push is a way out too.
-      const bool  only_deep = R >= 2 * hole && longest <= 1.5 * R;
-      std::string problem;
-      if (R < 2 * hole)
-        problem = "is too small for the gaps between the surface nodes where "
-                  "it touches (the nearest is " +
-                  Utilities::to_string(hole, 3) +
-                  " m away across the surface): the contact acts at nodes, "
-                  "so pushed in, the sphere passes between them and renders "
-                  "no force";
-      else if (!only_deep)
-        problem = "is smaller than the surface triangles around where it "
-                  "touches (edges up to " +
-                  Utilities::to_string(longest, 3) + " m" +
-                  (midpoints ? " between contact nodes" : "") +
-                  "): moved along the surface it sinks between the nodes, "
-                  "those states are failure points, and the haptic loop "
-                  "renders no force there";
-      else if (engulfed)
-        problem = "is pushed " + Utilities::to_string(depth, 3) +
-                  " m deep (the push: Prescribed displacement, solve's --to or "
-                  "a trajectory's farthest point), more "
-                  "than its diameter: the tissue closes over the sphere, "
-                  "its nodes pass behind it and the state is a failure "
-                  "point (\"sphere through the surface\")";
-      else
-        problem =
-          "is pushed deeper than its radius (the push: Prescribed "
-          "displacement, solve's --to or a trajectory's farthest point, " +
-          Utilities::to_string(depth, 3) +
-          " m) and clears the surface's node spacing where it "
-          "touches (the nearest node " +
-          Utilities::to_string(hole, 3) + " m away, edges up to " +
-          Utilities::to_string(longest, 3) + " m" +
-          (midpoints ? " between contact nodes" : "") + ") by less than " +
-          Utilities::to_string(margin, 2) +
-          " times: pushed that deep, such a sphere slips between "
-          "the nodes and the state is a failure point";
+      const bool        only_deep = R >= 2 * hole && longest <= 1.5 * R;
+      const std::string problem =
+        sphere_problem(R, hole, longest, depth, margin, midpoints);
       throw scene.error(
         "Boundary conditions/Active node/Tip radius",
         "a sphere of " + Utilities::to_string(R, 3) + " m radius " + problem,
@@ -627,10 +654,9 @@ namespace palpate
                         "trajectory) no longer than the sphere's diameter" :
                         ", or a push (Prescribed displacement, --to, the "
                         "trajectory) no longer than the radius") +
-          (scene.displacement_degree() == 2 || deep ?
-             std::string(".") :
-             std::string(", or Polynomial degree = 2 (the edge "
-                         "midpoints become contact nodes).")));
+          (p2 || deep ? std::string(".") :
+                        std::string(", or Polynomial degree = 2 (the edge "
+                                    "midpoints become contact nodes).")));
     }
 
 

@@ -563,6 +563,12 @@ main(int argc, char **argv)
   run("a study CSV that is a device", "study good.prm --quick --csv /dev/zero");
   run("a study CSV that is a loop of links",
       "study good.prm --quick --csv loop");
+  run("a study CSV named .png (the plot would overwrite it)",
+      "study good.prm --quick --csv study.png");
+  run("a study CSV in a 'directory' that is a file",
+      "study good.prm --quick --csv good.prm/study.csv");
+  run("a study CSV in a directory that is a loop of links",
+      "study good.prm --quick --csv loop/study.csv");
   run("'solve' without a scene", "solve");
   run("'solve --to' with two numbers", "solve good.prm --to 0,0");
   run("'solve --to' without its value", "solve good.prm --to");

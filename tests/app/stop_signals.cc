@@ -544,6 +544,58 @@ main()
             << std::endl;
   }
 
+  // The study stopped while its Pareto plot is drawn: a plot that hangs
+  // (here python's start-up, through a sitecustomize on PYTHONPATH that
+  // says it started and sleeps) is ended, and the study ends as stopped
+  // (it held the plot's 120 s, then ended 0).
+  {
+    const std::string site   = dir + "/site";
+    const std::string marker = dir + "/plot-started";
+    std::filesystem::create_directories(site);
+    write_file(site + "/sitecustomize.py",
+               "import time\nopen('" + marker +
+                 "', 'w').close()\ntime.sleep(600)\n");
+    std::filesystem::remove(out);
+    setenv("PYTHONPATH", site.c_str(), 1);
+    const pid_t pid = start_palpate({"study",
+                                     scene,
+                                     "--quick",
+                                     "--skip",
+                                     "tolerance,increment,combined,mesh,"
+                                     "element",
+                                     "--samples",
+                                     "8",
+                                     "--csv",
+                                     dir + "/study-plot.csv",
+                                     "--set",
+                                     "Output/Directory=" + dir},
+                                    out,
+                                    err);
+    unsetenv("PYTHONPATH");
+    bool started = false;
+    for (unsigned int k = 0; k < 3000 && !started; ++k)
+      {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        started = std::filesystem::exists(marker);
+      }
+    kill(pid, SIGTERM);
+    int        status = -1;
+    const bool ended  = wait_status_for(pid, 20, status);
+    if (!ended)
+      {
+        kill(pid, SIGKILL);
+        wait_status(pid);
+      }
+    const std::string text = read_file(out);
+    deallog << "study, SIGTERM while the plot is drawn: plot started "
+            << ok(started) << ", ended within 20 s " << ok(ended)
+            << ", exit status " << status << " " << ok(status == 143)
+            << ", says so "
+            << ok(text.find("the study was stopped while drawing it") !=
+                  std::string::npos)
+            << std::endl;
+  }
+
   // The study's time budget: the same path, exit status 0.
   {
     const std::string csv    = dir + "/study-budget.csv";

@@ -280,6 +280,19 @@ main(int argc, char **argv)
       {0, 0, -0.004}};
     deallog << "; pushed 4 mm: accepted " << ok(refusal(liver).empty())
             << std::endl;
+    // A pull away from the surface presses it no deeper (the twelfth
+    // re-run's 3 cm pull was refused as "pushed 0.03 m deep"); the same
+    // length pushed in is refused.
+    liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
+      {0, 0, 0.03}};
+    deallog << "  the same sphere pulled 3 cm away: accepted "
+            << ok(refusal(liver).empty());
+    liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
+      {0, 0, -0.03}};
+    deallog << ", pushed 3 cm in: refused as deeper than its diameter "
+            << ok(refusal(liver).find("more than its diameter") !=
+                  std::string::npos)
+            << std::endl;
   }
   // Taylor-Hood has quadratic displacements whatever Polynomial degree
   // says: its edge midpoints are contact nodes, and the refusal must not
