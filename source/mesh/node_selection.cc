@@ -474,6 +474,15 @@ namespace palpate
 
 
     /**
+     * How deep a sphere may be pushed, in radii: the tissue closes over a
+     * deeper one. 6.1 mm (suggested for the graded liver's 1 cm push)
+     * failed at 1.5 - 5 cm, 8 mm held 1.5 cm and 10 mm 2 cm (the eleventh
+     * re-run); with Node id 38, 7.5 mm failed at 1.5 cm (2 radii) and
+     * 7.6 mm held (the twelfth).
+     */
+    constexpr double deepest_push = 1.9;
+
+    /**
      * Why a sphere of radius @p R fails place_sphere_tip()'s checks, in
      * words: the nearest node @p hole away, edges up to @p longest near it,
      * pushed @p depth into the body, needing @p margin when deeper than R.
@@ -502,11 +511,12 @@ namespace palpate
                "): moved along the surface it sinks between the nodes, "
                "those states are failure points, and the haptic loop "
                "renders no force there";
-      if (depth > 2 * R)
+      if (depth > deepest_push * R)
         return "is pushed " + Utilities::to_string(depth, 3) +
                " m deep (the push: Prescribed displacement, solve's --to or "
-               "a trajectory's farthest point), more "
-               "than its diameter: the tissue closes over the sphere, "
+               "a trajectory's farthest point), more than " +
+               Utilities::to_string(deepest_push, 2) +
+               " times its radius: the tissue closes over the sphere, "
                "its nodes pass behind it and the state is a failure "
                "point (\"sphere through the surface\")";
       return "is pushed deeper than its radius (the push: Prescribed "
@@ -608,7 +618,7 @@ namespace palpate
           return std::ceil(
                    std::max(margin *
                               std::max(2 * hole, longest_within(2 * r) / 1.5),
-                            depth / 2) *
+                            depth / deepest_push) *
                    1e4) /
                  1e4;
         };
@@ -622,10 +632,8 @@ namespace palpate
           }
         return needed;
       };
-      // And at most a diameter deep: 6.1 mm (suggested for the graded
-      // liver's 1 cm push) failed at 1.5 - 5 cm, 8 mm held 1.5 cm and 10 mm
-      // 2 cm (the eleventh re-run): the tissue closes over the sphere.
-      const bool   engulfed = depth > 2 * R;
+      // And at most deepest_push radii deep.
+      const bool   engulfed = depth > deepest_push * R;
       const double longest  = longest_within(2 * R);
       if (!engulfed && R >= required * 2 * hole &&
           required * longest <= 1.5 * R)
@@ -640,20 +648,22 @@ namespace palpate
         "a sphere of " + Utilities::to_string(R, 3) + " m radius " + problem,
         "use a radius of at least " +
           Utilities::to_string(passing_radius(), 6) +
-          " m (the larger of half the push and " +
+          " m (the larger of the push over " +
+          Utilities::to_string(deepest_push, 2) + " and " +
           Utilities::to_string(margin, 2) +
           " times the larger of twice the nearest node's distance and two "
           "thirds of the longest edge within two radii: a sphere that just "
           "clears them still slips between the nodes when pushed deeper "
-          "than its radius, and one pushed deeper than its diameter goes "
+          "than its radius, and one pushed nearly its diameter deep goes "
           "through the surface), or a mesh finer "
           "near the probe (Mesh / Source = surface with Refinement size "
           "about a third of the radius)" +
           (!only_deep ? "" :
            engulfed   ? ", or a push (Prescribed displacement, --to, the "
-                        "trajectory) no longer than the sphere's diameter" :
-                        ", or a push (Prescribed displacement, --to, the "
-                        "trajectory) no longer than the radius") +
+                        "trajectory) no longer than " +
+                        Utilities::to_string(deepest_push, 2) + " radii" :
+                      ", or a push (Prescribed displacement, --to, the "
+                      "trajectory) no longer than the radius") +
           (p2 || deep ? std::string(".") :
                         std::string(", or Polynomial degree = 2 (the edge "
                                     "midpoints become contact nodes).")));

@@ -457,8 +457,10 @@ namespace palpate
           "distance to the nearest surface node and two thirds of the "
           "longest surface edge within two radii (with quadratic elements "
           "the edge midpoints count), both by a margin of 1.7 (and on the "
-          "vertices) when Prescribed displacement is longer than the "
-          "radius; a refusal names the radius that passes.");
+          "vertices) when the push into the body (Prescribed displacement, "
+          "solve's --to) is longer than the radius; and a sphere may be "
+          "pushed at most 1.9 radii deep. A refusal names the radius that "
+          "passes; an interaction whose trajectory goes deeper is warned.");
       }
       prm.leave_subsection();
     }
