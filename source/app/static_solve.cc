@@ -147,6 +147,14 @@ namespace palpate
                                        4) +
                   " N): the device would clip it. Is the modulus in Pa, the "
                   "push in metres, the mesh's Scale factor right?\n" :
+                std::string())
+          << (Utilities::norm(state.force) == 0 &&
+                  scene.parameters.boundary_conditions.active_node.tip ==
+                    Parameters::ActiveNode::Tip::sphere ?
+                "  note:           the sphere does not touch the surface "
+                "there (0 N): the push moves it away from the organ or "
+                "along it. A push into the organ points against the "
+                "surface's outward normal (the report's probe tip line).\n" :
                 std::string());
       else if (stopped)
         out << "  STOPPED:        by " << stop.description() << " after "

@@ -44,6 +44,14 @@ namespace palpate
 {
   namespace
   {
+    /** The first line of the study's CSV: a file that has another is not
+     * overwritten. */
+    const std::string csv_header =
+      "material,knob,value,interpolation,probe,h_mm,samples,covered,"
+      "err_mean_N,err_p95_N,err_max_N,err_mean_pct,err_p95_pct,"
+      "err_max_pct,shape_err_mm,state_ms,states,failures,states_per_cm,"
+      "region_states,precompute_s,memory_MiB,speed_mm_s,recommended";
+
     /**
      * python3 SCRIPT CSV PNG, without a shell (a quote in a file name is
      * only a name), with its input and output /dev/null, for at most
@@ -959,6 +967,21 @@ namespace palpate
                                  "file: the study writes its table there "
                                  "and the Pareto plot reads it back",
                                "name a regular file, e.g. --csv study.csv.");
+            // A file of the user's (the scene, its mesh) is not a table
+            // to overwrite: only one a study wrote is.
+            if (std::filesystem::is_regular_file(status))
+              {
+                std::ifstream in(result.csv_file);
+                std::string   first;
+                std::getline(in, first);
+                if (!first.empty() && first != csv_header)
+                  refuse("'" + result.csv_file +
+                           "' exists and is not a study's table (it begins '" +
+                           first.substr(0, 40) +
+                           "'): the study would overwrite it",
+                         "name a new file, e.g. --csv study.csv, or remove "
+                         "this one first if it is no longer needed.");
+              }
             if (std::filesystem::is_directory(status))
               throw InputError(
                 "command line",
@@ -987,11 +1010,7 @@ namespace palpate
       write_csv() const
       {
         std::ofstream csv(result.csv_file);
-        csv
-          << "material,knob,value,interpolation,probe,h_mm,samples,covered,"
-             "err_mean_N,err_p95_N,err_max_N,err_mean_pct,err_p95_pct,"
-             "err_max_pct,shape_err_mm,state_ms,states,failures,states_per_cm,"
-             "region_states,precompute_s,memory_MiB,speed_mm_s,recommended\n";
+        csv << csv_header << "\n";
         for (unsigned int r = 0; r < result.rows.size(); ++r)
           {
             const auto &row = result.rows[r];

@@ -459,7 +459,7 @@ namespace palpate
           "the edge midpoints count), both by a margin of 1.7 (and on the "
           "vertices) when the push into the body (Prescribed displacement, "
           "solve's --to) is longer than the radius; and a sphere may be "
-          "pushed at most 1.9 radii deep. A refusal names the radius that "
+          "pushed at most 1.7 radii deep. A refusal names the radius that "
           "passes; an interaction whose trajectory goes deeper is warned.");
       }
       prm.leave_subsection();

@@ -563,6 +563,8 @@ main(int argc, char **argv)
   run("a study CSV that is a device", "study good.prm --quick --csv /dev/zero");
   run("a study CSV that is a loop of links",
       "study good.prm --quick --csv loop");
+  run("a study CSV that is the scene itself (it would be overwritten)",
+      "study good.prm --quick --csv good.prm");
   run("a study CSV named .png (the plot would overwrite it)",
       "study good.prm --quick --csv study.png");
   run("a study CSV in a 'directory' that is a file",

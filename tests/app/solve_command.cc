@@ -30,4 +30,21 @@ main()
         deallog << r.output.substr(at, r.output.find('\n', at) - at)
                 << std::endl;
     }
+  // A 1 cm sphere at the beam's tip pulled 5 mm away from the surface
+  // (its outward normal there is (0.707, 0, 0.707)): accepted (a pull
+  // presses it no deeper), 0 N, and said so.
+  const ProgramRun r =
+    run_palpate("solve " + beam +
+                " --set 'Boundary conditions/Active node/Tip=sphere'"
+                " --set 'Boundary conditions/Active node/Tip radius=0.01'"
+                " --to 0.005,0,0.005");
+  deallog << "a sphere pulled away: exit status " << r.exit_status
+          << ", |f| = 0 "
+          << (r.output.find("|f| = 0 N") != std::string::npos ? "yes" : "NO")
+          << ", said "
+          << (r.output.find("the sphere does not touch the surface") !=
+                  std::string::npos ?
+                "yes" :
+                "NO")
+          << std::endl;
 }
