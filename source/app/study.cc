@@ -57,9 +57,10 @@ namespace palpate
      * only a name), with its input and output /dev/null, for at most
      * 120 s and until @p stop is asked for: a plot that hangs (a stalled
      * back end, a file on a dead mount) must not keep the study from
-     * ending. Whether it succeeded.
+     * ending. Its exit status: 0 drawn, 124 cut at 120 s, 127 not
+     * started, -1 stopped.
      */
-    bool
+    int
     run_plot_script(const std::string &script,
                     const std::string &csv,
                     const std::string &png,
@@ -81,7 +82,7 @@ namespace palpate
         &child, "timeout", &actions, nullptr, argv.data(), environ);
       posix_spawn_file_actions_destroy(&actions);
       if (spawned != 0)
-        return false;
+        return 127;
       // A stop signal meanwhile ends the plot (timeout passes SIGTERM on
       // to python) instead of waiting out its time limit.
       int status = 0;
@@ -91,17 +92,17 @@ namespace palpate
           if (done == child)
             break;
           if (done < 0 && errno != EINTR)
-            return false;
+            return 127;
           if (stop.signal_number() != 0)
             {
               ::kill(child, SIGTERM);
               while (waitpid(child, &status, 0) < 0 && errno == EINTR)
                 {}
-              return false;
+              return -1;
             }
           std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
-      return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     }
 
     using Point3 = Utilities::Point3;
@@ -1598,26 +1599,42 @@ namespace palpate
         if (result.stop_signal != 0 || stop->signal_number() != 0)
           out << "No Pareto plot: the study was stopped; to draw it, run "
               << by_hand << "\n";
-        else if (std::filesystem::exists(script) &&
-                 run_plot_script(script.string(), result.csv_file, png, *stop))
-          {
-            result.plot_file = png.string();
-            out << "The Pareto plot (force error against speed): "
-                << result.plot_file << "\n";
-          }
-        else if (stop->signal_number() != 0)
-          {
-            // Stopped while drawing: the study ends as stopped.
-            result.stopped     = "stopped by " + stop->description();
-            result.stop_signal = stop->signal_number();
-            out << "No Pareto plot: the study was stopped while drawing it; "
-                   "to draw it, run "
-                << by_hand << "\n";
-          }
         else
-          out << "No Pareto plot: it needs python3 with matplotlib (Debian: "
-                 "apt install python3-matplotlib); then run "
-              << by_hand << "\n";
+          {
+            const int status =
+              std::filesystem::exists(script) ?
+                run_plot_script(script.string(), result.csv_file, png, *stop) :
+                127;
+            if (status == 0)
+              {
+                result.plot_file = png.string();
+                out << "The Pareto plot (force error against speed): "
+                    << result.plot_file << "\n";
+              }
+            else if (stop->signal_number() != 0)
+              {
+                // Stopped while drawing: the study ends as stopped.
+                result.stopped     = "stopped by " + stop->description();
+                result.stop_signal = stop->signal_number();
+                out << "No Pareto plot: the study was stopped while drawing "
+                       "it; to draw it, run "
+                    << by_hand << "\n";
+              }
+            else
+              out << "No Pareto plot: "
+                  << (status == 124 ?
+                        std::string("the plotting script took more than "
+                                    "120 s") :
+                      status == 127 ?
+                        std::string("python3 or the plotting script was not "
+                                    "found") :
+                        "the plotting script failed (exit status " +
+                          std::to_string(status) + ")")
+                  << "; it needs python3 with matplotlib (Debian: apt install "
+                     "python3-matplotlib) and room for the PNG beside the "
+                     "CSV. To see why, run "
+                  << by_hand << "\n";
+          }
       }
 
       std::ostream                    &out;
