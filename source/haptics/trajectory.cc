@@ -417,6 +417,26 @@ namespace palpate
                          " m (0.1 mm) of motion are needed for the force to "
                          "change",
                        "record a motion, with the positions in metres.");
+    // Times in milliseconds read as seconds: a 2 s stroke of 2,000 lines
+    // ran as 1,999 s at micrometres per second with no word (the twelfth
+    // re-run). A hand that palpates moves millimetres to centimetres per
+    // second; a long recording averaging under 0.1 mm/s is a unit slip.
+    double path = 0;
+    for (std::size_t k = 1; k < points.size(); ++k)
+      path += Utilities::distance(points[k], points[k - 1]);
+    if (times.back() > 60 && path / times.back() < 1e-4)
+      throw InputError(filename,
+                       0,
+                       "trajectory replay (Haptics / Trajectory / File name)",
+                       "the recording lasts " +
+                         Utilities::to_string(times.back(), 4) +
+                         " s and moves " + Utilities::to_string(path, 3) +
+                         " m, " +
+                         Utilities::to_string(1000 * path / times.back(), 3) +
+                         " mm/s on average: a hand that palpates moves "
+                         "millimetres to centimetres per second",
+                       "give the times in seconds (times in milliseconds "
+                       "divided by 1000).");
   }
 
 

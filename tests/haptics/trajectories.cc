@@ -148,6 +148,15 @@ main(int argc, char **argv)
   try_replay("not-increasing.csv",
              "0, 0, 0, 0\n0.1, 0, 0, 0.001\n0.1, 0, 0, 0.002\n");
   try_replay("empty.csv", "t,x,y,z\n");
+  {
+    // A 2 s stroke of 14 mm recorded at 1 kHz with the times in
+    // milliseconds: read as 1,999 s at 7 micrometres per second.
+    std::string milliseconds = "t,x,y,z\n";
+    for (unsigned int k = 0; k < 2000; ++k)
+      milliseconds +=
+        std::to_string(k) + "," + std::to_string(-0.014 * k / 1999) + ",0,0\n";
+    try_replay("milliseconds.csv", milliseconds);
+  }
   try
     {
       palpate::Replay replay("no-such-file.csv");
