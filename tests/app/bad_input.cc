@@ -209,6 +209,21 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = ms.csv\n  end\nend\n");
+  {
+    // Two hours of strokes at 5 mm/s: a real motion, but longer than the
+    // loop preallocates for.
+    std::string two_hours = "t, x, y, z\n";
+    for (unsigned int k = 0; k <= 7200; ++k)
+      two_hours +=
+        std::to_string(k) + ", 0, 0, " + (k % 2 == 0 ? "0" : "-0.005") + "\n";
+    write_file("two-hours.csv", two_hours);
+  }
+  scene("a replay recording of two hours",
+        "replay-two-hours.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = two-hours.csv\n  "
+          "end\nend\n");
   write_file("far.csv", "t, x, y, z\n0, 0, 0, 0\n1, 0, 0, 1e308\n");
   scene("a replay position at 1e308 m",
         "replay-far.prm",

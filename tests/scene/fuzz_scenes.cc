@@ -309,8 +309,16 @@ main(int argc, char **argv)
                         << ": NOT an input error: " << e.what() << std::endl;
               }
           }
-        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(2))
-          ++c.slow;
+        if (const std::chrono::duration<double> took =
+              std::chrono::steady_clock::now() - start;
+            took > std::chrono::seconds(2))
+          {
+            ++c.slow;
+            // Which one, to look at (printed only when this fails).
+            std::lock_guard<std::mutex> lock(log_mutex);
+            deallog << "mutant " << i << " of " << names[origin[i]] << " took "
+                    << took.count() << " s" << std::endl;
+          }
       }
     std::filesystem::remove(file);
   };
