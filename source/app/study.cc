@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -67,7 +68,7 @@ namespace palpate
                     const StopRequest &stop)
     {
       std::vector<std::string> words = {
-        "timeout", "120", "/usr/bin/python3", script, csv, png};
+        "timeout", "-k", "5", "120", "/usr/bin/python3", script, csv, png};
       std::vector<char *> argv;
       for (auto &w : words)
         argv.push_back(w.data());
@@ -77,10 +78,17 @@ namespace palpate
       posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
       posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
       posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+      // In a process group of its own, so that a plot that ignores
+      // SIGTERM can be ended with everything it started.
+      posix_spawnattr_t attributes;
+      posix_spawnattr_init(&attributes);
+      posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+      posix_spawnattr_setpgroup(&attributes, 0);
       pid_t     child   = 0;
       const int spawned = posix_spawnp(
-        &child, "timeout", &actions, nullptr, argv.data(), environ);
+        &child, "timeout", &actions, &attributes, argv.data(), environ);
       posix_spawn_file_actions_destroy(&actions);
+      posix_spawnattr_destroy(&attributes);
       if (spawned != 0)
         return 127;
       // A stop signal meanwhile ends the plot (timeout passes SIGTERM on
@@ -95,7 +103,15 @@ namespace palpate
             return 127;
           if (stop.signal_number() != 0)
             {
-              ::kill(child, SIGTERM);
+              // SIGTERM, and after 2 s SIGKILL to the whole group (a plot
+              // that ignored SIGTERM hung the study for good: the
+              // thirteenth re-run).
+              ::kill(-child, SIGTERM);
+              for (unsigned int k = 0;
+                   k < 100 && waitpid(child, &status, WNOHANG) == 0;
+                   ++k)
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+              ::kill(-child, SIGKILL);
               while (waitpid(child, &status, 0) < 0 && errno == EINTR)
                 {}
               return -1;
@@ -968,20 +984,47 @@ namespace palpate
                                  "file: the study writes its table there "
                                  "and the Pareto plot reads it back",
                                "name a regular file, e.g. --csv study.csv.");
+            // Nor is a PNG beside it that this plot did not draw (its
+            // Software text chunk says "palpate study").
+            if (std::filesystem::path png =
+                  std::filesystem::path(result.csv_file)
+                    .replace_extension(".png");
+                options.plot && std::filesystem::exists(png, error))
+              {
+                std::ifstream in(png, std::ios::binary);
+                std::string   head(65536, '\0');
+                in.read(head.data(), head.size());
+                head.resize(in.gcount());
+                if (head.find("palpate study") == std::string::npos)
+                  refuse("the Pareto plot would be written to '" +
+                           png.string() +
+                           "', which exists and is not a plot of a study",
+                         "name the CSV so that its .png is free, e.g. --csv "
+                         "study.csv, or remove that file first.");
+              }
             // A file of the user's (the scene, its mesh) is not a table
             // to overwrite: only one a study wrote is.
             if (std::filesystem::is_regular_file(status))
               {
-                std::ifstream in(result.csv_file);
-                std::string   first;
-                std::getline(in, first);
-                if (!first.empty() && first != csv_header)
-                  refuse("'" + result.csv_file +
-                           "' exists and is not a study's table (it begins '" +
-                           first.substr(0, 40) +
-                           "'): the study would overwrite it",
-                         "name a new file, e.g. --csv study.csv, or remove "
-                         "this one first if it is no longer needed.");
+                // Its first bytes only (a large file without a newline
+                // was read whole); printable, to quote them.
+                std::ifstream in(result.csv_file, std::ios::binary);
+                std::string   head(4096, '\0');
+                in.read(head.data(), head.size());
+                head.resize(in.gcount());
+                if (!head.empty() && head.rfind(csv_header, 0) != 0)
+                  {
+                    std::string begins = head.substr(0, 40);
+                    for (char &ch : begins)
+                      if (!std::isprint(static_cast<unsigned char>(ch)))
+                        ch = ' ';
+                    refuse("'" + result.csv_file +
+                             "' exists and is not a study's table (it "
+                             "begins '" +
+                             begins + "'): the study would overwrite it",
+                           "name a new file, e.g. --csv study.csv, or remove "
+                           "this one first if it is no longer needed.");
+                  }
               }
             if (std::filesystem::is_directory(status))
               throw InputError(

@@ -645,14 +645,12 @@ namespace palpate
       const bool        only_deep = R >= 2 * hole && longest <= 1.5 * R;
       const std::string problem =
         sphere_problem(R, hole, longest, depth, margin, midpoints);
-      // The push this sphere takes: to deepest_push radii if it clears the
-      // checks by the margin, else to its radius (a 4 mm sphere was
-      // offered "a push no longer than its diameter", then refused for
-      // the margin: the twelfth re-run).
-      const bool clears_margin =
-        R >= margin * 2 * hole && margin * longest <= 1.5 * R;
-      const double shallow_enough =
-        std::floor((clears_margin ? deepest_push * R : R) * 1e4) / 1e4;
+      // The push this sphere takes: its radius, which needs no margin (a
+      // 4 mm sphere was offered "a push no longer than its diameter", then
+      // refused for the margin: the twelfth re-run; 6 mm pushed the 1.7
+      // radii it clears were failure points at Node ids 40 and 41: the
+      // thirteenth).
+      const double shallow_enough = std::floor(R * 1e4) / 1e4;
       throw scene.error(
         "Boundary conditions/Active node/Tip radius",
         "a sphere of " + Utilities::to_string(R, 3) + " m radius " + problem,

@@ -1695,17 +1695,24 @@ namespace palpate
                     "about 1,000-1,100",
                   "use 1060 (liver) or your tissue's density in kg/m^3.");
     if (p.material_model.density > 0 && p.material_model.density < min_density)
-      throw error("Material model/Density",
-                  "0 (weightless) or at least " +
-                    Utilities::to_string(min_density, 3) +
-                    " kg/m^3: the density is in kg/m^3 and tissue's is "
-                    "about 1,000-1,100 (lung about 300); " +
-                    Utilities::to_string(p.material_model.density, 4) +
-                    " looks like g/cm^3, which would make gravity a "
-                    "thousand times too weak",
-                  "use " +
-                    Utilities::to_string(1000 * p.material_model.density, 4) +
-                    " if you meant g/cm^3 (1060 is liver).");
+      {
+        const double rho = p.material_model.density;
+        // g/cm^3 only where that reading gives a tissue's density.
+        const bool in_g_per_cm3 = rho >= 0.2 && rho <= 2;
+        throw error(
+          "Material model/Density",
+          "0 (weightless) or at least " + Utilities::to_string(min_density, 3) +
+            " kg/m^3: the density is in kg/m^3 and tissue's is "
+            "about 1,000-1,100 (lung about 300)" +
+            (in_g_per_cm3 ? "; " + Utilities::to_string(rho, 4) +
+                              " looks like g/cm^3, which would make gravity a "
+                              "thousand times too weak" :
+                            std::string()),
+          in_g_per_cm3 ? "use " + Utilities::to_string(1000 * rho, 4) +
+                           " if you meant g/cm^3 (1060 is liver)." :
+                         "use 1060 (liver) or your tissue's density in "
+                         "kg/m^3.");
+      }
   }
 
 

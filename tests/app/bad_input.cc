@@ -582,6 +582,10 @@ main(int argc, char **argv)
       "study good.prm --quick --csv good.prm");
   run("a study CSV named .png (the plot would overwrite it)",
       "study good.prm --quick --csv study.png");
+  write_file("photo.png", "not a plot\n");
+  run("a study CSV whose .png beside it is not a plot (it would be "
+      "overwritten)",
+      "study good.prm --quick --csv photo.csv");
   run("a study CSV in a 'directory' that is a file",
       "study good.prm --quick --csv good.prm/study.csv");
   run("a study CSV in a directory that is a loop of links",
