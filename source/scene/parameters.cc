@@ -455,12 +455,15 @@ namespace palpate
           "sphere (Tip = sphere). Must be 0 for Tip = point. The contact "
           "acts at nodes, so a sphere's radius must be at least twice the "
           "distance to the nearest surface node and two thirds of the "
-          "longest surface edge within two radii (with quadratic elements "
-          "the edge midpoints count), both by a margin of 1.7 (and on the "
-          "vertices) when the push into the body (Prescribed displacement, "
-          "solve's --to) is longer than the radius; and a sphere may be "
-          "pushed at most 1.7 radii deep. A refusal names the radius that "
-          "passes; an interaction whose trajectory goes deeper is warned.");
+          "longest surface edge within two radii of its path (with "
+          "quadratic elements the edge midpoints count), both by a margin "
+          "of 2.2 (and on the vertices) when pushed deeper than its radius; "
+          "and a sphere may be pushed at most 1.5 radii deep. The depth is "
+          "the push's component along the surface's inward normal at the "
+          "probe (Prescribed displacement, solve's --to, a trajectory's "
+          "deepest and farthest points); its sideways part slides the "
+          "frictionless sphere. A refusal names the radius that passes; an "
+          "interaction whose trajectory goes deeper is warned.");
       }
       prm.leave_subsection();
     }

@@ -132,10 +132,9 @@ subsection Haptics
 end
 )");
   r = run_palpate("deep-sphere.prm");
-  deallog
-    << "a trajectory deeper than the sphere's checks: "
-    << line_with(r.output, "the trajectory takes the sphere").substr(0, 160)
-    << std::endl;
+  deallog << "a trajectory deeper than the sphere's checks: "
+          << line_with(r.output, "the trajectory's point").substr(0, 200)
+          << std::endl;
 
   // A 10 cm cube's surface in millimetres, read as metres.
   palpate::Surface cube;

@@ -293,6 +293,48 @@ main(int argc, char **argv)
             << ok(refusal(liver).find("the tissue closes over the sphere") !=
                   std::string::npos)
             << std::endl;
+    // Only the push's inward part is its depth: the scene's 1 cm sphere
+    // moved 2 cm along x (4.3 mm in) was refused as "pushed 0.02 m deep",
+    // and solves at 0.308 N (the thirteenth re-run); 3 cm nearly along
+    // the surface, 0.09 mm in, was refused as closing the tissue over it.
+    liver.parameters.boundary_conditions.active_node.tip_radius = 0.01;
+    liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
+      {0.02, 0, 0}};
+    deallog << "  a 1 cm sphere moved 2 cm sideways: accepted "
+            << ok(refusal(liver).empty());
+    liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
+      {0.0292, 0, 0.0066}};
+    deallog << ", 3 cm along the surface: not refused as deep "
+            << ok(refusal(liver).find("deep") == std::string::npos)
+            << std::endl;
+  }
+  // At Node id 41 (edges up to 4.9 mm) a 6 mm sphere pushed 1.45 and 1.54
+  // radii along the normal was a failure point, 1.35 converged; 7.5 mm
+  // held 1.49 radii (the nineteenth session): deeper than its radius a
+  // sphere must clear the spacing by 2.2, and at most 1.5 radii.
+  {
+    palpate::Scene liver = shipped_scene("liver-indenter.prm");
+    auto          &a     = liver.parameters.boundary_conditions.active_node;
+    a.selection          = "node id";
+    a.node_id            = 41;
+    a.tip_radius         = 0.006;
+    // Its outward normal there: (-0.242, 0.332, 0.912).
+    const auto along = [&](const double depth) {
+      a.prescribed_displacement = {
+        {0.242 * depth, -0.332 * depth, -0.912 * depth}};
+    };
+    along(1.45 * 0.006);
+    const std::string refused = refusal(liver);
+    deallog << "a 6 mm sphere at node 41 pushed 1.45 radii: refused "
+            << ok(refused.find("pushed deeper than its radius") !=
+                  std::string::npos);
+    a.tip_radius = suggested(refused);
+    deallog << ", the radius it names (" << a.tip_radius
+            << " m) is accepted: " << ok(refusal(liver).empty());
+    a.tip_radius = 0.006;
+    along(0.9 * 0.006);
+    deallog << "; pushed 0.9 radii: accepted " << ok(refusal(liver).empty())
+            << std::endl;
   }
   // Taylor-Hood has quadratic displacements whatever Polynomial degree
   // says: its edge midpoints are contact nodes, and the refusal must not

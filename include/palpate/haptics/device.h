@@ -80,6 +80,17 @@ namespace palpate
       return {{0, 0, 0}};
     }
 
+    /** The planned displacement from rest that goes farthest against
+     * @p outward (a unit normal: the deepest into the body), where the
+     * motion is known in advance; zero if not. A circle's deepest point
+     * need not be its farthest (the thirteenth re-run). */
+    virtual Utilities::Point3
+    planned_deepest(const Utilities::Point3 &outward) const
+    {
+      (void)outward;
+      return {{0, 0, 0}};
+    }
+
     /** One line for reports. */
     virtual std::string
     description() const = 0;

@@ -74,6 +74,18 @@ namespace palpate
      */
     static NodeSelection
     create(const Scene &scene, const Mesh &mesh);
+
+    /**
+     * Ask a sphere tip's checks (Tip = sphere: that it meets the surface
+     * nodes, with a margin when pushed deeper than its radius, and is not
+     * pushed deeper than the tissue lets it) for the push @p push instead
+     * of the scene's Prescribed displacement; the fixed nodes are not
+     * selected again. Throws the InputError create() would.
+     */
+    static void
+    check_sphere_push(const Scene             &scene,
+                      const Mesh              &mesh,
+                      const Utilities::Point3 &push);
   };
 } // namespace palpate
 

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace palpate
 {
@@ -30,9 +31,11 @@ namespace palpate
         // How far it goes from rest along any axis, for the report, and
         // its farthest point.
         const double T = this->trajectory->duration();
+        planned.reserve(1001);
         for (unsigned int k = 0; k <= 1000; ++k)
           {
             const auto x = this->trajectory->position(T * k / 1000);
+            planned.push_back(x);
             for (const double c : x)
               reach = std::max(reach, std::abs(c));
             if (Utilities::norm(x) > Utilities::norm(farthest))
@@ -101,6 +104,16 @@ namespace palpate
         return farthest;
       }
 
+      Utilities::Point3
+      planned_deepest(const Utilities::Point3 &outward) const override
+      {
+        Utilities::Point3 deepest = {{0, 0, 0}};
+        for (const auto &x : planned)
+          if (Utilities::dot(x, outward) < Utilities::dot(deepest, outward))
+            deepest = x;
+        return deepest;
+      }
+
       std::string
       description() const override
       {
@@ -111,6 +124,8 @@ namespace palpate
       std::unique_ptr<Trajectory> trajectory;
       double                      reach    = 0;
       Utilities::Point3           farthest = {{0, 0, 0}};
+      /** The motion, sampled at 1,001 times (set-up only). */
+      std::vector<Utilities::Point3> planned;
     };
   } // namespace
 
