@@ -725,7 +725,10 @@ namespace palpate
           else if (args[i] == "--finer-mesh" && has_value)
             options.finer_mesh = args[++i];
           else if (args[i] == "--csv" && has_value)
-            options.csv_file = args[++i];
+            {
+              options.csv_file  = args[++i];
+              options.csv_given = true;
+            }
           else if (args[i] == "--time-limit" && has_value)
             options.time_limit =
               number_argument("--time-limit", args[++i], 1, 7 * 86400, "600");
@@ -794,6 +797,46 @@ namespace palpate
 
 
 
+    /**
+     * ", did you mean 'solve'?" for a word at most two edits (Levenshtein)
+     * from a command, else nothing.
+     */
+    std::string
+    nearest_command(const std::string &word)
+    {
+      std::string best;
+      std::size_t best_distance = 3;
+      for (const std::string command :
+           {"solve", "study", "precompute", "serve", "mesh"})
+        {
+          std::vector<std::size_t> row(command.size() + 1);
+          for (std::size_t j = 0; j <= command.size(); ++j)
+            row[j] = j;
+          for (std::size_t i = 1; i <= word.size(); ++i)
+            {
+              std::size_t diagonal = row[0];
+              row[0]               = i;
+              for (std::size_t j = 1; j <= command.size(); ++j)
+                {
+                  const std::size_t above = row[j];
+                  row[j] =
+                    std::min({row[j] + 1,
+                              row[j - 1] + 1,
+                              diagonal + (word[i - 1] != command[j - 1])});
+                  diagonal = above;
+                }
+            }
+          if (row.back() < best_distance)
+            {
+              best_distance = row.back();
+              best          = command;
+            }
+        }
+      return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+    }
+
+
+
     int
     dispatch(const std::vector<std::string> &args,
              const std::vector<std::string> &settings,
@@ -853,6 +896,20 @@ namespace palpate
         return run_precompute_command(args, settings, out);
       if (args[0] == "study")
         return run_study_command(args, settings, out);
+      // "palpate slove scene.prm" blamed the scene as an unexpected
+      // argument (the thirteenth re-run): a first word that is no file,
+      // followed by more, is a command mistyped.
+      if (args.size() > 1 && args[0].find('/') == std::string::npos &&
+          std::filesystem::path(args[0]).extension() != ".prm" &&
+          !std::filesystem::exists(args[0]))
+        throw InputError("command line",
+                         0,
+                         args[0],
+                         "unknown command '" + args[0] + "'",
+                         "the commands are solve, study, precompute, serve "
+                         "and mesh" +
+                           nearest_command(args[0]) +
+                           "; a scene alone runs as 'palpate SCENE.prm'.");
       if (args.size() > 1)
         throw InputError("command line",
                          0,

@@ -10,6 +10,7 @@
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state.h>
+#include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
@@ -187,6 +188,10 @@ namespace palpate
       void
       warn_if_sphere_too_small_for_the_motion() const;
 
+      /** Refuses a planned motion longer than the body is across. */
+      void
+      check_motion_fits_the_body() const;
+
       /** Attach, start the loop, wait for the initial cloud and run the
        * motion, reporting events as they happen, until its end or a stop
        * signal. */
@@ -277,8 +282,9 @@ namespace palpate
       duration = std::min(device->max_duration(), Limits::max_motion_duration);
       // How far the device's planned motion takes the probe from rest,
       // along any axis: beyond the grid's extent the force fades to zero.
-      reach                    = device->planned_reach();
-      interaction              = std::make_unique<Interaction>(scene);
+      reach       = device->planned_reach();
+      interaction = std::make_unique<Interaction>(scene);
+      check_motion_fits_the_body();
       const double max_seconds = wait_limit + duration + 1;
       loop                     = std::make_unique<HapticLoop>(*interaction,
                                           *device,
@@ -326,6 +332,35 @@ namespace palpate
 
 
     void
+    InteractionRun::check_motion_fits_the_body() const
+    {
+      // A motion farther from rest than the body is across is a unit
+      // mistake (a recording in millimetres read as metres), as solve's
+      // --to says of such a push: a replay moving 0.9 m over a 0.36 m
+      // liver ran with only the state space's warning (the thirteenth
+      // re-run).
+      const auto  &farthest = device->planned_farthest();
+      const double length   = std::hypot(farthest[0], farthest[1], farthest[2]);
+      const double size     = interaction->mesh().diameter();
+      if (!(length > size))
+        return;
+      const bool replay = p.haptics.trajectory.type == "replay";
+      throw scene.error(
+        replay ? "Haptics/Trajectory/File name" : "Haptics/Trajectory/Speed",
+        "the trajectory moves the probe " + Utilities::to_string(length, 3) +
+          " m from rest, more than the body is across (" +
+          Utilities::to_string(size, 3) + " m, its bounding box's diagonal)",
+        replay ? "give the recording's positions in metres "
+                 "(a recording in millimetres is 1000 times "
+                 "too far)." :
+                 "shorten the motion (Speed in m/s times Duration in s, "
+                 "or Radius) to stay within the body; a hand moves at "
+                 "0.01 - 0.1 m/s.");
+    }
+
+
+
+    void
     InteractionRun::warn_if_sphere_too_small_for_the_motion() const
     {
       // The sphere's set-up checks weighed the scene's Prescribed
@@ -333,27 +368,38 @@ namespace palpate
       // again at its farthest point: where they fail, the sphere may go
       // between the surface nodes, those states are failure points and
       // the force is held there (the summary counts it).
-      const auto &a        = p.boundary_conditions.active_node;
-      const auto  farthest = device->planned_farthest();
-      if (a.tip != Parameters::ActiveNode::Tip::sphere ||
-          !(Utilities::norm(farthest) >
-            std::max(Utilities::norm(a.prescribed_displacement), a.tip_radius)))
+      const auto &a = p.boundary_conditions.active_node;
+      if (a.tip != Parameters::ActiveNode::Tip::sphere)
         return;
-      Scene deeper = scene;
-      deeper.parameters.boundary_conditions.active_node
-        .prescribed_displacement = farthest;
-      try
+      // Its farthest point drags the sphere farthest along the surface,
+      // its deepest presses it deepest (a circle's need not be the same).
+      const auto &outward = interaction->nodes().active_normal;
+      for (const auto &[point, what] :
+           {std::make_pair(device->planned_farthest(), "farthest from rest"),
+            std::make_pair(device->planned_deepest(outward),
+                           "deepest into the body")})
         {
-          NodeSelection::create(deeper, interaction->mesh());
-        }
-      catch (const InputError &e)
-        {
-          out << "  warning:       the trajectory takes the sphere "
-              << 1000 * Utilities::norm(farthest)
-              << " mm from rest, deeper than the set-up checks weighed: "
-              << e.problem()
-              << "; the force is held at such states. To avoid it: " << e.fix()
-              << "\n";
+          if (point == a.prescribed_displacement ||
+              !(Utilities::norm(point) > 0))
+            continue;
+          try
+            {
+              NodeSelection::check_sphere_push(scene,
+                                               interaction->mesh(),
+                                               point);
+            }
+          catch (const InputError &e)
+            {
+              out << "  warning:       the trajectory's point " << what << " ("
+                  << 1000 * Utilities::norm(point) << " mm from rest, "
+                  << -1000 * Utilities::dot(point, outward)
+                  << " mm into the body) fails the set-up checks that "
+                     "weighed the Prescribed displacement: the sphere "
+                  << e.problem().substr(e.problem().find(" radius ") + 8)
+                  << "; the force is held at such states. To avoid it: "
+                  << e.fix() << "\n";
+              return;
+            }
         }
     }
 

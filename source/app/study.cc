@@ -921,7 +921,7 @@ namespace palpate
       check_csv_file()
       {
         result.csv_file = options.csv_file;
-        if (!result.csv_file.empty())
+        if (options.csv_given || !result.csv_file.empty())
           {
             namespace fs      = std::filesystem;
             const auto refuse = [&](const std::string &problem,
@@ -929,6 +929,31 @@ namespace palpate
               throw InputError(
                 "command line", 0, "--csv " + result.csv_file, problem, fix);
             };
+            // Names that do not say a file: the default name was used for
+            // an empty one, a file named "-" made for standard output,
+            // and "x.csv/" refused as a missing directory (the thirteenth
+            // re-run).
+            if (result.csv_file.empty())
+              refuse("the file name is empty",
+                     "name the table, e.g. --csv study.csv, or leave --csv "
+                     "out to write it to Output / Directory.");
+            if (result.csv_file == "-")
+              refuse("the study cannot write its table to standard output: "
+                     "the Pareto plot reads it back from a file",
+                     "name a file, e.g. --csv study.csv.");
+            if (result.csv_file.back() == '/')
+              refuse("the name ends in '/', so it names a directory, not "
+                     "a file",
+                     "give the CSV file's name, e.g. --csv " +
+                       (fs::path(result.csv_file) / "study.csv").string() +
+                       ".");
+            // A link to nowhere: the table would be made wherever it
+            // points, or fail after the whole study.
+            if (const std::string link = dangling_link(result.csv_file);
+                !link.empty())
+              refuse(link,
+                     "name another file, or remove the link (rm '" +
+                       result.csv_file + "') first.");
             // The plot is written beside the CSV, its name ending in .png.
             if (fs::path(result.csv_file).extension() == ".png")
               refuse("the Pareto plot is written beside the table under the "
@@ -941,6 +966,11 @@ namespace palpate
               {
                 std::error_code error;
                 const auto      status = fs::status(parent, error);
+                if (const std::string link = dangling_link(parent.string());
+                    !link.empty())
+                  refuse("its directory " + link,
+                         "make the link's target, or name a file in a "
+                         "directory that exists.");
                 if (status.type() == fs::file_type::not_found)
                   refuse("its directory '" + parent.string() +
                            "' does not exist",
@@ -1635,9 +1665,18 @@ namespace palpate
           "accuracy_pareto.py";
         std::filesystem::path png(result.csv_file);
         png.replace_extension(".png");
-        const std::string by_hand = "python3 '" + script.string() + "' '" +
-                                    result.csv_file + "' '" + png.string() +
-                                    "'";
+        // Quoted for a shell, as the user will paste it: a name with an
+        // apostrophe broke the command, and a scene's Output / Directory
+        // of ';touch PWNED;' ran one when pasted (the thirteenth re-run).
+        const auto quoted = [](const std::string &word) {
+          std::string q = "'";
+          for (const char c : word)
+            q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+          return q + "'";
+        };
+        const std::string by_hand = "python3 " + quoted(script.string()) + " " +
+                                    quoted(result.csv_file) + " " +
+                                    quoted(png.string());
         // After a stop signal the user wants the run to end: no plot.
         if (result.stop_signal != 0 || stop->signal_number() != 0)
           out << "No Pareto plot: the study was stopped; to draw it, run "
@@ -1669,8 +1708,8 @@ namespace palpate
                         std::string("the plotting script took more than "
                                     "120 s") :
                       status == 127 ?
-                        std::string("python3 or the plotting script was not "
-                                    "found") :
+                        std::string("python3, timeout (coreutils) or the "
+                                    "plotting script was not found") :
                         "the plotting script failed (exit status " +
                           std::to_string(status) + ")")
                   << "; it needs python3 with matplotlib (Debian: apt install "

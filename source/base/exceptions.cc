@@ -108,10 +108,32 @@ namespace palpate
       *missing = none;
     if (fd >= 0)
       return "";
+    if (const std::string link = dangling_link(file); none && !link.empty())
+      return "it " + link.substr(link.find("' is ") + 2);
     return none                ? "it does not exist" :
            why == EACCES       ? "it is not readable (permissions)" :
            why == ELOOP        ? "it is a loop of symbolic links" :
            why == ENAMETOOLONG ? "the path is longer than the system allows" :
                                  std::strerror(why);
+  }
+
+
+
+  std::string
+  dangling_link(const std::string &path)
+  {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    // A trailing slash would make the system follow the link.
+    fs::path plain(path);
+    while (plain.has_relative_path() && !plain.has_filename())
+      plain = plain.parent_path();
+    // A loop of links is not "not_found" (ELOOP), and is said as a loop.
+    if (!fs::is_symlink(fs::symlink_status(plain, error)) ||
+        fs::status(plain, error).type() != fs::file_type::not_found)
+      return "";
+    const fs::path target = fs::read_symlink(plain, error);
+    return "'" + plain.string() + "' is a symbolic link to '" +
+           target.string().substr(0, 300) + "', which does not exist";
   }
 } // namespace palpate

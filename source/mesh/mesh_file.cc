@@ -1744,13 +1744,20 @@ namespace palpate
     // std::filesystem's throwing forms would report a path that cannot be
     // examined (a symbolic link loop, a directory on the way that may not
     // be searched) as a std::filesystem_error, not as bad input.
+    // Why it cannot be opened is said as every reader says it (a loop of
+    // links is no missing file, a link to nowhere names its target).
+    bool              missing = false;
+    const std::string why     = why_cannot_open(filename, &missing);
+    if (missing)
+      throw InputError(filename,
+                       0,
+                       "mesh file",
+                       "the file " + why.substr(why.find(' ') + 1),
+                       "check the path.");
+    if (!why.empty())
+      throw unreadable(filename, why);
     std::error_code       ec;
     const fs::file_status status = fs::status(filename, ec);
-    if (status.type() == fs::file_type::not_found)
-      throw InputError(
-        filename, 0, "mesh file", "the file does not exist", "check the path.");
-    if (ec)
-      throw unreadable(filename, ec.message());
     if (fs::is_directory(status))
       {
         std::vector<std::string> meshes;

@@ -1155,6 +1155,10 @@ namespace palpate
                                         ", ") +
           ("'" + (error ? candidates[i] : shown.lexically_normal().string()) +
            "'");
+        // A link to nowhere is there: what is missing is its target.
+        if (const std::string link = dangling_link(candidates[i]);
+            !link.empty())
+          text += " (" + link.substr(link.find("' is ") + 5) + ")";
       }
     return text;
   }

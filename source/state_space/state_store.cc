@@ -594,9 +594,22 @@ namespace palpate
                     "there is no store at this path",
                     "name an existing store, or make one with palpate "
                     "precompute SCENE.prm.");
+      // A link to nowhere was replaced by a regular store, and its target
+      // never made (the thirteenth re-run).
+      if (const std::string link = dangling_link(path.string()); !link.empty())
+        store_error(file,
+                    link,
+                    "name the store by the link's target instead (in a "
+                    "directory that exists), or remove the link (rm '" +
+                      path.string() + "') to make the store here.");
       std::error_code error;
       const fs::path  dir =
         path.has_parent_path() ? path.parent_path() : fs::path(".");
+      if (const std::string link = dangling_link(dir.string()); !link.empty())
+        store_error(file,
+                    "its directory " + link,
+                    "make the link's target, or name a store in a "
+                    "directory that exists.");
       const fs::file_status d = fs::status(dir, error);
       if (d.type() == fs::file_type::not_found)
         store_error(file,

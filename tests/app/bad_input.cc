@@ -236,6 +236,18 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = mm.csv\n  end\nend\n");
+  write_file("metres-far.csv", "t, x, y, z\n0, 0, 0, 0\n30, 0, 0, -0.9\n");
+  scene("a replay moving 0.9 m over a 10 cm beam (a unit mistake)",
+        "replay-beyond.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = metres-far.csv\n  "
+          "end\nend\n");
+  scene("a straight line of 0.5 m over a 10 cm beam",
+        "line-beyond.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Speed = 0.05\n    set Duration = 10\n  end\nend\n");
   scene("Engine / Workers = 1000 (once: accepted, 1,400 deadline misses)",
         "workers.prm",
         beam + "subsection Engine\n  set Workers = 1000\nend\n");
@@ -597,6 +609,7 @@ main(int argc, char **argv)
       "solve good.prm --to 0,0,-0.01 --to 0,0,-0.02");
   run("'serve --port' given twice", "serve good.prm --port 8080 --port 8081");
   run("an unexpected second argument", "good.prm other.prm");
+  run("a mistyped command", "slove good.prm");
   // Scene variants on the command line (--set): checked like a line of
   // the file, and named in the message.
   run("--set with a misspelled entry",
@@ -868,6 +881,29 @@ main(int argc, char **argv)
       "export=true' --to 0,0,-0.001");
   run("study --csv into a directory that does not exist",
       "study good.prm --quick --csv no-such-dir/study.csv");
+  // Links to nowhere (the thirteenth re-run): "does not exist, mkdir -p"
+  // was the wrong fix, and a store that was such a link was replaced.
+  std::filesystem::remove("gone-dir");
+  std::filesystem::create_symlink("no-such-target-dir", "gone-dir");
+  std::filesystem::remove("gone.csv");
+  std::filesystem::create_symlink("no-such-target.csv", "gone.csv");
+  std::filesystem::remove("gone.h5");
+  std::filesystem::create_symlink("no-such-target.h5", "gone.h5");
+  std::filesystem::remove("gone.prm");
+  std::filesystem::create_symlink("no-such-target.prm", "gone.prm");
+  run("study --csv in a directory that is a link to nowhere",
+      "study good.prm --quick --csv gone-dir/study.csv");
+  run("study --csv that is a link to nowhere",
+      "study good.prm --quick --csv gone.csv");
+  run("a state store that is a link to nowhere",
+      "precompute good.prm --set 'State space/Store=gone.h5'");
+  run("a state store in a directory that is a link to nowhere",
+      "precompute good.prm --set 'State space/Store=gone-dir/x.h5'");
+  run("a scene file that is a link to nowhere", "gone.prm");
+  run("study --csv with an empty name", "study good.prm --quick --csv ''");
+  run("study --csv - (standard output)", "study good.prm --quick --csv -");
+  run("study --csv naming a directory with a trailing slash",
+      "study good.prm --quick --csv new.csv/");
 
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;

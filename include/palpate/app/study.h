@@ -26,8 +26,11 @@ namespace palpate
      * the mesh knob is skipped.
      */
     std::string finer_mesh;
-    /** The CSV to write (empty: study-SCENE.csv in Output / Directory). */
+    /** The CSV to write (not given: study-SCENE.csv in Output /
+     * Directory). */
     std::string csv_file;
+    /** --csv was given (an empty name is refused, not the default). */
+    bool csv_given = false;
     /** Draw the Pareto plot (PNG next to the CSV) with the source tree's
      * doc/images/accuracy_pareto.py, if python3 and matplotlib are there. */
     bool plot = true;

@@ -118,6 +118,16 @@ namespace palpate
   why_cannot_open(const std::string &file, bool *missing = nullptr);
 
   /**
+   * If @p path is a symbolic link whose target does not exist, says so
+   * ("'a.h5' is a symbolic link to '/mnt/x/a.h5', which does not exist");
+   * otherwise an empty string. A writer that followed such a link would
+   * make a file somewhere else or fail at its end, and "does not exist,
+   * mkdir -p" would be the wrong fix: the path is there, its target is not.
+   */
+  std::string
+  dangling_link(const std::string &path);
+
+  /**
    * A capability that a scene asks for but that this version of palpate
    * does not have yet. Reported like an InputError, but it is not the
    * user's fault, so the message says which capability and where it is
