@@ -530,6 +530,9 @@ namespace palpate
                                       std::to_string(shape->frames().first) +
                                       " frames: " + shape->failure());
         }
+      // Stopped by a signal: the states in flight are not waited for.
+      if (stop_request && stop_request->requested())
+        interaction->abandon_running();
       interaction->detach();
       interaction->poll_events(out);
 

@@ -134,8 +134,10 @@ namespace palpate
     bool replan = false;
     // The bridge found nothing with this many tasks finished and the HIP
     // in this cell: do not scan the grid again until one changes.
-    BridgeMemory             bridge;
-    std::atomic<bool>        is_running{false};
+    BridgeMemory      bridge;
+    std::atomic<bool> is_running{false};
+    // A stop signal: the running solves give up (abandon_running()).
+    std::atomic<bool>        abandoning{false};
     bool                     started_once = false;
     std::vector<std::thread> workers;
     // Per worker: the point it solves (~0u: none; under the mutex), and
@@ -356,10 +358,12 @@ namespace palpate
         // real organ a state takes seconds, in which a hand moves
         // centimetres): the worker is free for the states the HIP now
         // needs. Asked at every Newton iteration.
-        solver.set_stop_check(
-          [left = left_behind(task), &flag = preempted[worker]] {
-            return flag.load(std::memory_order_relaxed) || left();
-          });
+        solver.set_stop_check([left     = left_behind(task),
+                               &flag    = preempted[worker],
+                               &abandon = abandoning] {
+          return flag.load(std::memory_order_relaxed) ||
+                 abandon.load(std::memory_order_relaxed) || left();
+        });
 
         // solve() reports numerical failures as failure points; anything
         // else that goes wrong (out of memory, a library error) must not
@@ -509,6 +513,7 @@ namespace palpate
       if (!s.started_once)
         s.t0 = Clock::now(); // task times count from the first attach
       s.started_once    = true;
+      s.abandoning      = false;
       s.failed          = false;
       s.is_running      = true;
       s.nothing_to_plan = false;
@@ -547,6 +552,14 @@ namespace palpate
     s.workers.clear();
     std::lock_guard<std::mutex> lock(s.mutex);
     s.queue.clear();
+  }
+
+
+
+  void
+  ThreadEngine::abandon_running()
+  {
+    impl->abandoning.store(true);
   }
 
 

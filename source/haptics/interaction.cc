@@ -264,6 +264,14 @@ namespace palpate
 
 
   void
+  Interaction::abandon_running()
+  {
+    impl->engine->abandon_running();
+  }
+
+
+
+  void
   Interaction::detach()
   {
     Impl                       &s = *impl;

@@ -184,8 +184,8 @@ namespace palpate
       << " % of the time\n"
       << "  scheduling:        " << tasks_dropped
       << " queued tasks dropped (left the cloud), " << tasks_cancelled
-      << " running states given up (the HIP moved away, or preempted for "
-         "a corner on its path), "
+      << " running states given up (the HIP moved away, preempted for a "
+         "corner on its path, or a stop signal), "
       << results_discarded << " results discarded (parameters changed)\n"
       << "  cache:             " << corner_hits << " of " << corner_reads
       << " corner reads found a state\n"

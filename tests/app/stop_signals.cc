@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -168,6 +169,37 @@ main()
             << ", force log and JSON written "
             << ok(force_log(dir + "/paper-stvk-forces.csv").second > 500 &&
                   std::filesystem::exists(dir + "/paper-stvk-summary.json"))
+            << std::endl;
+  }
+
+  // A stop in the initial cloud does not wait for the states being
+  // computed: they give up at their next Newton iteration (a SIGTERM in
+  // the graded liver's cloud waited 6 s for them, the thirteenth re-run).
+  // Here each state takes seconds (increments of 0.1 mm), so two are
+  // running when the signal comes, and the summary counts them given up.
+  {
+    start_afresh();
+    std::vector<std::string> slow = interaction;
+    slow.insert(slow.end(),
+                {"--set", "Nonlinear solver/Maximum increment length=0.0001"});
+    const pid_t pid     = start_palpate(slow, out, err);
+    const bool  waiting = wait_for_text(out, "grid points around the rest");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    kill(pid, SIGTERM);
+    const int         status = wait_status(pid);
+    const std::string text   = read_file(out);
+    const std::string json   = read_file(dir + "/paper-stvk-summary.json");
+    const auto        given  = json.find("\"tasks_cancelled\": ");
+    const int         given_up =
+      given == std::string::npos ?
+                -1 :
+                std::stoi(json.substr(given + std::strlen("\"tasks_cancelled\": ")));
+    deallog << "SIGTERM in the initial cloud: cloud started " << ok(waiting)
+            << ", exit status 143 " << ok(status == 143)
+            << ", before the motion "
+            << ok(line_with(text, "STOPPED:").find("before the motion") !=
+                  std::string::npos)
+            << ", the running states given up " << ok(given_up >= 1)
             << std::endl;
   }
 

@@ -108,6 +108,17 @@ namespace palpate
     virtual void
     stop() = 0;
 
+    /**
+     * Give up the states being computed at their next Newton iteration,
+     * so that the stop() after it returns within an iteration: on a stop
+     * signal the user wants the run to end, not the states in flight (a
+     * SIGTERM in the graded liver's initial cloud waited 6 s for them: the
+     * thirteenth re-run). Nothing of them is kept. By default they finish.
+     */
+    virtual void
+    abandon_running()
+    {}
+
     /** Whether start() has been called without stop(). */
     virtual bool
     running() const = 0;

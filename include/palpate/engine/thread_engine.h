@@ -52,6 +52,9 @@ namespace palpate
     void
     stop() override;
 
+    void
+    abandon_running() override;
+
     bool
     running() const override;
 

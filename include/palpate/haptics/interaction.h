@@ -75,6 +75,12 @@ namespace palpate
     void
     detach();
 
+    /** Before a detach() on a stop signal: the running tasks give up at
+     * their next Newton iteration instead of finishing
+     * (PrecomputationEngine::abandon_running()). */
+    void
+    abandon_running();
+
     /** Whether the HIP is attached. */
     bool
     attached() const noexcept;
