@@ -419,24 +419,34 @@ namespace palpate
                        "record a motion, with the positions in metres.");
     // Times in milliseconds read as seconds: a 2 s stroke of 2,000 lines
     // ran as 1,999 s at micrometres per second with no word (the twelfth
-    // re-run). A hand that palpates moves millimetres to centimetres per
-    // second; a long recording averaging under 0.1 mm/s is a unit slip.
-    double path = 0;
-    for (std::size_t k = 1; k < points.size(); ++k)
-      path += Utilities::distance(points[k], points[k - 1]);
-    if (times.back() > 60 && path / times.back() < 1e-4)
-      throw InputError(filename,
-                       0,
-                       "trajectory replay (Haptics / Trajectory / File name)",
-                       "the recording lasts " +
-                         Utilities::to_string(times.back(), 4) +
-                         " s and moves " + Utilities::to_string(path, 3) +
-                         " m, " +
-                         Utilities::to_string(1000 * path / times.back(), 3) +
-                         " mm/s on average: a hand that palpates moves "
-                         "millimetres to centimetres per second",
-                       "give the times in seconds (times in milliseconds "
-                       "divided by 1000).");
+    // re-run). A device records at 100 Hz - 1 kHz: a long recording whose
+    // lines are typically half a second or more apart is one in
+    // milliseconds (1 - 10 apart). An average speed said it less well: a
+    // 99 ms stroke written in ms ran as 99 s, and a slow 61 s recording
+    // in seconds was refused (the thirteenth re-run).
+    if (times.size() >= 100)
+      {
+        std::vector<double> steps(times.size() - 1);
+        for (std::size_t k = 1; k < times.size(); ++k)
+          steps[k - 1] = times[k] - times[k - 1];
+        std::nth_element(steps.begin(),
+                         steps.begin() + steps.size() / 2,
+                         steps.end());
+        const double median = steps[steps.size() / 2];
+        if (median >= 0.5)
+          throw InputError(
+            filename,
+            0,
+            "trajectory replay (Haptics / Trajectory / File name)",
+            "its " + std::to_string(times.size()) +
+              " positions are typically " + Utilities::to_string(median, 3) +
+              " s apart (a recording of " +
+              Utilities::to_string(times.back(), 4) +
+              " s): a haptic device records at 100 - 1000 Hz, so the "
+              "times look like milliseconds",
+            "give the times in seconds (times in milliseconds divided by "
+            "1000).");
+      }
   }
 
 

@@ -210,12 +210,15 @@ main(int argc, char **argv)
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = ms.csv\n  end\nend\n");
   {
-    // Two hours of strokes at 5 mm/s: a real motion, but longer than the
-    // loop preallocates for.
+    // Two hours of strokes at 5 mm/s, a position every 0.25 s: a real
+    // motion, but longer than the loop preallocates for.
     std::string two_hours = "t, x, y, z\n";
-    for (unsigned int k = 0; k <= 7200; ++k)
-      two_hours +=
-        std::to_string(k) + ", 0, 0, " + (k % 2 == 0 ? "0" : "-0.005") + "\n";
+    for (unsigned int k = 0; k <= 28800; ++k)
+      two_hours += std::to_string(0.25 * k) + ", 0, 0, " +
+                   (k % 4 == 0 ? "0" :
+                    k % 4 == 2 ? "-0.005" :
+                                 "-0.0025") +
+                   "\n";
     write_file("two-hours.csv", two_hours);
   }
   scene("a replay recording of two hours",
@@ -236,6 +239,20 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = mm.csv\n  end\nend\n");
+  {
+    // A 99 ms stroke written in milliseconds, a line per ms: it ran as a
+    // 99 s motion (the thirteenth re-run).
+    std::string ms = "t, x, y, z\n";
+    for (unsigned int k = 0; k < 100; ++k)
+      ms += std::to_string(k) + ", 0, 0, " + std::to_string(-0.0002 * k) + "\n";
+    write_file("short-ms.csv", ms);
+  }
+  scene("a 99 ms stroke with its times in milliseconds",
+        "replay-short-ms.prm",
+        interaction + beam_body +
+          "subsection Haptics\n  subsection Trajectory\n"
+          "    set Type = replay\n    set File name = short-ms.csv\n  "
+          "end\nend\n");
   write_file("metres-far.csv", "t, x, y, z\n0, 0, 0, 0\n30, 0, 0, -0.9\n");
   scene("a replay moving 0.9 m over a 10 cm beam (a unit mistake)",
         "replay-beyond.prm",

@@ -156,6 +156,15 @@ main(int argc, char **argv)
       milliseconds +=
         std::to_string(k) + "," + std::to_string(-0.014 * k / 1999) + ",0,0\n";
     try_replay("milliseconds.csv", milliseconds);
+    // A slow 61 s recording in seconds at 100 Hz (5 mm, 0.08 mm/s) is a
+    // motion: it was refused as milliseconds by its average speed.
+    std::string slow = "t,x,y,z\n";
+    for (unsigned int k = 0; k <= 6100; ++k)
+      slow += std::to_string(0.01 * k) + "," +
+              std::to_string(-0.005 * k / 6100) + ",0,0\n";
+    write_file("slow.csv", slow);
+    deallog << "slow.csv: a recording of "
+            << palpate::Replay("slow.csv").duration() << " s" << std::endl;
   }
   try
     {
