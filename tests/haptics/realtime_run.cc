@@ -170,9 +170,17 @@ end
         previous[d] = v[4 + d];
       ++rows;
     }
+  // A stall skips the deadlines that passed (no burst of catch-up ticks)
+  // and counts them as misses: under CI's load 2 % of the motion's ticks
+  // were once skipped so. Every tick that ran has its row.
   const double motion_ticks = number("motion_duration_s") * rate;
-  deallog << "force log: one row per tick of the motion (2 %): "
-          << (std::abs(rows / motion_ticks - 1) < 0.02 ? "yes" : "NO")
+  const double skipped      = number("deadline_misses");
+  deallog << "force log: one row per tick of the motion (2 %, less the "
+             "deadlines a stall skipped): "
+          << (rows < 1.02 * motion_ticks &&
+                  rows + skipped > 0.98 * motion_ticks ?
+                "yes" :
+                "NO")
           << ", times in (0, motion] and increasing: " << (clock ? "yes" : "NO")
           << ", all finite: " << (finite ? "yes" : "NO")
           << ", change per row <= 0.01 N: " << (smooth ? "yes" : "NO")
