@@ -200,6 +200,11 @@ namespace palpate
     void
     cancel_left_behind();
 
+    /** Send Kind::cancel for every running or queued task (a stop signal:
+     * abandon_running()). */
+    void
+    cancel_every_task();
+
     /** With @p waiting corners of the HIP's path that found no free
      * server: cancel as many running tasks that are no such corner, the
      * farthest from the path first (as the thread engine does); and the
@@ -227,7 +232,9 @@ namespace palpate
     // Which servers hold the whole state of each point (bit r-1 for rank
     // r), and which server computes it (its rank, or 0).
     std::vector<std::uint64_t> holders;
-    std::vector<int>           in_progress;
+    // A stop signal: cancel every task (abandon_running()).
+    std::atomic<bool> abandoning{false};
+    std::vector<int>  in_progress;
     // For each dispatched task: the distance from the HIP's predicted path
     // beyond which it is cancelled (left_behind()), and whether the cancel
     // was sent.
@@ -526,6 +533,21 @@ namespace palpate
           // Not sent (the server is being lost): its result never comes
           // either, and lose() plans the point again.
           limit.second = messenger.send(in_progress[point], pack(h));
+        }
+  }
+
+
+
+  void
+  MpiEngine::Impl::cancel_every_task()
+  {
+    for (unsigned int p = 0; p < in_progress.size(); ++p)
+      if (in_progress[p] != 0 && !cancel_limit[p].second)
+        {
+          Header h;
+          h.kind                 = Kind::cancel;
+          h.point                = p;
+          cancel_limit[p].second = messenger.send(in_progress[p], pack(h));
         }
   }
 
@@ -845,6 +867,10 @@ namespace palpate
               if (t >= next_tick)
                 next_tick = std::max(next_tick + period, t);
             }
+          // After abandon_running(), attached or not (stop() waits for
+          // the cancelled tasks' answers).
+          if (abandoning.exchange(false))
+            cancel_every_task();
           if (!attached && busy == 0)
             stopped.notify_all();
         }
@@ -924,6 +950,14 @@ namespace palpate
     s.attached = false;
     // Running tasks finish (their servers may also be lost meanwhile).
     s.stopped.wait(lock, [&s] { return s.busy == 0; });
+  }
+
+
+
+  void
+  MpiEngine::abandon_running()
+  {
+    impl->abandoning.store(true);
   }
 
 

@@ -57,6 +57,11 @@ namespace palpate
     void
     stop() override;
 
+    /** Cancels every task on the servers (Kind::cancel): a server gives a
+     * running solve up at its next Newton iteration. */
+    void
+    abandon_running() override;
+
     bool
     running() const override;
 
