@@ -778,7 +778,10 @@ namespace palpate
                          0,
                          "--finer-mesh " + options.finer_mesh,
                          "the mesh file '" + options.finer_mesh +
-                           "' cannot be read (" + std::strerror(errno) + ")",
+                           "' cannot be read: " +
+                           (why_cannot_open(options.finer_mesh).empty() ?
+                              std::string("it cannot be opened") :
+                              why_cannot_open(options.finer_mesh)),
                          "give a finer mesh of the same organ, in the "
                          "scene's file unit (its Scale factor applies).");
       const Scene       scene  = read_and_report(args[1], settings, out);

@@ -1674,9 +1674,10 @@ namespace palpate
             q += c == '\'' ? std::string("'\\''") : std::string(1, c);
           return q + "'";
         };
-        const std::string by_hand = "python3 " + quoted(script.string()) + " " +
-                                    quoted(result.csv_file) + " " +
-                                    quoted(png.string());
+        // The python3 the study runs (PATH's may lack matplotlib: pyenv).
+        const std::string by_hand =
+          "/usr/bin/python3 " + quoted(script.string()) + " " +
+          quoted(result.csv_file) + " " + quoted(png.string());
         // After a stop signal the user wants the run to end: no plot.
         if (result.stop_signal != 0 || stop->signal_number() != 0)
           out << "No Pareto plot: the study was stopped; to draw it, run "
@@ -1704,14 +1705,16 @@ namespace palpate
               }
             else
               out << "No Pareto plot: "
-                  << (status == 124 ?
+                  << (status == 124 || status == 137 ?
+                        // 137: it ignored timeout's SIGTERM and was killed
+                        // 5 s later.
                         std::string("the plotting script took more than "
                                     "120 s") :
-                      status == 127 ?
+                        status == 127 ?
                         std::string("python3, timeout (coreutils) or the "
                                     "plotting script was not found") :
                         "the plotting script failed (exit status " +
-                          std::to_string(status) + ")")
+                            std::to_string(status) + ")")
                   << "; it needs python3 with matplotlib (Debian: apt install "
                      "python3-matplotlib) and room for the PNG beside the "
                      "CSV. To see why, run "

@@ -1919,16 +1919,27 @@ namespace palpate
     const auto &t = h.trajectory;
     // At least 0.1 mm: below, a smooth random motion's speed scaling
     // divides by (nearly) zero and its positions are NaN.
+    // A circle starts at rest and goes around through the point two radii
+    // away (Radius = Extent was offered and ran out of the state space to
+    // twice it: the fourteenth re-run); a random walk stays within Radius.
+    const double across = t.type == "circle" ? 2 : 1;
     if ((t.type == "circle" || t.type == "smooth random") &&
-        t.radius > p.state_space.extent)
+        across * t.radius > p.state_space.extent)
       throw error("Haptics/Trajectory/Radius",
                   "a " + t.type + " of radius " +
-                    Utilities::to_string(t.radius, 3) +
-                    " m leaves the state space (State space / Extent = " +
+                    Utilities::to_string(t.radius, 3) + " m goes " +
+                    Utilities::to_string(across * t.radius, 3) +
+                    " m from rest and leaves the state space (State space "
+                    "/ Extent = " +
                     Utilities::to_string(p.state_space.extent, 3) +
                     " m), where no force is computed",
-                  "give the radius in metres, e.g. 0.01, at most the "
-                  "extent.",
+                  "give the radius in metres, e.g. 0.01, at most " +
+                    Utilities::to_string(p.state_space.extent / across, 3) +
+                    " m" +
+                    (across == 2 ? std::string(" (half the extent: a circle "
+                                               "through rest reaches twice "
+                                               "its radius).") :
+                                   std::string(" (the extent).")),
                   {"State space/Extent"});
     if ((t.type == "circle" || t.type == "smooth random") &&
         !(t.radius >= 1e-4))
