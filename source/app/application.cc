@@ -773,15 +773,14 @@ namespace palpate
           else
             throw unexpected(args[i]);
         }
-      if (!options.finer_mesh.empty() && !std::ifstream(options.finer_mesh))
+      if (const std::string why = why_cannot_open(options.finer_mesh);
+          !options.finer_mesh.empty() && !std::ifstream(options.finer_mesh))
         throw InputError("command line",
                          0,
                          "--finer-mesh " + options.finer_mesh,
                          "the mesh file '" + options.finer_mesh +
                            "' cannot be read: " +
-                           (why_cannot_open(options.finer_mesh).empty() ?
-                              std::string("it cannot be opened") :
-                              why_cannot_open(options.finer_mesh)),
+                           (why.empty() ? "it cannot be opened" : why),
                          "give a finer mesh of the same organ, in the "
                          "scene's file unit (its Scale factor applies).");
       const Scene       scene  = read_and_report(args[1], settings, out);
@@ -902,7 +901,10 @@ namespace palpate
       // "palpate slove scene.prm" blamed the scene as an unexpected
       // argument (the thirteenth re-run): a first word that is no file,
       // followed by more, is a command mistyped.
-      if (args.size() > 1 && args[0].find('/') == std::string::npos &&
+      // Alone, a word two edits from a command is one too ("palpate
+      // slove" said the file 'slove' does not exist).
+      if ((args.size() > 1 || !nearest_command(args[0]).empty()) &&
+          args[0].find('/') == std::string::npos &&
           std::filesystem::path(args[0]).extension() != ".prm" &&
           !std::filesystem::exists(args[0]))
         throw InputError("command line",

@@ -391,8 +391,11 @@ namespace palpate
           catch (const InputError &e)
             {
               out << "  warning:       the trajectory's point " << what << " ("
-                  << 1000 * Utilities::norm(point) << " mm from rest, "
-                  << -1000 * Utilities::dot(point, outward)
+                  << Utilities::to_string(1000 * Utilities::norm(point), 3)
+                  << " mm from rest, "
+                  << Utilities::to_string(-1000 *
+                                            Utilities::dot(point, outward),
+                                          3)
                   << " mm into the body) fails the set-up checks that "
                      "weighed the Prescribed displacement: the sphere "
                   << e.problem().substr(e.problem().find(" radius ") + 8)

@@ -937,6 +937,16 @@ namespace palpate
               refuse("the file name is empty",
                      "name the table, e.g. --csv study.csv, or leave --csv "
                      "out to write it to Output / Directory.");
+            // A name like an option or of blanks only is a slip, not a file
+            // to make in the working directory (the fourteenth re-run).
+            if (result.csv_file.front() == '-' && result.csv_file != "-")
+              refuse("the name begins with '-', like an option",
+                     "name the table, e.g. --csv study.csv (a file whose "
+                     "name begins with '-': --csv ./" +
+                       result.csv_file + ").");
+            if (result.csv_file.find_first_not_of(" \t") == std::string::npos)
+              refuse("the file name is blank",
+                     "name the table, e.g. --csv study.csv.");
             if (result.csv_file == "-")
               refuse("the study cannot write its table to standard output: "
                      "the Pareto plot reads it back from a file",
@@ -1016,6 +1026,16 @@ namespace palpate
                                "name a regular file, e.g. --csv study.csv.");
             // Nor is a PNG beside it that this plot did not draw (its
             // Software text chunk says "palpate study").
+            // A link to nowhere there would be followed: the plot made
+            // its target.
+            if (const std::string link =
+                  dangling_link(std::filesystem::path(result.csv_file)
+                                  .replace_extension(".png")
+                                  .string());
+                options.plot && !link.empty())
+              refuse("the Pareto plot would be written beside it, but " + link,
+                     "name the CSV so that its .png is free, e.g. --csv "
+                     "study.csv, or remove that link first.");
             if (std::filesystem::path png =
                   std::filesystem::path(result.csv_file)
                     .replace_extension(".png");

@@ -627,6 +627,7 @@ main(int argc, char **argv)
   run("'serve --port' given twice", "serve good.prm --port 8080 --port 8081");
   run("an unexpected second argument", "good.prm other.prm");
   run("a mistyped command", "slove good.prm");
+  run("a mistyped command alone", "slove");
   // Scene variants on the command line (--set): checked like a line of
   // the file, and named in the message.
   run("--set with a misspelled entry",
@@ -919,6 +920,13 @@ main(int argc, char **argv)
   run("a scene file that is a link to nowhere", "gone.prm");
   run("study --csv with an empty name", "study good.prm --quick --csv ''");
   run("study --csv - (standard output)", "study good.prm --quick --csv -");
+  run("study --csv named like an option",
+      "study good.prm --quick --csv -x.csv");
+  run("study --csv of a blank", "study good.prm --quick --csv ' '");
+  std::filesystem::remove("beside.png");
+  std::filesystem::create_symlink("no-such-target.png", "beside.png");
+  run("study --csv whose .png beside it is a link to nowhere",
+      "study good.prm --quick --csv beside.csv");
   run("study --csv naming a directory with a trailing slash",
       "study good.prm --quick --csv new.csv/");
 
