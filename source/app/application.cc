@@ -500,6 +500,32 @@ namespace palpate
                          "the volume mesh is written as Gmsh 2.2, so its "
                          "name must end in .msh",
                          "e.g. 'palpate mesh " + args[1] + " organ.msh'.");
+      // A link to nowhere was replaced by the mesh and its target made
+      // empty; a file of the user's that is no mesh was overwritten (the
+      // fifteenth re-run).
+      if (const std::string link = dangling_link(args[2]); !link.empty())
+        throw InputError("command line",
+                         0,
+                         args[2],
+                         link,
+                         "name the mesh by the link's target (in a directory "
+                         "that exists), or remove the link first.");
+      if (std::filesystem::is_regular_file(args[2]))
+        {
+          std::ifstream in(args[2], std::ios::binary);
+          std::string   head(11, '\0');
+          in.read(head.data(), head.size());
+          head.resize(in.gcount());
+          if (!head.empty() && head != "$MeshFormat")
+            throw InputError("command line",
+                             0,
+                             args[2],
+                             "'" + args[2] +
+                               "' exists and is not a Gmsh mesh: it would "
+                               "be overwritten",
+                             "name a new file, or remove this one first if "
+                             "it is no longer needed.");
+        }
       {
         // Check that the output can be written before any work.
         const auto      dir = std::filesystem::path(args[2]).parent_path();

@@ -628,6 +628,16 @@ main(int argc, char **argv)
   run("an unexpected second argument", "good.prm other.prm");
   run("a mistyped command", "slove good.prm");
   run("a mistyped command alone", "slove");
+  write_file("good.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+             "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  std::filesystem::remove("gone.msh");
+  std::filesystem::create_symlink("no-such-dir/organ.msh", "gone.msh");
+  run("palpate mesh writing through a link to nowhere",
+      "mesh good.obj gone.msh");
+  write_file("notes.msh", "my notes, not a mesh\n");
+  run("palpate mesh overwriting a file that is no mesh",
+      "mesh good.obj notes.msh");
   // Scene variants on the command line (--set): checked like a line of
   // the file, and named in the message.
   run("--set with a misspelled entry",
