@@ -202,6 +202,20 @@ setTimeout(() => { console.error("drive.js: gave up after 300 s"); process.exit(
   await sleep(1000);
   const after = await page.evaluate(() => [window.palpate.received, performance.now()]);
   out("RATE", (after[0] - before[0]) / ((after[1] - before[1]) / 1000), "dragged_pixels", pixels);
+  // The server's answer to /frame alone, without the page's drawing: the
+  // median of 21 requests one after another. Nagle's algorithm with the
+  // browser's delayed ACK made it 40-44 ms (serve.cc); the drawing's
+  // share of the rate above depends on the machine's load.
+  const trips = await page.evaluate(async () => {
+    const t = [];
+    for (let i = 0; i < 21; ++i) {
+      const began = performance.now();
+      await (await fetch("/frame")).text();
+      t.push(performance.now() - began);
+    }
+    return t.sort((a, b) => a - b)[10];
+  });
+  out("FRAME_TRIP", trips);
   const dragged = sub(await page.evaluate(() => window.palpate.target.slice()), v5.probeTarget);
   out("DRAG", dot(dragged, down) / norm(dragged), norm(dragged) / (pixels * scale));
   await until(settled, 120000);
