@@ -202,15 +202,10 @@ namespace palpate
                       const Utilities::Point3 &push,
                       const bool               from_command_line)
     {
-      // (hypot: a push of 1e300 m is said to be that, not 'inf').
-      const double length = std::hypot(push[0], push[1], push[2]);
-      if (!(length > mesh.diameter()))
+      const std::string farther = mesh.farther_than_across(push);
+      if (farther.empty())
         return;
-      const std::string size = Utilities::to_string(mesh.diameter(), 3);
-      const std::string what = "the probe would move " +
-                               Utilities::to_string(length, 3) +
-                               " m, more than the body is across (" + size +
-                               " m, its bounding box's diagonal)";
+      const std::string what = "the probe would move " + farther;
       if (from_command_line)
         throw InputError("command line",
                          0,

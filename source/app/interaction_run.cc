@@ -339,17 +339,14 @@ namespace palpate
       // --to says of such a push: a replay moving 0.9 m over a 0.36 m
       // liver ran with only the state space's warning (the thirteenth
       // re-run).
-      const auto  &farthest = device->planned_farthest();
-      const double length   = std::hypot(farthest[0], farthest[1], farthest[2]);
-      const double size     = interaction->mesh().diameter();
-      if (!(length > size))
+      const std::string farther =
+        interaction->mesh().farther_than_across(device->planned_farthest());
+      if (farther.empty())
         return;
       const bool replay = p.haptics.trajectory.type == "replay";
       throw scene.error(
         replay ? "Haptics/Trajectory/File name" : "Haptics/Trajectory/Speed",
-        "the trajectory moves the probe " + Utilities::to_string(length, 3) +
-          " m from rest, more than the body is across (" +
-          Utilities::to_string(size, 3) + " m, its bounding box's diagonal)",
+        "the trajectory moves the probe from rest by " + farther,
         replay ? "give the recording's positions in metres "
                  "(a recording in millimetres is 1000 times "
                  "too far)." :
@@ -384,9 +381,9 @@ namespace palpate
             continue;
           try
             {
-              NodeSelection::check_sphere_push(scene,
-                                               interaction->mesh(),
-                                               point);
+              interaction->nodes().check_sphere_push(scene,
+                                                     interaction->mesh(),
+                                                     point);
             }
           catch (const InputError &e)
             {

@@ -1082,6 +1082,21 @@ namespace palpate
 
 
 
+  std::string
+  Mesh::farther_than_across(const Utilities::Point3 &motion) const
+  {
+    // (hypot: a push of 1e300 m is said to be that, not 'inf').
+    const double length = std::hypot(motion[0], motion[1], motion[2]);
+    if (!(length > diameter()))
+      return "";
+    return Utilities::to_string(length, 3) +
+           " m, more than the body is across (" +
+           Utilities::to_string(diameter(), 3) +
+           " m, its bounding box's diagonal)";
+  }
+
+
+
   const std::string &
   Mesh::description() const
   {

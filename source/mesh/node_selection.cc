@@ -538,12 +538,40 @@ namespace palpate
       return 1 + (margin - 1) * std::clamp(2 * depth / R - 1, 0.0, 1.0);
     }
 
+    /**
+     * How far towards the fixed nodes a refusal still offers a radius, as
+     * a part of the distance from the active node to the nearest of them:
+     * the farthest every site measured converged with the radius offered.
+     * On the graded liver of liver-indenter.prm (fixed nodes 13 - 14 cm
+     * away), pushed along -z with the radius each refusal offered (the
+     * fifteenth re-run's S4: 10 cm at the Point was offered 6.47 cm, which
+     * stagnated at 8.4 cm), the inward depths that converged reached 0.254
+     * (Node id 30), 0.30 - 0.35 (Node ids 40, 42, 45) and 0.43 - 0.57 (the
+     * Point, Node ids 33, 36, 38), and failure points began at 0.26 (4.1 cm
+     * at Node id 30), 0.33 - 0.37 and 0.51: Newton stagnates as the contact
+     * patch of so large a sphere (its radius at least the depth over 1.5)
+     * grows. With the fixed nodes nearer (z below 0.02, 0.05: 8.3 and 5.4 cm
+     * away) the tissue is squeezed against them, and failures came at 0.60 and
+     * 0.64. Every push to 0.25 converged, at 8 sites and 3 supports (and
+     * liver-stvk.prm's 3 cm, 0.255, in the fifteenth re-run): 0.22 keeps
+     * a margin below the first failure. Such a push asks 5 - 8 N there,
+     * about what a haptic device renders (deeper, 15 - 60 N). A radius of the
+     * user's own that passes the checks is not refused deeper: a 1 cm sphere
+     * pushed 1 cm into the beam, half the way to its fixed end, converges (the
+     * indenter tests), and a deeper push's failure point says where it failed.
+     */
+    constexpr double towards_support = 0.22;
+
     /** What place_sphere_tip()'s checks find for a sphere of one radius. */
     struct SphereFit
     {
       NodeSelection placed; // with the sphere's normal, centre and lift
       bool          midpoints = false;
       double        hole = 0, longest = 0, depth = 0, required = 1;
+      /** The distance from the active node to the nearest fixed node. */
+      double support = std::numeric_limits<double>::max();
+      /** Pushed no farther towards them than a radius is offered for. */
+      bool supported = true;
       /** It meets the nodes at all (the checks without a margin). */
       bool meets  = false;
       bool passes = false;
@@ -624,8 +652,15 @@ namespace palpate
           fit.placed.sphere_center[d] - (R + fit.placed.sphere_lift) * n[d];
       fit.longest =
         longest_edge_near(mesh, anchor, slide, 2 * R, fit.midpoints);
-      fit.meets  = R >= 2 * fit.hole && fit.longest <= 1.5 * R;
-      fit.passes = fit.depth <= deepest_push * R &&
+      const auto &x  = mesh.vertices();
+      const auto &at = x[selection.active_vertex];
+      for (const unsigned int v : selection.fixed_vertices)
+        fit.support = std::min(fit.support, Utilities::distance(x[v], at));
+      for (const auto &[v, component] : selection.fixed_components)
+        fit.support = std::min(fit.support, Utilities::distance(x[v], at));
+      fit.supported = fit.depth <= towards_support * fit.support;
+      fit.meets     = R >= 2 * fit.hole && fit.longest <= 1.5 * R;
+      fit.passes    = fit.depth <= deepest_push * R &&
                    R >= fit.required * 2 * fit.hole &&
                    fit.required * fit.longest <= 1.5 * R;
       return fit;
@@ -695,6 +730,32 @@ namespace palpate
           selection = fit.placed;
           return;
         }
+      // Beyond the depths measured, no radius is offered: the one the
+      // checks find was a failure point (above); the push is what to
+      // change.
+      if (!fit.supported)
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "a sphere of " + Utilities::to_string(R, 3) + " m radius " +
+            sphere_problem(R, fit),
+          "a push no deeper than " +
+            Utilities::to_string(
+              std::floor(towards_support * fit.support * 1e4) / 1e4, 3) +
+            " m along the surface's inward normal (Prescribed displacement, "
+            "--to, the trajectory), for which a radius is then offered. None "
+            "is for this push, " +
+            Utilities::to_string(fit.depth, 3) + " m deep, more than " +
+            Utilities::to_string(towards_support, 3) +
+            " of the way to the nearest fixed node (" +
+            Utilities::to_string(fit.support, 3) +
+            " m from the active node): the radius these checks find for so "
+            "deep a push was measured to fail at some sites, Newton "
+            "stagnating as the contact patch grows or the tissue squeezed "
+            "against the fixed nodes (on the liver of liver-indenter.prm "
+            "every push to 0.25 of the way converged, failure points from "
+            "0.26; such a push already asks 5 - 8 N, about what a haptic "
+            "device renders). Or fixed nodes farther from the probe "
+            "(Boundary conditions / Fixed nodes).");
       // The radius to offer: the smallest that passes, found by trying
       // radii 2 % apart from what the figures at R ask for. Worked out
       // from R's figures alone, one in six offers was refused when used:
@@ -806,12 +867,14 @@ namespace palpate
   void
   NodeSelection::check_sphere_push(const Scene             &scene,
                                    const Mesh              &mesh,
-                                   const Utilities::Point3 &push)
+                                   const Utilities::Point3 &push) const
   {
     Scene pushed = scene;
     pushed.parameters.boundary_conditions.active_node.prescribed_displacement =
       push;
     NodeSelection selection;
+    selection.fixed_vertices   = fixed_vertices;
+    selection.fixed_components = fixed_components;
     select_active_vertex(pushed, mesh, selection);
     place_sphere_tip(pushed, mesh, selection);
   }

@@ -228,11 +228,15 @@ main(int argc, char **argv)
     return at == std::string::npos ? 0.0 :
                                      std::stod(refused.substr(at + key.size()));
   };
+  // Pushed 2 cm: the scene's 3 cm goes more than 0.22 of the way to its
+  // fixed nodes, beyond the depths a radius is offered for (below).
   {
     palpate::Scene liver = shipped_scene("liver-stvk.prm");
     liver.parameters.boundary_conditions.active_node.tip =
       palpate::Parameters::ActiveNode::Tip::sphere;
     liver.parameters.boundary_conditions.active_node.tip_radius = 0.002;
+    liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
+      0, 0, -0.02};
     const std::string refused = refusal(liver);
     deallog << "a 2 mm sphere on the liver: refused when read: "
             << ok(refused.find("smaller than the surface triangles") !=
@@ -244,6 +248,40 @@ main(int argc, char **argv)
       suggested(refused);
     deallog << "  the radius it names is accepted: "
             << ok(suggested(refused) > 0 && refusal(liver).empty())
+            << std::endl;
+  }
+  // Pushed 10 cm into the graded liver (0.7 of the way to its fixed
+  // nodes), the radius offered (6.47 cm) stagnated at 8.4 cm (the
+  // fifteenth re-run's S4); 4.1 cm at Node id 30 (0.26 of the way) failed
+  // too. Beyond 0.22 of the way no radius is offered: the push is what to
+  // change, and the depth it names (along the inward normal) gets a
+  // radius that is accepted.
+  {
+    palpate::Scene liver = shipped_scene("liver-indenter.prm");
+    auto          &a     = liver.parameters.boundary_conditions.active_node;
+    a.tip_radius         = 0.001;
+    a.prescribed_displacement = {0, 0, -0.1};
+    const std::string refused = refusal(liver);
+    const std::string key     = "a push no deeper than ";
+    const auto        at      = refused.find(key);
+    deallog << "a 1 mm sphere pushed 10 cm into the graded liver: no radius "
+               "offered: "
+            << ok(!refused.empty() && suggested(refused) == 0)
+            << ", a push named: " << ok(at != std::string::npos);
+    const double depth =
+      at == std::string::npos ? 0 : std::stod(refused.substr(at + key.size()));
+    const Body     at_rest(shipped_scene("liver-indenter.prm"));
+    const auto    &n         = at_rest.nodes.active_normal;
+    palpate::Scene shallower = shipped_scene("liver-indenter.prm");
+    auto          &b = shallower.parameters.boundary_conditions.active_node;
+    b.tip_radius     = 0.001;
+    b.prescribed_displacement = {-depth * n[0], -depth * n[1], -depth * n[2]};
+    const std::string offered = refusal(shallower);
+    b.tip_radius              = suggested(offered);
+    deallog << ", that push along the inward normal gets a radius that is "
+               "accepted: "
+            << ok(depth > 0.02 && suggested(offered) > 0 &&
+                  refusal(shallower).empty())
             << std::endl;
   }
   // The graded liver of liver-indenter.prm: a 3 mm sphere is refused by

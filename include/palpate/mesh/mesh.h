@@ -123,6 +123,15 @@ namespace palpate
     double
     diameter() const;
 
+    /**
+     * Whether a motion to @p motion from rest goes farther than the body
+     * is across (a unit mistake: a push or a recording in millimetres read
+     * as metres): the words that say so ("0.9 m, more than the body is
+     * across (0.36 m, ...)"), or an empty string.
+     */
+    std::string
+    farther_than_across(const Utilities::Point3 &motion) const;
+
     /** Where the mesh came from, e.g. "liver501.msh (Gmsh 2.2 ASCII)". */
     const std::string &
     description() const;

@@ -78,14 +78,15 @@ namespace palpate
     /**
      * Ask a sphere tip's checks (Tip = sphere: that it meets the surface
      * nodes, with a margin when pushed deeper than its radius, and is not
-     * pushed deeper than the tissue lets it) for the push @p push instead
-     * of the scene's Prescribed displacement; the fixed nodes are not
-     * selected again. Throws the InputError create() would.
+     * pushed deeper than the tissue lets it, nor too far towards the fixed
+     * nodes) for the push @p push instead of the scene's Prescribed
+     * displacement; the fixed nodes are this selection's, not selected
+     * again. Throws the InputError create() would.
      */
-    static void
+    void
     check_sphere_push(const Scene             &scene,
                       const Mesh              &mesh,
-                      const Utilities::Point3 &push);
+                      const Utilities::Point3 &push) const;
   };
 } // namespace palpate
 
