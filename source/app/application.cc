@@ -879,7 +879,17 @@ namespace palpate
                          "use it with a scene: 'palpate SCENE.prm --set "
                          "ENTRY=VALUE', or with solve, study, precompute or "
                          "serve.");
-      if (args.empty() || args[0] == "--help" || args[0] == "-h")
+      // Asked anywhere (`palpate solve --help` read it as the scene, the
+      // sixteenth re-run), or as `palpate help`: the usage, which gives
+      // every command's arguments.
+      const bool asks_help = std::any_of(args.begin(),
+                                         args.end(),
+                                         [](const std::string &a) {
+                                           return a == "--help" || a == "-h";
+                                         }) ||
+                             (args.size() == 1 && args[0] == "help" &&
+                              !std::filesystem::exists(args[0]));
+      if (args.empty() || asks_help)
         {
           out << usage;
           return args.empty() ? ExitStatus::input_error : ExitStatus::success;

@@ -37,31 +37,34 @@ namespace palpate
   check_output_directory(const Scene &scene)
   {
     const std::string &directory = scene.parameters.output.directory;
-    std::string        problem;
-    try
-      {
-        std::filesystem::create_directories(directory);
-        const std::string probe = directory + "/.palpate-write-test";
+    // A link to nowhere said "cannot be created: File exists" (the
+    // sixteenth re-run): say what it is, as every other path does.
+    std::string problem = dangling_link(directory);
+    if (problem.empty())
+      try
         {
-          std::ofstream test(probe);
-          test << "test\n";
-          test.flush();
-          if (!test)
-            problem = "files cannot be written in it";
+          std::filesystem::create_directories(directory);
+          const std::string probe = directory + "/.palpate-write-test";
+          {
+            std::ofstream test(probe);
+            test << "test\n";
+            test.flush();
+            if (!test)
+              problem = "files cannot be written in it";
+          }
+          std::filesystem::remove(probe);
         }
-        std::filesystem::remove(probe);
-      }
-    catch (const std::filesystem::filesystem_error &e)
-      {
-        // error_code: the path may be one the file system refuses
-        // altogether (a loop of links).
-        std::error_code error;
-        problem = std::string("it cannot be created: ") + e.code().message() +
-                  (std::filesystem::exists(directory, error) &&
-                       !std::filesystem::is_directory(directory, error) ?
-                     " (a file of that name is in the way)" :
-                     "");
-      }
+      catch (const std::filesystem::filesystem_error &e)
+        {
+          // error_code: the path may be one the file system refuses
+          // altogether (a loop of links).
+          std::error_code error;
+          problem = std::string("it cannot be created: ") + e.code().message() +
+                    (std::filesystem::exists(directory, error) &&
+                         !std::filesystem::is_directory(directory, error) ?
+                       " (a file of that name is in the way)" :
+                       "");
+        }
     if (!problem.empty())
       throw scene.error(
         "Output/Directory",

@@ -464,7 +464,10 @@ namespace palpate
           "the push's component along the surface's inward normal at the "
           "probe (Prescribed displacement, solve's --to, a trajectory's "
           "deepest and farthest points); its sideways part slides the "
-          "frictionless sphere. A refusal names the radius that passes; an "
+          "frictionless sphere. A refusal names the radius that passes, "
+          "for a push no deeper than 0.22 of the way from the active node "
+          "to the nearest fixed node (deeper, the radius found was "
+          "measured to fail: the refusal names the push instead); an "
           "interaction whose trajectory goes deeper is warned.");
       }
       prm.leave_subsection();
@@ -1091,7 +1094,8 @@ namespace palpate
                           Patterns::Double(0.),
                           "The cloud is centred on the point the HIP will "
                           "reach after this time at its current velocity "
-                          "(s); 0 is the paper's cloud around the HIP.");
+                          "(s, at most 2); 0 is the paper's cloud around the "
+                          "HIP.");
       }
       prm.leave_subsection();
     }

@@ -1370,19 +1370,34 @@ namespace palpate
       {
         const double E      = material->youngs_modulus();
         const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+        // With nu <= 0.499 it is the modulus that makes lambda too large
+        // (E from 6.1e11 Pa with the liver's nu = 0.49 blamed nu, whose
+        // fix, nu <= 0.499, it already met: the sixteenth re-run).
+        const auto moduli  = material->moduli();
+        const bool modulus = nu > 0 && nu <= 0.499 && !moduli.empty() &&
+                             !moduli.front().first.empty();
         if (!(std::abs(lambda) <= max_modulus))
-          throw error("Material model/" + m.model_name + "/Poisson's ratio",
-                      "nu = " + Utilities::to_string_exact(nu) +
-                        " makes the first Lame constant lambda = E nu / ((1 "
-                        "+ nu)(1 - 2 nu)) = " +
-                        Utilities::to_string(lambda, 3) + " Pa, more than " +
-                        Utilities::to_string(max_modulus, 3) +
-                        " Pa: stiffer than any solid, it only overflows the "
-                        "solver's force scale",
-                      "for a nearly incompressible tissue use nu <= 0.499 "
-                      "(linear elements lock long before 0.5), or "
-                      "Mooney-Rivlin, whose mixed formulation keeps the "
-                      "volume without locking.");
+          throw error(
+            "Material model/" + m.model_name + "/" +
+              (modulus ? moduli.front().first : "Poisson's ratio"),
+            (modulus ? "E = " + Utilities::to_string(E, 3) + " Pa with nu = " :
+                       std::string("nu = ")) +
+              Utilities::to_string_exact(nu) +
+              " makes the first Lame constant lambda = E nu / ((1 + nu)(1 - "
+              "2 nu)) = " +
+              Utilities::to_string(lambda, 3) + " Pa, more than " +
+              Utilities::to_string(max_modulus, 3) +
+              " Pa: stiffer than any solid, it only overflows the solver's "
+              "force scale",
+            modulus ?
+              "give the modulus in Pa, at most " +
+                Utilities::to_string(max_modulus * (1 + nu) * (1 - 2 * nu) / nu,
+                                     3) +
+                " Pa with this nu: soft tissue is 1e2 - 1e7 Pa (liver: E = "
+                "15465 Pa)." :
+              "for a nearly incompressible tissue use nu <= 0.499 (linear "
+              "elements lock long before 0.5), or Mooney-Rivlin, whose mixed "
+              "formulation keeps the volume without locking.");
       }
 
     // An element pair (Taylor-Hood, P1-P1) fixes the displacement degree.
@@ -1781,6 +1796,16 @@ namespace palpate
                   "keep the cloud local: a radius of 4-6 grid spacings (the "
                   "default 0.025 m with 0.005 m spacing); at most Extent.",
                   {"State space/Extent"});
+    // 1e9 s was taken: the cloud went to where the HIP would be in 30
+    // years and the hand met missing data (the sixteenth re-run).
+    if (p.scheduler.look_ahead_time > 2)
+      throw error("Scheduler/Look-ahead time",
+                  "at most 2 s: the cloud is centred where the HIP would be "
+                  "after this time at its current velocity, and a hand keeps "
+                  "its velocity for a fraction of a second; farther ahead "
+                  "the cloud leaves the HIP and the force fades",
+                  "use 0.2 s (the default), or 0 for the paper's cloud "
+                  "around the HIP.");
     if (p.scheduler.rate > max_scheduler_rate)
       throw error("Scheduler/Rate",
                   "at most " + Utilities::to_string(max_scheduler_rate, 4) +
@@ -1926,9 +1951,10 @@ namespace palpate
     if ((t.type == "circle" || t.type == "smooth random") &&
         across * t.radius > p.state_space.extent)
       throw error("Haptics/Trajectory/Radius",
+                  // (6 digits: 0.0501 said "goes 0.1 m", as if it fitted.)
                   "a " + t.type + " of radius " +
-                    Utilities::to_string(t.radius, 3) + " m goes " +
-                    Utilities::to_string(across * t.radius, 3) +
+                    Utilities::to_string(t.radius, 6) + " m goes " +
+                    Utilities::to_string(across * t.radius, 6) +
                     " m from rest and leaves the state space (State space "
                     "/ Extent = " +
                     Utilities::to_string(p.state_space.extent, 3) +

@@ -38,6 +38,18 @@ main()
                 " --set 'Boundary conditions/Active node/Tip=sphere'"
                 " --set 'Boundary conditions/Active node/Tip radius=0.01'"
                 " --to 0.005,0,0.005");
+  // Asking for help after a command (`palpate solve --help` read --help
+  // as the scene, the sixteenth re-run) or as `palpate help`: the usage,
+  // exit 0.
+  for (const std::string arguments :
+       {"solve --help", "study -h", "mesh --help", "help"})
+    {
+      const ProgramRun h = run_palpate(arguments);
+      deallog << "palpate " << arguments << ": exit status " << h.exit_status
+              << ", the usage "
+              << (h.output.find("Usage:") != std::string::npos ? "yes" : "NO")
+              << std::endl;
+    }
   deallog << "a sphere pulled away: exit status " << r.exit_status
           << ", |f| = 0 "
           << (r.output.find("|f| = 0 N") != std::string::npos ? "yes" : "NO")
