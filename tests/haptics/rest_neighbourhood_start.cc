@@ -6,7 +6,9 @@
 // corners of every cell that touches it), not for the whole initial cloud
 // (515 points on the paper's liver); the rest of the cloud is computed
 // during the motion. Through the palpate program on the paper's liver,
-// a 3 s stroke at 10 mm/s:
+// a 6 s stroke at 5 mm/s (at 10 mm/s, under CI's load beside a re-run's
+// solves, the scheduler once fell 0.087 s behind; the check is of what it
+// plans first, not of the machine's speed):
 // - the report says what the motion waits for, and when it starts it says
 //   the 27 are there, with fewer states computed than the cloud has (at
 //   least the 27);
@@ -35,8 +37,8 @@ main()
   const ProgramRun r =
     run_palpate(palpate_source_dir + "/parameters/paper-stvk.prm" +
                 " --set 'Haptics/Trajectory/Start=after rest neighbourhood'" +
-                " --set Haptics/Trajectory/Speed=0.01" +
-                " --set Haptics/Trajectory/Duration=3");
+                " --set Haptics/Trajectory/Speed=0.005" +
+                " --set Haptics/Trajectory/Duration=6");
   const std::string waits    = line_with(r.output, "the motion starts when");
   const std::string starts   = line_with(r.output, "; motion starts");
   unsigned int      computed = 0;
