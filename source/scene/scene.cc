@@ -1362,6 +1362,14 @@ namespace palpate
                     "(liver: E = 15465 Pa, or C10 = 2148, C01 = 430).");
       }
 
+    // The largest modulus whose lambda fits with @p nu, to 3 digits rounded
+    // down: rounded to nearest, 6.006e10 (nu = 0.499) was named "6.01e+10"
+    // and that was refused again (the seventeenth re-run).
+    const auto largest_modulus = [](const double nu) {
+      const double E     = max_modulus * (1 + nu) * (1 - 2 * nu) / nu;
+      const double digit = std::pow(10., std::floor(std::log10(E)) - 2);
+      return std::floor(E / digit) * digit;
+    };
     // A Poisson's ratio a hair below 0.5 passes its own check but makes the
     // first Lame constant astronomical: nu = 0.49999999999999994 gave a
     // 1.7e12 N force for a 1 cm push (lambda 4.6e19 Pa). Held against the
@@ -1391,8 +1399,7 @@ namespace palpate
               "force scale",
             modulus ?
               "give the modulus in Pa, at most " +
-                Utilities::to_string(max_modulus * (1 + nu) * (1 - 2 * nu) / nu,
-                                     3) +
+                Utilities::to_string(largest_modulus(nu), 3) +
                 " Pa with this nu: soft tissue is 1e2 - 1e7 Pa (liver: E = "
                 "15465 Pa)." :
               "for a nearly incompressible tissue use nu <= 0.499 (linear "

@@ -919,6 +919,16 @@ main(int argc, char **argv)
       "solve good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' "
       "--set \"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.49\" "
       "--set \"Material model/St.Venant-Kirchhoff/Young's modulus=1e12\"");
+  // The modulus it names is accepted: rounded to nearest, 6.006e10 was
+  // named 6.01e10 and refused again (the seventeenth re-run).
+  run("St.Venant-Kirchhoff's Young's modulus 1e12 Pa with nu = 0.499",
+      "good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' --set "
+      "\"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.499\" --set "
+      "\"Material model/St.Venant-Kirchhoff/Young's modulus=1e12\"");
+  run("... with the modulus it names, 6e10 Pa",
+      "good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' --set "
+      "\"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.499\" --set "
+      "\"Material model/St.Venant-Kirchhoff/Young's modulus=6e10\"");
   run("a look-ahead of 1e9 s",
       "good.prm --set 'Scheduler/Look-ahead time=1e9'");
   make_link("no-such-target-out", "gone-out");
