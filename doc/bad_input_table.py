@@ -45,8 +45,13 @@ def table(text):
         if status == 0:
             seen = "accepted: the scene runs (its report is in the test output)"
         else:
-            where = lines[0].removeprefix("palpate: the input has a problem, ") if lines else ""
-            seen = f"{where}; **{fields.get('entry', '')}**: {fields.get('problem', '')}. *Fix:* {fields.get('fix', '')}"
+            # Lines before the error (a sphere's offer tried by a solve) are
+            # progress, shown before it.
+            head = next((i for i, l in enumerate(lines)
+                         if l.startswith("palpate: the input has a problem, ")), 0)
+            before = " ".join(l for l in lines[:head] if l.strip())
+            where = lines[head].removeprefix("palpate: the input has a problem, ") if lines else ""
+            seen = (f"(first: {before}) " if before else "") + f"{where}; **{fields.get('entry', '')}**: {fields.get('problem', '')}. *Fix:* {fields.get('fix', '')}"
         rows.append(f"| {n} | {cell(what)} | {status} | {cell(seen)} |")
     return "\n".join(rows) + "\n"
 

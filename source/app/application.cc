@@ -12,6 +12,7 @@
 #include <palpate/base/stop_request.h>
 #include <palpate/engine/mpi_engine.h>
 #include <palpate/haptics/run_summary.h>
+#include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/mesh/volume_mesher.h>
@@ -253,7 +254,7 @@ namespace palpate
                           mesh,
                           target ? *target : prescribed,
                           target.has_value());
-      const NodeSelection nodes = NodeSelection::create(scene, mesh);
+      const NodeSelection nodes = select_nodes(scene, mesh, &std::cerr);
       // Under mpirun the other ranks got this far too; with the MPI
       // engine they now wait as solver servers, and are released whatever
       // happens here (the engine releases them itself when it ends).
@@ -379,7 +380,7 @@ namespace palpate
     {
       const Scene         scene = Scene::read(file, settings);
       const Mesh          mesh  = Mesh::create(scene);
-      const NodeSelection nodes = NodeSelection::create(scene, mesh);
+      const NodeSelection nodes = select_nodes(scene, mesh, &std::cerr);
       print_scene_report(out, scene, mesh, nodes);
       out << "\n" << std::flush; // as in the interaction's: kept on a stop
       return scene;

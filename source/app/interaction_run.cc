@@ -9,6 +9,7 @@
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/shape_interpolator.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -386,7 +387,8 @@ namespace palpate
             {
               interaction->nodes().check_sphere_push(scene,
                                                      interaction->mesh(),
-                                                     point);
+                                                     point,
+                                                     &sphere_push_reached);
             }
           catch (const InputError &e)
             {

@@ -7,6 +7,7 @@
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/material.h>
+#include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
@@ -318,7 +319,7 @@ namespace palpate
       explicit Body(const Scene &s)
         : scene(s)
         , mesh(Mesh::create(scene))
-        , nodes(NodeSelection::create(scene, mesh))
+        , nodes(select_nodes(scene, mesh))
       {}
     };
 

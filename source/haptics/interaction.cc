@@ -5,6 +5,7 @@
 #include <palpate/engine/hip_channel.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -32,7 +33,7 @@ namespace palpate
     explicit Impl(const Scene &s)
       : scene(s)
       , mesh(Mesh::create(scene))
-      , nodes(NodeSelection::create(scene, mesh))
+      , nodes(select_nodes(scene, mesh))
       , grid(scene.parameters.state_space.grid_spacing,
              scene.parameters.state_space.extent)
       , cache(grid,
@@ -598,7 +599,7 @@ namespace palpate
     Scene changed      = s.scene;
     changed.parameters = parameters;
     changed.validate();
-    NodeSelection nodes = NodeSelection::create(changed, s.mesh);
+    NodeSelection nodes = select_nodes(changed, s.mesh);
 
     // The engine's solvers are built from s.nodes: commit, and restore the
     // old scene if the engine cannot take the new one (the cache is

@@ -6,6 +6,7 @@
 
 #include <palpate/base/utilities.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -66,14 +67,32 @@ namespace palpate
     std::string fixed_description;
 
     /**
+     * How far a static solve gets with a sphere: for @p scene (its Tip
+     * radius and Prescribed displacement those to try) and the nodes
+     * @p placed for it on @p mesh, the part of the push (0 - 1) reached
+     * by converged increments, 1 if the push converged. The
+     * hyperelastic layer, which can solve, gives one
+     * (hyperelastic/sphere_trial.h); a refusal of a sphere's radius then
+     * offers only a radius (and, if need be, a push) whose solve
+     * converged.
+     */
+    using SphereTrial = std::function<double(const Scene         &scene,
+                                             const Mesh          &mesh,
+                                             const NodeSelection &placed)>;
+
+    /**
      * Select the nodes a scene asks for on @p mesh. Throws an InputError,
      * naming the scene entry, if the fixed region selects no node, if the
      * fixed nodes cannot hold the body (they all lie on one line, so it
      * could rotate about it), if a node number does not exist, or if the
-     * active node is fixed or not on the surface.
+     * active node is fixed or not on the surface. With a sphere whose
+     * radius fails its checks, the radius the refusal offers is tried by
+     * @p trial if one is given.
      */
     static NodeSelection
-    create(const Scene &scene, const Mesh &mesh);
+    create(const Scene       &scene,
+           const Mesh        &mesh,
+           const SphereTrial &trial = SphereTrial());
 
     /**
      * Ask a sphere tip's checks (Tip = sphere: that it meets the surface
@@ -86,7 +105,8 @@ namespace palpate
     void
     check_sphere_push(const Scene             &scene,
                       const Mesh              &mesh,
-                      const Utilities::Point3 &push) const;
+                      const Utilities::Point3 &push,
+                      const SphereTrial       &trial = SphereTrial()) const;
   };
 } // namespace palpate
 

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/hyperelastic/sphere_trial.h>
+#include <palpate/hyperelastic/state_solver.h>
+#include <palpate/scene/scene.h>
+
+#include <exception>
+#include <ostream>
+
+namespace palpate
+{
+  double
+  sphere_push_reached(const Scene         &scene,
+                      const Mesh          &mesh,
+                      const NodeSelection &placed)
+  {
+    const auto &push =
+      scene.parameters.boundary_conditions.active_node.prescribed_displacement;
+    try
+      {
+        StateSolver solver(mesh, placed, scene.parameters);
+        // The path parameter of the last converged increment: how far a
+        // failure point got.
+        double reached = 0;
+        solver.set_increment_observer(
+          [&reached](const State &, const double t) { reached = t; });
+        const State end = solver.solve(solver.rest_state(), push);
+        return end.converged ? 1.0 : reached;
+      }
+    catch (const std::exception &)
+      {
+        // A solver that cannot be set up for this radius (its contact
+        // candidates, the linear solver's memory): not a radius to offer.
+        return 0;
+      }
+  }
+
+
+
+  NodeSelection
+  select_nodes(const Scene &scene, const Mesh &mesh, std::ostream *progress)
+  {
+    if (progress == nullptr)
+      return NodeSelection::create(scene, mesh, &sphere_push_reached);
+    return NodeSelection::create(
+      scene,
+      mesh,
+      [progress](const Scene         &with,
+                 const Mesh          &on,
+                 const NodeSelection &placed) {
+        const auto &a = with.parameters.boundary_conditions.active_node;
+        *progress << "palpate: the Tip radius fails the sphere's checks; "
+                     "trying "
+                  << Utilities::to_string(a.tip_radius, 3)
+                  << " m by a static solve to "
+                  << Utilities::to_string(a.prescribed_displacement, 4)
+                  << " m before offering it ... " << std::flush;
+        const double reached = sphere_push_reached(with, on, placed);
+        *progress << (reached >= 1 ?
+                        std::string("converged") :
+                        "stopped at " + Utilities::to_string(reached, 2) +
+                          " of the way")
+                  << std::endl;
+        return reached;
+      });
+  }
+} // namespace palpate
