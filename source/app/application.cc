@@ -882,13 +882,14 @@ namespace palpate
                          "serve.");
       // Asked anywhere (`palpate solve --help` read it as the scene, the
       // sixteenth re-run), or as `palpate help`: the usage, which gives
-      // every command's arguments.
+      // every command's arguments (`palpate help solve` too: the usage
+      // is one page for all commands).
       const bool asks_help = std::any_of(args.begin(),
                                          args.end(),
                                          [](const std::string &a) {
                                            return a == "--help" || a == "-h";
                                          }) ||
-                             (args.size() == 1 && args[0] == "help" &&
+                             (!args.empty() && args[0] == "help" &&
                               !std::filesystem::exists(args[0]));
       if (args.empty() || asks_help)
         {

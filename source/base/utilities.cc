@@ -157,6 +157,20 @@ namespace palpate
 
 
     std::string
+    to_string_apart(const double       x,
+                    const double       from,
+                    const unsigned int precision)
+    {
+      unsigned int digits = precision;
+      while (digits < 17 && x != from &&
+             to_string(x, digits) == to_string(from, digits))
+        ++digits;
+      return to_string(x, digits);
+    }
+
+
+
+    std::string
     to_string(const Point3 &p, const unsigned int precision)
     {
       std::ostringstream s;

@@ -839,19 +839,19 @@ namespace palpate
       // Beyond the depths measured, no radius is offered: the one the
       // checks find was a failure point (above); the push is what to
       // change.
+      const double no_deeper =
+        std::floor(towards_support * fit.support * 1e4) / 1e4;
       if (!fit.supported)
         throw scene.error(
           "Boundary conditions/Active node/Tip radius",
           "a sphere of " + Utilities::to_string(R, 3) + " m radius " +
             sphere_problem(R, fit),
-          "a push no deeper than " +
-            Utilities::to_string(
-              std::floor(towards_support * fit.support * 1e4) / 1e4, 3) +
+          "a push no deeper than " + Utilities::to_string(no_deeper, 3) +
             " m along the surface's inward normal (Prescribed displacement, "
             "--to, the trajectory), for which a radius is then offered. None "
             "is for this push, " +
-            Utilities::to_string(fit.depth, 3) + " m deep, more than " +
-            Utilities::to_string(towards_support, 3) +
+            Utilities::to_string_apart(fit.depth, no_deeper) +
+            " m deep, more than " + Utilities::to_string(towards_support, 3) +
             " of the way to the nearest fixed node (" +
             Utilities::to_string(fit.support, 3) +
             " m from the active node): the radius these checks find for so "

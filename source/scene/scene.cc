@@ -1388,13 +1388,14 @@ namespace palpate
           throw error(
             "Material model/" + m.model_name + "/" +
               (modulus ? moduli.front().first : "Poisson's ratio"),
-            (modulus ? "E = " + Utilities::to_string(E, 3) + " Pa with nu = " :
-                       std::string("nu = ")) +
+            (modulus ?
+               "E = " + Utilities::to_string_exact(E) + " Pa with nu = " :
+               std::string("nu = ")) +
               Utilities::to_string_exact(nu) +
               " makes the first Lame constant lambda = E nu / ((1 + nu)(1 - "
               "2 nu)) = " +
-              Utilities::to_string(lambda, 3) + " Pa, more than " +
-              Utilities::to_string(max_modulus, 3) +
+              Utilities::to_string_apart(lambda, max_modulus) +
+              " Pa, more than " + Utilities::to_string(max_modulus, 3) +
               " Pa: stiffer than any solid, it only overflows the solver's "
               "force scale",
             modulus ?
@@ -1960,8 +1961,10 @@ namespace palpate
       throw error("Haptics/Trajectory/Radius",
                   // (6 digits: 0.0501 said "goes 0.1 m", as if it fitted.)
                   "a " + t.type + " of radius " +
-                    Utilities::to_string(t.radius, 6) + " m goes " +
-                    Utilities::to_string(across * t.radius, 6) +
+                    Utilities::to_string_exact(t.radius) + " m goes " +
+                    Utilities::to_string_apart(across * t.radius,
+                                               p.state_space.extent,
+                                               6) +
                     " m from rest and leaves the state space (State space "
                     "/ Extent = " +
                     Utilities::to_string(p.state_space.extent, 3) +

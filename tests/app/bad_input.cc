@@ -931,6 +931,16 @@ main(int argc, char **argv)
       "\"Material model/St.Venant-Kirchhoff/Young's modulus=6e10\"");
   run("a look-ahead of 1e9 s",
       "good.prm --set 'Scheduler/Look-ahead time=1e9'");
+  // Just over a limit, a value must not read as the limit (the seventeenth
+  // re-run: "1e+13 Pa, more than 1e+13 Pa"; a circle of radius 0.05000001
+  // "goes 0.1 m" from rest, as if it fitted an extent of 0.1 m).
+  run("a modulus that makes lambda just over 1e13 Pa",
+      "good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' --set "
+      "\"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.49\" --set "
+      "\"Material model/St.Venant-Kirchhoff/Young's modulus=6.0817e11\"");
+  run("a circle of radius 0.05000001 m in an extent of 0.1 m",
+      "good.prm --set 'Haptics/Trajectory/Type=circle' --set "
+      "'Haptics/Trajectory/Radius=0.05000001' --set 'State space/Extent=0.1'");
   make_link("no-such-target-out", "gone-out");
   run("Output / Directory a link to nowhere",
       "solve good.prm --set 'Output/Directory=gone-out' --set 'Effects/VTU "

@@ -39,10 +39,11 @@ main()
                 " --set 'Boundary conditions/Active node/Tip radius=0.01'"
                 " --to 0.005,0,0.005");
   // Asking for help after a command (`palpate solve --help` read --help
-  // as the scene, the sixteenth re-run) or as `palpate help`: the usage,
+  // as the scene, the sixteenth re-run) or as `palpate help` (`help solve`:
+  // the seventeenth re-run said "unknown command"): the usage,
   // exit 0.
   for (const std::string arguments :
-       {"solve --help", "study -h", "mesh --help", "help"})
+       {"solve --help", "study -h", "mesh --help", "help", "help solve"})
     {
       const ProgramRun h = run_palpate(arguments);
       deallog << "palpate " << arguments << ": exit status " << h.exit_status

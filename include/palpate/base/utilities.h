@@ -104,6 +104,17 @@ namespace palpate
     std::string
     to_string_exact(const double x);
 
+    /**
+     * @p x with @p precision significant digits, or as many more as it
+     * takes to tell it from @p from as to_string() shows that: a value
+     * just over a limit must not read as the limit ("0.0271 m deep, more
+     * than ... 0.0271 m"; "1e+13 Pa, more than 1e+13 Pa").
+     */
+    std::string
+    to_string_apart(const double       x,
+                    const double       from,
+                    const unsigned int precision = 3);
+
     /** Format @p p as "x, y, z" with @p precision significant digits. */
     std::string
     to_string(const Point3 &p, const unsigned int precision = 6);
