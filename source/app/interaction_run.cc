@@ -27,6 +27,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <iostream>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -388,7 +389,7 @@ namespace palpate
               interaction->nodes().check_sphere_push(scene,
                                                      interaction->mesh(),
                                                      point,
-                                                     &sphere_push_reached);
+                                                     sphere_trial(&std::cerr));
             }
           catch (const InputError &e)
             {

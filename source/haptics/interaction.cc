@@ -550,6 +550,64 @@ namespace palpate
 
 
 
+  namespace
+  {
+    /**
+     * The checks of Interaction::change_parameters(): that @p parameters
+     * change only what may change during an interaction, and that @p scene
+     * with them is valid and selects nodes on @p mesh. @p scene becomes the
+     * changed scene; returns its nodes.
+     */
+    NodeSelection
+    checked_change(Scene                           &scene,
+                   const Mesh                      &mesh,
+                   const Parameters::AllParameters &parameters)
+    {
+      // What the grid, the cache, the mesh and the engine's threads were
+      // built for cannot change here.
+      const Parameters::AllParameters &o = scene.parameters;
+      // The Mesh subsection is compared as a whole: field by field, the
+      // surface settings were left out, and a live change of them was
+      // accepted and then ignored.
+      const char *fixed = nullptr;
+      if (o.mesh != parameters.mesh)
+        fixed = "Mesh";
+      else if (o.state_space.grid_spacing !=
+                 parameters.state_space.grid_spacing ||
+               o.state_space.extent != parameters.state_space.extent)
+        fixed = "State space";
+      else if (o.engine.type != parameters.engine.type ||
+               o.engine.workers != parameters.engine.workers ||
+               o.engine.memory_budget != parameters.engine.memory_budget)
+        fixed = "Engine";
+      else if (o.scheduler.cloud_radius != parameters.scheduler.cloud_radius ||
+               o.scheduler.rate != parameters.scheduler.rate ||
+               o.scheduler.look_ahead_time !=
+                 parameters.scheduler.look_ahead_time)
+        fixed = "Scheduler";
+      else if (o.haptics.force_limit != parameters.haptics.force_limit ||
+               o.haptics.max_force_change !=
+                 parameters.haptics.max_force_change)
+        fixed = "Haptics";
+      if (fixed != nullptr)
+        throw std::invalid_argument(
+          std::string("Interaction::change_parameters: the subsection '") +
+          fixed +
+          "' cannot change during an interaction (the mesh, state grid, cache, "
+          "engine and force filter are built for it). Change only the "
+          "material, the boundary conditions, the effects or the solver "
+          "settings, or create a new Interaction from the changed scene.");
+
+      // Check the new scene and select its nodes before anything changes, so
+      // that bad parameters leave the interaction as it was.
+      scene.parameters = parameters;
+      scene.validate();
+      return select_nodes(scene, mesh);
+    }
+  } // namespace
+
+
+
   void
   Interaction::change_parameters(const Parameters::AllParameters &parameters)
   {
@@ -560,46 +618,8 @@ namespace palpate
         "Interaction::change_parameters: detach first (parameters can "
         "change only while no contact is active)");
 
-    // What the grid, the cache, the mesh and the engine's threads were
-    // built for cannot change here.
-    const Parameters::AllParameters &o = s.scene.parameters;
-    // The Mesh subsection is compared as a whole: field by field, the
-    // surface settings were left out, and a live change of them was
-    // accepted and then ignored.
-    const char *fixed = nullptr;
-    if (o.mesh != parameters.mesh)
-      fixed = "Mesh";
-    else if (o.state_space.grid_spacing !=
-               parameters.state_space.grid_spacing ||
-             o.state_space.extent != parameters.state_space.extent)
-      fixed = "State space";
-    else if (o.engine.type != parameters.engine.type ||
-             o.engine.workers != parameters.engine.workers ||
-             o.engine.memory_budget != parameters.engine.memory_budget)
-      fixed = "Engine";
-    else if (o.scheduler.cloud_radius != parameters.scheduler.cloud_radius ||
-             o.scheduler.rate != parameters.scheduler.rate ||
-             o.scheduler.look_ahead_time !=
-               parameters.scheduler.look_ahead_time)
-      fixed = "Scheduler";
-    else if (o.haptics.force_limit != parameters.haptics.force_limit ||
-             o.haptics.max_force_change != parameters.haptics.max_force_change)
-      fixed = "Haptics";
-    if (fixed != nullptr)
-      throw std::invalid_argument(
-        std::string("Interaction::change_parameters: the subsection '") +
-        fixed +
-        "' cannot change during an interaction (the mesh, state grid, cache, "
-        "engine and force filter are built for it). Change only the "
-        "material, the boundary conditions, the effects or the solver "
-        "settings, or create a new Interaction from the changed scene.");
-
-    // Check the new scene and select its nodes before anything changes, so
-    // that bad parameters leave the interaction as it was.
-    Scene changed      = s.scene;
-    changed.parameters = parameters;
-    changed.validate();
-    NodeSelection nodes = select_nodes(changed, s.mesh);
+    Scene         changed = s.scene;
+    NodeSelection nodes   = checked_change(changed, s.mesh, parameters);
 
     // The engine's solvers are built from s.nodes: commit, and restore the
     // old scene if the engine cannot take the new one (the cache is
@@ -627,6 +647,16 @@ namespace palpate
                         "the states computed after the change were not "
                         "stored (they belong to other physics)";
       }
+  }
+
+
+
+  void
+  Interaction::check_parameters(
+    const Parameters::AllParameters &parameters) const
+  {
+    Scene scene = this->scene();
+    checked_change(scene, impl->mesh, parameters);
   }
 
 

@@ -20,13 +20,22 @@ namespace palpate
     try
       {
         StateSolver solver(mesh, placed, scene.parameters);
-        // The path parameter of the last converged increment: how far a
-        // failure point got.
-        double reached = 0;
+        // The path parameter of the last converged increment, and of the
+        // one before: how far a failure point got. Its last increment may
+        // converge and the end still be refused (the sphere through the
+        // surface, a non-finite force): then it got as far as the one
+        // before (the eighteenth re-run's F1 said "converged" so and
+        // offered a failure point).
+        double reached = 0, before = 0;
         solver.set_increment_observer(
-          [&reached](const State &, const double t) { reached = t; });
+          [&reached, &before](const State &, const double t) {
+            before  = reached;
+            reached = t;
+          });
         const State end = solver.solve(solver.rest_state(), push);
-        return end.converged ? 1.0 : reached;
+        if (end.converged)
+          return 1;
+        return reached < 1 ? reached : before;
       }
     catch (const std::exception &)
       {
@@ -38,31 +47,37 @@ namespace palpate
 
 
 
+  NodeSelection::SphereTrial
+  sphere_trial(std::ostream *progress)
+  {
+    if (progress == nullptr)
+      return &sphere_push_reached;
+    return [progress](const Scene         &with,
+                      const Mesh          &on,
+                      const NodeSelection &placed) {
+      const auto &a = with.parameters.boundary_conditions.active_node;
+      *progress << "palpate: the Tip radius fails the sphere's checks; "
+                   "trying "
+                << Utilities::to_string(a.tip_radius, 3)
+                << " m by a static solve to "
+                << Utilities::to_string(a.prescribed_displacement, 4)
+                << " m before offering it ... " << std::flush;
+      const double reached = sphere_push_reached(with, on, placed);
+      *progress << (reached >= 1 ? std::string("converged") :
+                    reached > 0  ? "stopped at " +
+                                    Utilities::to_string(reached, 2) +
+                                    " of the way" :
+                                  std::string("did not converge"))
+                << std::endl;
+      return reached;
+    };
+  }
+
+
+
   NodeSelection
   select_nodes(const Scene &scene, const Mesh &mesh, std::ostream *progress)
   {
-    if (progress == nullptr)
-      return NodeSelection::create(scene, mesh, &sphere_push_reached);
-    return NodeSelection::create(
-      scene,
-      mesh,
-      [progress](const Scene         &with,
-                 const Mesh          &on,
-                 const NodeSelection &placed) {
-        const auto &a = with.parameters.boundary_conditions.active_node;
-        *progress << "palpate: the Tip radius fails the sphere's checks; "
-                     "trying "
-                  << Utilities::to_string(a.tip_radius, 3)
-                  << " m by a static solve to "
-                  << Utilities::to_string(a.prescribed_displacement, 4)
-                  << " m before offering it ... " << std::flush;
-        const double reached = sphere_push_reached(with, on, placed);
-        *progress << (reached >= 1 ?
-                        std::string("converged") :
-                        "stopped at " + Utilities::to_string(reached, 2) +
-                          " of the way")
-                  << std::endl;
-        return reached;
-      });
+    return NodeSelection::create(scene, mesh, sphere_trial(progress));
   }
 } // namespace palpate

@@ -714,17 +714,33 @@ namespace palpate
 
 
 
+    /** "a, b, c" with 3 digits each. */
+    std::string
+    list(const std::vector<double> &values)
+    {
+      std::string text;
+      for (const double v : values)
+        text += (text.empty() ? "" : ", ") + Utilities::to_string(v, 3);
+      return text;
+    }
+
+    /** What tried_offer() found: the push to name with the radius ("" for
+     * the scene's own), and what the trials said. */
+    struct TriedOffer
+    {
+      std::string push, why;
+    };
+
     /**
      * Try the radius @p offer a refusal names (it passes the checks) by a
-     * static solve to the scene's push; if it does not converge, the next
-     * radii 25 % apart that pass, and if none does, a shorter push with
-     * the radius that got farthest. @p offer becomes the radius to name;
-     * returns what to say after it: "" (this push converged), or the
-     * shorter push and why. Throws the refusal itself when nothing tried
-     * converges.
+     * static solve to the scene's push, or at rest to the six grid points
+     * beside it; if it does not converge, the next radii 25 % apart that
+     * pass, and if none does, a shorter push with the radius that got
+     * farthest. @p offer becomes the radius to name. Throws the refusal
+     * itself when nothing tried converges.
      */
     template <typename FirstPassing>
-    std::string
+    TriedOffer
     tried_offer(const Scene                      &scene,
                 const Mesh                       &mesh,
                 const NodeSelection              &selection,
@@ -735,8 +751,23 @@ namespace palpate
       const double largest = 0.25 * mesh.diameter();
       const auto  &push    = scene.parameters.boundary_conditions.active_node
                            .prescribed_displacement;
-      if (!(Utilities::norm(push) > 0))
-        return ""; // at rest nothing is solved
+      // At rest (an interaction's scene) the states first computed are the
+      // grid points around it: the six one spacing away along the axes are
+      // tried (the eighteenth re-run's F3: 0.0175 m, offered untried on
+      // liver-stvk.prm, was a failure point at (0, -0.01, 0) and (0.01, 0,
+      // 0), dragged sideways between the nodes).
+      const bool                     at_rest = !(Utilities::norm(push) > 0);
+      std::vector<Utilities::Point3> targets;
+      if (!at_rest)
+        targets.push_back(push);
+      else
+        for (unsigned int d = 0; d < 3; ++d)
+          for (const double sign : {-1.0, 1.0})
+            {
+              Utilities::Point3 to = {{0, 0, 0}};
+              to[d] = sign * scene.parameters.state_space.grid_spacing;
+              targets.push_back(to);
+            }
       // The part of @p to a solve with radius r reaches, if r's sphere
       // passes the checks for that push (else -1).
       const auto reached = [&](const double r, const Utilities::Point3 &to) {
@@ -747,70 +778,96 @@ namespace palpate
         const SphereFit f          = fit_sphere(with, mesh, selection, r);
         return f.passes ? trial(with, mesh, f.placed) : -1.0;
       };
+      // The least of the targets (stopping at the first that fails).
+      const auto reached_all = [&](const double r) {
+        double least = 1;
+        for (const auto &to : targets)
+          if ((least = std::min(least, reached(r, to))) < 1)
+            break;
+        return least;
+      };
       // Up to three radii, the next ones only within 10 s: at Node id 27,
       // 0.9 - 2 times the offer all failed within 0.36 - 0.58 of the push,
       // so more would only cost time. A solve takes 2 - 5 s on the graded
       // liver, a minute with Taylor-Hood (whose refusal then tries one
       // radius and one push).
-      const auto   start = std::chrono::steady_clock::now();
-      double       best = offer, best_reached = -1;
-      std::string  radii;
-      unsigned int n_tried = 0;
+      const auto          start = std::chrono::steady_clock::now();
+      double              best = offer, best_reached = -1;
+      std::vector<double> radii;
       for (double r = offer;
-           r <= largest && n_tried < 3 &&
-           (n_tried == 0 || std::chrono::steady_clock::now() - start <
-                              std::chrono::seconds(10));
-           r = first_passing(std::ceil(r * 1.25 * 1e4) / 1e4), ++n_tried)
+           r <= largest && radii.size() < 3 &&
+           (radii.empty() || std::chrono::steady_clock::now() - start <
+                               std::chrono::seconds(10));
+           r = first_passing(std::ceil(r * 1.25 * 1e4) / 1e4))
         {
-          const double part = reached(r, push);
+          const double part = reached_all(r);
           if (part >= 1)
             {
               offer = r;
-              return radii.empty() ? std::string() :
-                                     " (a static solve to this push "
-                                     "converged with it; with " +
-                                       radii + " m it did not)";
+              return {"",
+                      radii.empty() ?
+                        std::string() :
+                        "; a static solve with it converged, with " +
+                          list(radii) + " m it did not"};
             }
-          radii += (radii.empty() ? "" : ", ") + Utilities::to_string(r, 3);
+          radii.push_back(r);
           if (part > best_reached)
             best = r, best_reached = part;
         }
+      const std::string tried = list(radii);
+      if (at_rest)
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "no sphere found here: radii that pass the checks (" + tried +
+            " m) were tried by static solves to the grid points one State "
+            "space / Grid spacing beside rest, and with each some "
+            "did not converge (failure points, no force there)",
+          "a mesh finer near the probe (Mesh / Source = surface with "
+          "Refinement size about a third of the radius), another Point or "
+          "Node id, or a smaller Grid spacing");
       // None converged: a shorter push along the same line, with the
       // radius that got farthest, tried too. (Shorter, it needs no larger
       // a radius: the checks' margin grows with the depth and the slide.)
       offer = best;
-      std::string  pushes;
-      unsigned int n_shorter = 0;
+      std::vector<double> parts;
       for (double part =
              std::floor(0.9 * std::max(best_reached, 0.0) * 100) / 100;
-           part >= 0.05 && n_shorter < 2;
-           part = std::floor(0.5 * part * 100) / 100, ++n_shorter)
+           part >= 0.05 && parts.size() < 2;
+           part = std::floor(0.5 * part * 100) / 100)
         {
           const Utilities::Point3 shorter = {
             {part * push[0], part * push[1], part * push[2]}};
           if (reached(best, shorter) >= 1)
-            return " and a push of " + Utilities::to_string(part, 3) +
-                   " times this one, to " + Utilities::to_string(shorter, 4) +
-                   " m (Prescribed displacement, --to, the trajectory): a "
-                   "static solve with these converged, while to this push "
-                   "it stopped at " +
-                   Utilities::to_string(best_reached, 2) +
-                   " of the way, a failure point, as with " + radii +
-                   " m (Newton does not find the way on where the contact "
-                   "set keeps changing)";
-          pushes +=
-            (pushes.empty() ? "" : ", ") + Utilities::to_string(part, 3);
+            {
+              std::vector<double> others;
+              for (const double r : radii)
+                if (r != best)
+                  others.push_back(r);
+              return {" and, as the push (Prescribed displacement, --to, "
+                      "the trajectory), " +
+                        Utilities::to_string(part, 3) + " times this one: " +
+                        Utilities::to_string(shorter, 4) + " m",
+                      "; a static solve with these converged, while to this "
+                      "push it stopped at " +
+                        Utilities::to_string(best_reached, 2) +
+                        " of the way, a failure point" +
+                        (others.empty() ? std::string() :
+                                          ", as with " + list(others) + " m") +
+                        " (Newton found no way on where the contact set "
+                        "keeps changing)"};
+            }
+          parts.push_back(part);
         }
       throw scene.error(
         "Boundary conditions/Active node/Tip radius",
         "no sphere found for this push: radii that pass the checks here (" +
-          radii +
+          tried +
           " m) were tried by a static solve to it, and none converged (the "
           "farthest got " +
           Utilities::to_string(std::max(best_reached, 0.0), 2) +
           " of the way)" +
-          (pushes.empty() ? std::string() :
-                            ", nor to " + pushes + " times the push"),
+          (parts.empty() ? std::string() :
+                           ", nor to " + list(parts) + " times the push"),
         "a shorter push (Prescribed displacement, --to, the trajectory), a "
         "mesh finer near the probe (Mesh / Source = surface with Refinement "
         "size about a third of the radius), or other fixed nodes");
@@ -896,10 +953,10 @@ namespace palpate
       // 8 of 372 offers were failure points, and at Node id 27 of
       // liver-indenter.prm every radius from 0.9 to 2 times the offer
       // stagnated at 0.4 of the push): what is offered has converged.
-      const std::string tried =
+      const TriedOffer tried =
         offer <= largest && trial ?
           tried_offer(scene, mesh, selection, trial, offer, first_passing) :
-          std::string();
+          TriedOffer();
       // A push no deeper than half the radius needs no margin.
       const double shallow_enough = std::floor(0.5 * R * 1e4) / 1e4;
       const bool   p2             = scene.displacement_degree() == 2;
@@ -908,8 +965,9 @@ namespace palpate
         "a sphere of " + Utilities::to_string(R, 3) + " m radius " +
           sphere_problem(R, fit),
         (offer <= largest ?
-           "use a radius of " + Utilities::to_string(offer, 6) +
-             " m (it passes these checks here, 10 % or more above the "
+           "use a radius of " + Utilities::to_string(offer, 6) + " m" +
+             tried.push +
+             " (it passes these checks here, 10 % or more above the "
              "smallest that does: found by trying radii" :
            std::string("no radius up to a quarter of the "
                        "body passes these checks here (") +
@@ -924,9 +982,9 @@ namespace palpate
           "and at least the depth over " +
           Utilities::to_string(deepest_push, 3) +
           ", as one pushed nearly its diameter deep goes through the "
-          "surface)" +
-          tried +
-          ", or a mesh finer near the probe (Mesh / Source = "
+          "surface" +
+          tried.why +
+          "), or a mesh finer near the probe (Mesh / Source = "
           "surface with Refinement size about a third of the radius)" +
           (!fit.meets ? std::string() :
                         ", or a push (Prescribed displacement, --to, the "

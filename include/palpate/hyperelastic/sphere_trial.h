@@ -27,10 +27,16 @@ namespace palpate
                       const NodeSelection &placed);
 
   /**
+   * sphere_push_reached(), each trial announced on @p progress if given (a
+   * refusal that solves takes seconds, with Taylor-Hood a minute or two).
+   */
+  NodeSelection::SphereTrial
+  sphere_trial(std::ostream *progress = nullptr);
+
+  /**
    * NodeSelection::create() with sphere_push_reached() as its trial: a
-   * refusal of a sphere's radius names one that converged. Each trial is
-   * announced on @p progress, if given (a refusal that solves takes
-   * seconds, with Taylor-Hood a minute or two).
+   * refusal of a sphere's radius names one that converged; the trials
+   * announced on @p progress, if given.
    */
   NodeSelection
   select_nodes(const Scene  &scene,
