@@ -515,14 +515,18 @@ main(int argc, char **argv)
     a.prescribed_displacement = {{0, 0, 0}};
     const double at_rest      = offer(liver);
     const double h            = liver.parameters.state_space.grid_spacing;
-    bool         beside       = at_rest > 0;
     // All 26 around rest: the six along the axes once passed while (0.01,
     // 0, -0.01) failed (the nineteenth re-run's R1, Node id 36).
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k)
-          if (i != 0 || j != 0 || k != 0)
-            beside = beside && converges(at_rest, {{i * h, j * h, k * h}});
+    const auto around = [&](const double R) {
+      bool all = R > 0;
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 1; ++j)
+          for (int k = -1; k <= 1; ++k)
+            if (i != 0 || j != 0 || k != 0)
+              all = all && converges(R, {{i * h, j * h, k * h}});
+      return all;
+    };
+    const bool beside = around(at_rest);
     deallog << "  at rest: the checks' 0.0175 m is a failure point beside "
                "rest "
             << ok(!converges(0.0175, {{h, 0, 0}}))
@@ -530,15 +534,9 @@ main(int argc, char **argv)
             << ok(beside) << std::endl;
     // At Node id 36, tried at the six along the axes only, 0.0171 m was
     // offered, a failure point at (0.01, 0, -0.01) (R1).
-    a.selection            = "node id";
-    a.node_id              = 36;
-    const double at_36     = offer(liver);
-    bool         around_36 = at_36 > 0;
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k)
-          if (i != 0 || j != 0 || k != 0)
-            around_36 = around_36 && converges(at_36, {{i * h, j * h, k * h}});
+    a.selection          = "node id";
+    a.node_id            = 36;
+    const bool around_36 = around(offer(liver));
     deallog << "  at rest at node 36: 0.0171 m is a failure point at (0.01, "
                "0, -0.01) "
             << ok(!converges(0.0171, {{h, 0, -h}}))
