@@ -160,6 +160,26 @@ namespace palpate
       return s.str();
     }
 
+    /** Runs @p f; returns "" if it succeeds, else why it was refused, as a
+     * live view's change reports it: "problem (fix)" for bad input. */
+    std::string
+    refusal_of(const std::function<void()> &f)
+    {
+      try
+        {
+          f();
+        }
+      catch (const InputError &e)
+        {
+          return e.problem() + " (" + e.fix() + ")";
+        }
+      catch (const std::exception &e)
+        {
+          return *e.what() != '\0' ? e.what() : "refused (no reason given)";
+        }
+      return "";
+    }
+
     std::string
     json_number(const double x)
     {
@@ -1328,45 +1348,27 @@ namespace palpate
       std::lock_guard<std::mutex> control(control_mutex);
       Parameters::AllParameters   p = interaction.scene().parameters;
       edit(p);
-      std::string refused;
       // Checked first, attached and outside the lock /frame waits for: a
       // refused sphere tries the radius it offers by static solves, and
       // under the locks the view froze for them (12.8 s on the graded
       // liver, the eighteenth re-run's F2).
-      try
-        {
-          interaction.check_parameters(p);
-        }
-      catch (const InputError &e)
-        {
-          return e.problem() + " (" + e.fix() + ")";
-        }
-      catch (const std::exception &e)
-        {
-          return e.what();
-        }
+      const std::string early =
+        refusal_of([&] { interaction.check_parameters(p); });
+      if (!early.empty())
+        return early;
       interaction.detach();
-      try
-        {
-          // The device held (the loop asks the interaction for nothing)
-          // while its scene is replaced.
-          const HeldDevice            held(*loop);
-          std::lock_guard<std::mutex> frame_lock(mutex);
-          interaction.change_parameters(p);
-          describe_active();
-          // Another active node: the device at rest on it (a target sent
-          // meanwhile was for the old one).
-          if (rest)
-            device.reset();
-        }
-      catch (const InputError &e)
-        {
-          refused = e.problem() + " (" + e.fix() + ")";
-        }
-      catch (const std::exception &e)
-        {
-          refused = e.what();
-        }
+      const std::string refused = refusal_of([&] {
+        // The device held (the loop asks the interaction for nothing)
+        // while its scene is replaced.
+        const HeldDevice            held(*loop);
+        std::lock_guard<std::mutex> frame_lock(mutex);
+        interaction.change_parameters(p);
+        describe_active();
+        // Another active node: the device at rest on it (a target sent
+        // meanwhile was for the old one).
+        if (rest)
+          device.reset();
+      });
       interaction.attach();
       if (refused.empty())
         record(describe());

@@ -1089,9 +1089,9 @@ namespace palpate
     const double length = std::hypot(motion[0], motion[1], motion[2]);
     if (!(length > diameter()))
       return "";
-    return Utilities::to_string(length, 3) +
+    return Utilities::to_string_apart(length, diameter()) +
            " m, more than the body is across (" +
-           Utilities::to_string(diameter(), 3) +
+           Utilities::to_string_apart(diameter(), length) +
            " m, its bounding box's diagonal)";
   }
 

@@ -1505,13 +1505,14 @@ namespace palpate
                     "set Tip radius in metres, e.g. 0.01 for a probe of "
                     "1 cm radius.");
       if (a.tip != Tip::point && a.tip_radius > max_sphere_radius)
-        throw error("Boundary conditions/Active node/Tip radius",
-                    std::string(a.tip == Tip::sphere ? "a sphere" :
-                                                       "a glued tip") +
-                      " of " + Utilities::to_string(a.tip_radius, 3) +
-                      " m radius is no probe (at most " +
-                      Utilities::to_string(max_sphere_radius, 3) + " m)",
-                    "give the radius in metres (a 1 cm probe: 0.01).");
+        throw error(
+          "Boundary conditions/Active node/Tip radius",
+          std::string(a.tip == Tip::sphere ? "a sphere" : "a glued tip") +
+            " of " +
+            Utilities::to_string_apart(a.tip_radius, max_sphere_radius) +
+            " m radius is no probe (at most " +
+            Utilities::to_string(max_sphere_radius, 3) + " m)",
+          "give the radius in metres (a 1 cm probe: 0.01).");
     }
   }
 

@@ -976,6 +976,14 @@ main(int argc, char **argv)
       "study good.prm --quick --csv beside.csv");
   run("study --csv naming a directory with a trailing slash",
       "study good.prm --quick --csv new.csv/");
+  // The nineteenth re-run's B9 and B10: a value just over its limit read
+  // as the limit ("0.1 m radius ... at most 0.1 m").
+  run("a sphere of 0.1000001 m radius, just over the largest",
+      "solve good.prm --set 'Boundary conditions/Active node/Tip=sphere' "
+      "--set 'Boundary conditions/Active node/Tip radius=0.1000001'");
+  run("a push just longer than liver501 is across",
+      "solve '" + palpate_source_dir +
+        "/parameters/liver-stvk.prm' --to 0,0,-0.35677");
 
   deallog << n_cases << " cases: " << n_internal << " with an internal error, "
           << n_crashes << " crashed (both must be 0)" << std::endl;
