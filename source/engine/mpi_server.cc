@@ -413,6 +413,12 @@ namespace palpate
       try
         {
           state = solver->solve(*source, target, behind.get(), behind2.get());
+          // As ThreadEngine's workers do: a point around rest that failed
+          // from its neighbour is solved again from rest, the path on
+          // which a sphere's offered radius was tried.
+          if (!state.converged && state.status != SolveStatus::stopped &&
+              task.source != origin && grid.beside_origin(task.point))
+            state = solver->solve(*rest, target);
         }
       catch (const std::exception &e)
         {

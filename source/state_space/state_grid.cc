@@ -139,6 +139,16 @@ namespace palpate
              (((k >> 2) & 1) ? s[2] : 1 - s[2]);
     return w;
   }
+  bool
+  StateGrid::beside_origin(const unsigned int point) const noexcept
+  {
+    const GridIndex g = index(point);
+    return std::abs(g[0]) <= 1 && std::abs(g[1]) <= 1 && std::abs(g[2]) <= 1 &&
+           (g[0] != 0 || g[1] != 0 || g[2] != 0);
+  }
+
+
+
   std::vector<unsigned int>
   StateGrid::neighbourhood(const unsigned int point) const
   {

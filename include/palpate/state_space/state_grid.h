@@ -101,6 +101,11 @@ namespace palpate
     std::array<unsigned int, 8>
     corners(const GridIndex &lower) const noexcept;
 
+    /** Whether @p point is one of the 26 points around the origin (rest):
+     * the corners, other than the origin, of the cells that touch it. */
+    bool
+    beside_origin(const unsigned int point) const noexcept;
+
     /** @p point and its (up to 26) neighbours inside the grid: the
      * points whose cross derivatives depend on it, and those its own
      * depend on. Not for the real-time side. */
