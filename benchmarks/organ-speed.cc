@@ -63,8 +63,9 @@ namespace
   struct Options
   {
     bool quick = false;
-    /** Refinement sizes near the probe (m): about 1,500 and 4,000 nodes. */
-    std::vector<double>      sizes     = {0.005, 0.0025};
+    /** Refinement sizes near the probe (m): 2,012 nodes (the shipped
+     * parameters/liver-indenter.prm) and 3,976 nodes. */
+    std::vector<double>      sizes     = {0.004, 0.0025};
     std::vector<std::string> materials = {"nh", "mr"};
     unsigned int             lines     = 6; // states per line
     /** Only the first and the last lever, on a series of meshes: the
@@ -477,7 +478,7 @@ main(int argc, char **argv)
   if (o.quick)
     {
       o.lines     = 2;
-      o.sizes     = {0.005};
+      o.sizes     = {0.004};
       o.materials = {"mr"};
     }
 
@@ -514,6 +515,13 @@ main(int argc, char **argv)
      "single-precision factors as GMRES's preconditioner (MUMPS single)",
      [](Parameters::AllParameters &p) {
        p.linear_solver.solver = "MUMPS single";
+     },
+     false},
+    {"+condensed contact",
+     "the sphere's contact out of the factorised tangent, solved on the "
+     "candidates' compliance (Contact solver = condensed)",
+     [](Parameters::AllParameters &p) {
+       p.nonlinear_solver.condensed_contact = true;
      },
      false},
     {"+study tolerance",
@@ -591,13 +599,15 @@ main(int argc, char **argv)
               continue;
             const Lever lever = configuration(l);
             ml_lever::setups = ml_lever::applications = ml_lever::failures = 0;
-            all.push_back(measure(mesh,
-                                  sel,
-                                  scene.parameters,
-                                  lever,
-                                  o.lines,
-                                  all.empty() ? nullptr : &all.front(),
-                                  o.trace && l + 1 == amg_lever));
+            all.push_back(
+              measure(mesh,
+                      sel,
+                      scene.parameters,
+                      lever,
+                      o.lines,
+                      all.empty() ? nullptr : &all.front(),
+                      o.trace &&
+                        (o.levers.empty() ? l + 1 == amg_lever : named)));
             const Measured &m = all.back();
             if (l == amg_lever)
               std::cout << "  (ML: " << ml_lever::setups << " hierarchies, "

@@ -1375,7 +1375,8 @@ namespace palpate
                                const Utilities::Point3   &target,
                                std::vector<double>       &residual,
                                std::vector<double>       *matrix,
-                               double                    *force_scale) const
+                               double                    *force_scale,
+                               const bool contact_in_matrix) const
   {
     const Impl &s = *impl;
     s.expand(x, s.u_work);
@@ -1473,7 +1474,9 @@ namespace palpate
               if (node.eq[a] >= 0)
                 residual[node.eq[a]] -= c.lambda_hat * c.n[a];
             residual[e] = -s.beta * c.gap;
-            if (matrix != nullptr)
+            if (matrix != nullptr && !contact_in_matrix)
+              (*matrix)[node.position_ll] = -s.beta;
+            else if (matrix != nullptr)
               {
                 (*matrix)[node.position_ll] = 0;
                 const double curvature      = c.lambda_hat / c.rho;
@@ -1515,6 +1518,24 @@ namespace palpate
                   std::sqrt(lambda_norm),
                   1e-12 * s.material->youngs_modulus() * s.L * s.L});
     return true;
+  }
+
+
+
+  void
+  HyperelasticSystem::contact_rows(const std::vector<double> &x,
+                                   const Utilities::Point3   &target,
+                                   std::vector<ContactRow>   &rows) const
+  {
+    const Impl &s = *impl;
+    s.expand(x, s.u_work);
+    rows.resize(s.n_contact);
+    for (unsigned int k = 0; k < s.n_contact; ++k)
+      {
+        const Impl::Contact c = s.contact_at(k, s.u_work, x, target);
+        rows[k]               = {
+                        s.contact[k].eq, s.n_free + k, c.n, c.rho, c.gap, c.lambda_hat};
+      }
   }
 
 

@@ -363,6 +363,12 @@ namespace palpate
       bool
       solve(std::vector<double> &rhs) override
       {
+        return solve_many(rhs, 1);
+      }
+
+      bool
+      solve_many(std::vector<double> &rhs, const unsigned int n_rhs) override
+      {
         {
           if constexpr (!Precision::exact)
             work.assign(rhs.begin(), rhs.end());
@@ -371,8 +377,11 @@ namespace palpate
             id.rhs = rhs.data();
           else
             id.rhs = work.data();
-          id.job = 3;
+          id.nrhs = n_rhs;
+          id.lrhs = n_rhs > 0 ? rhs.size() / n_rhs : 0;
+          id.job  = 3;
           Precision::call(&id);
+          id.nrhs = 1;
         }
         if constexpr (!Precision::exact)
           std::copy(work.begin(), work.end(), rhs.begin());
@@ -773,6 +782,25 @@ namespace palpate
       const std::vector<unsigned int>      *row_start = nullptr;
     };
   } // namespace
+
+
+
+  bool
+  LinearSolver::solve_many(std::vector<double> &block, const unsigned int n_rhs)
+  {
+    if (n_rhs == 0)
+      return true;
+    const std::size_t   n = block.size() / n_rhs;
+    std::vector<double> column(n);
+    for (unsigned int j = 0; j < n_rhs; ++j)
+      {
+        std::copy_n(block.begin() + j * n, n, column.begin());
+        if (!solve(column))
+          return false;
+        std::copy(column.begin(), column.end(), block.begin() + j * n);
+      }
+    return true;
+  }
 
 
 

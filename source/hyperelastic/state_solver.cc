@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/hyperelastic/condensed_contact.h>
 #include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/linear_solver.h>
@@ -212,6 +213,8 @@ namespace palpate
       chosen.ordering                 = ordering;
       linear_solver = LinearSolver::create(chosen, system->n_equations());
       linear_solver->analyze(system->sparsity());
+      if (system->has_contact())
+        condensed = std::make_unique<CondensedContact>(*system);
       setup_time = seconds_since(start);
     }
 
@@ -247,6 +250,36 @@ namespace palpate
            const Utilities::Point3 &target,
            State                   &state,
            const bool               may_cut_back = false);
+
+    /**
+     * newton() with Contact solver = condensed: the factorised tangent
+     * leaves the sphere's contact out, and each step solves the contact
+     * on the compliance of the candidates near the sphere.
+     */
+    Outcome
+    newton_condensed(std::vector<double>     &x,
+                     const Utilities::Point3 &target,
+                     State                   &state,
+                     const bool               may_cut_back);
+
+    /** Assemble the contact-free tangent at @p x and factorise it; the
+     * compliance columns of the old factors are dropped. */
+    bool
+    factorize_contact_free(const std::vector<double> &x,
+                           const Utilities::Point3   &target);
+
+    /** The active-node stiffness of a converged state from the condensed
+     * contact problem on the kept factors (Contact solver = condensed). */
+    bool
+    condensed_stiffness(State &state);
+
+    /** Whether Newton must stop before iteration @p iteration (the
+     * residual in `residual`, its force scale @p scale): not finite, a
+     * stop asked for, or out of iterations; @p outcome then says so. */
+    bool
+    halt(const unsigned int iteration,
+         const double       scale,
+         Outcome           &outcome) const;
 
     /** The failure of a solve that used up its Newton work. */
     static Outcome
@@ -373,9 +406,9 @@ namespace palpate
                         const double         tolerance,
                         unsigned int        &krylov_iterations)
     {
-      factorized = factorized_current = false;
-      krylov_iterations               = 0;
-      bool solved                     = linear_solver->factorize(matrix);
+      factorized = factorized_current = contact_free_factors = false;
+      krylov_iterations                                      = 0;
+      bool solved = linear_solver->factorize(matrix);
       if (solved && linear_solver->exact())
         solved = linear_solver->solve(rhs);
       else if (solved)
@@ -402,7 +435,7 @@ namespace palpate
         return false;
       linear_solver = LinearSolver::create("MUMPS", ordering);
       linear_solver->analyze(system->sparsity());
-      factorized = factorized_current = false;
+      factorized = factorized_current = contact_free_factors = false;
       return true;
     }
 
@@ -424,6 +457,13 @@ namespace palpate
     // Whether that factorisation is of the tangent in matrix.
     bool                             factorized_current = false;
     std::vector<std::vector<double>> krylov_v, krylov_z;
+
+    // Condensed contact: whether the kept factors are of a contact-free
+    // tangent (only then do the compliance columns of `condensed` hold),
+    // and the candidates' rows at the current iterate.
+    bool                                        contact_free_factors = false;
+    std::vector<HyperelasticSystem::ContactRow> rows;
+    std::unique_ptr<CondensedContact>           condensed;
 
     /**
      * The active-node stiffness of a converged @p state, from the tangent
@@ -672,6 +712,8 @@ namespace palpate
                             State                   &state,
                             const bool               may_cut_back)
   {
+    if (settings.condensed_contact && system->has_contact())
+      return newton_condensed(x, target, state, may_cut_back);
     Outcome outcome;
     double  scale = 0;
 
@@ -696,37 +738,8 @@ namespace palpate
             outcome.iterations = iteration;
             return outcome;
           }
-        if (!std::isfinite(scale) ||
-            !std::isfinite(system->force_residual_norm(residual)))
-          {
-            outcome.status     = SolveStatus::not_finite;
-            outcome.iterations = iteration;
-            outcome.message =
-              "the residual or its force scale is not finite (force scale " +
-              Utilities::to_string(scale, 3) +
-              " N: are the material constants within their physical range?)";
-            return outcome;
-          }
-        if (stop_check && stop_check())
-          {
-            outcome.status     = SolveStatus::stopped;
-            outcome.iterations = iteration;
-            outcome.message    = "a stop was asked for";
-            return outcome;
-          }
-        if (iteration == settings.max_newton_iterations)
-          {
-            outcome.status     = SolveStatus::max_iterations;
-            outcome.iterations = iteration;
-            outcome.message =
-              "Newton did not converge in " + std::to_string(iteration) +
-              " iterations (relative residual " +
-              Utilities::to_string(system->force_residual_norm(residual) /
-                                     scale,
-                                   3) +
-              ")";
-            return outcome;
-          }
+        if (halt(iteration, scale, outcome))
+          return outcome;
 
         NewtonIteration record;
         record.increment       = state.increments;
@@ -804,6 +817,222 @@ namespace palpate
           }
         assembly_time = seconds_since(start);
       }
+  }
+
+
+
+  bool
+  StateSolver::Impl::halt(const unsigned int iteration,
+                          const double       scale,
+                          Outcome           &outcome) const
+  {
+    outcome.iterations = iteration;
+    if (!std::isfinite(scale) ||
+        !std::isfinite(system->force_residual_norm(residual)))
+      {
+        outcome.status = SolveStatus::not_finite;
+        outcome.message =
+          "the residual or its force scale is not finite (force scale " +
+          Utilities::to_string(scale, 3) +
+          " N: are the material constants within their physical range?)";
+        return true;
+      }
+    if (stop_check && stop_check())
+      {
+        outcome.status  = SolveStatus::stopped;
+        outcome.message = "a stop was asked for";
+        return true;
+      }
+    if (iteration == settings.max_newton_iterations)
+      {
+        outcome.status = SolveStatus::max_iterations;
+        outcome.message =
+          "Newton did not converge in " + std::to_string(iteration) +
+          " iterations (relative residual " +
+          Utilities::to_string(system->force_residual_norm(residual) / scale,
+                               3) +
+          ")";
+        return true;
+      }
+    return false;
+  }
+
+
+
+  bool
+  StateSolver::Impl::factorize_contact_free(const std::vector<double> &x,
+                                            const Utilities::Point3   &target)
+  {
+    // The tangent without the contact rows (every candidate's row is that
+    // of a node out of contact): the same matrix whatever the active set,
+    // so its factors serve while the sphere's contact set moves.
+    if (!system->assemble(x, target, trial_residual, &matrix, nullptr, false))
+      return false;
+    factorized = factorized_current = contact_free_factors = false;
+    bool ok = linear_solver->factorize(matrix);
+    if (!ok && fall_back_to_double())
+      ok = linear_solver->factorize(matrix);
+    factorized = contact_free_factors = ok;
+    condensed->reset();
+    return ok;
+  }
+
+
+
+  StateSolver::Impl::Outcome
+  StateSolver::Impl::newton_condensed(std::vector<double>     &x,
+                                      const Utilities::Point3 &target,
+                                      State                   &state,
+                                      const bool               may_cut_back)
+  {
+    // The same equilibrium as newton() (its residual, its convergence
+    // test), reached another way: the factors are of the contact-free
+    // tangent of some earlier iterate, possibly of an earlier state, and
+    // are renewed only when the iteration slows down. Each iteration then
+    // costs a residual, a triangular solve, the compliance columns of
+    // candidates that joined, and a dense contact problem on a few dozen
+    // nodes; a change of the contact set no longer costs a factorisation.
+    Outcome outcome;
+    double  scale = 0;
+    auto    start = Clock::now();
+    if (!system->assemble(x, target, residual, nullptr, &scale))
+      {
+        outcome.status  = SolveStatus::not_finite;
+        outcome.message = "the starting state is not admissible";
+        return outcome;
+      }
+    double       assembly_time   = seconds_since(start);
+    double       last_correction = -1;
+    unsigned int short_steps = 0, slow = 0;
+    bool         refactorize = !contact_free_factors;
+    const double beta        = system->constraint_scale();
+    for (unsigned int iteration = 0;; ++iteration)
+      {
+        if (converged(residual, scale, last_correction))
+          {
+            outcome.iterations = iteration;
+            return outcome;
+          }
+        if (halt(iteration, scale, outcome))
+          return outcome;
+
+        NewtonIteration record;
+        record.increment       = state.increments;
+        record.residual_before = system->force_residual_norm(residual) / scale;
+        record.assembly_time   = assembly_time;
+        record.factorized      = refactorize;
+        start                  = Clock::now();
+        if (refactorize && !factorize_contact_free(x, target))
+          {
+            outcome.status  = SolveStatus::linear_solver_failure;
+            outcome.message = linear_solver->message();
+            return outcome;
+          }
+        refactorize = false;
+
+        // du_0 = -K^-1 R with the candidates' forces lambda = beta x_lambda
+        // held: the residual's contact forces lambda_hat are replaced by
+        // lambda (they differ where the last step left a gap open or
+        // closed), and the contact rows carry nothing.
+        system->contact_rows(x, target, rows);
+        step = residual;
+        for (const auto &r : rows)
+          {
+            const double lambda = beta * x[r.multiplier_eq];
+            for (unsigned int a = 0; a < 3; ++a)
+              if (r.eq[a] >= 0)
+                step[r.eq[a]] += (r.lambda_hat - lambda) * r.n[a];
+            step[r.multiplier_eq] = 0;
+          }
+        for (double &v : step)
+          v = -v;
+        if (!linear_solver->solve(step) ||
+            !condensed->step(*linear_solver,
+                             x,
+                             rows,
+                             step,
+                             1e-3 * settings.increment_tolerance *
+                               system->length_scale()))
+          {
+            outcome.status  = SolveStatus::linear_solver_failure;
+            outcome.message = linear_solver->message();
+            return outcome;
+          }
+        record.solve_time = seconds_since(start);
+
+        start                               = Clock::now();
+        const auto [best_alpha, best_scale] = line_search(x, target, 1);
+        record.line_search_time             = seconds_since(start);
+        if (best_alpha < 0)
+          {
+            record.step_length      = 0;
+            record.correction       = 0;
+            record.residual_after   = record.residual_before;
+            record.constraint_after = system->constraint_violation(residual);
+            state.history.push_back(record);
+            outcome.status     = SolveStatus::inverted_element;
+            outcome.iterations = iteration + 1;
+            outcome.message    = "every step the line search tried inverts "
+                                 "an element";
+            return outcome;
+          }
+        x.swap(best_x);
+        residual.swap(best_residual);
+        scale                   = best_scale;
+        record.residual_after   = system->force_residual_norm(residual) / scale;
+        record.constraint_after = system->constraint_violation(residual);
+        record.step_length      = best_alpha;
+        record.correction       = best_alpha * system->max_displacement(step);
+        state.history.push_back(record);
+        // The round-off test of converged() trusts a negligible step only
+        // from the factors of this iterate's tangent: a quasi-Newton step
+        // with older factors is short while the residual is still well
+        // above the tolerance (it shrinks by a fixed ratio).
+        last_correction =
+          record.factorized ? system->max_displacement(step) : -1;
+        // A multiplier the line search left between two forces is still a
+        // force: never negative.
+        for (const auto &r : rows)
+          x[r.multiplier_eq] = std::max(0.0, x[r.multiplier_eq]);
+
+        if (const std::string why =
+              stagnation(state, record, iteration, may_cut_back, short_steps);
+            !why.empty())
+          {
+            outcome.status     = SolveStatus::max_iterations;
+            outcome.iterations = iteration + 1;
+            outcome.message    = why;
+            return outcome;
+          }
+        // The factors of an older tangent make each step cut the residual
+        // by a fixed ratio; when that ratio is poor twice in a row (the
+        // material has moved on), a new factorisation is cheaper than the
+        // iterations it saves.
+        // The ratio is that of the relative residual: once the sphere
+        // lets go, the residual is the internal force itself and stays at
+        // 1 relative to it under any fixed factors, while exact Newton
+        // steps reach rest in a few iterations.
+        slow =
+          record.residual_after > 0.25 * record.residual_before ? slow + 1 : 0;
+        refactorize = slow >= 2 && !record.factorized;
+        if (refactorize)
+          slow = 0;
+        assembly_time = 0;
+      }
+  }
+
+
+
+  bool
+  StateSolver::Impl::condensed_stiffness(State &state)
+  {
+    // From the kept contact-free factors, like the Newton steps: within
+    // their quasi-Newton distance of the converged tangent.
+    if (!contact_free_factors)
+      return false;
+    const std::vector<double> x = system->from_state(state);
+    system->contact_rows(x, state.active_displacement, rows);
+    return condensed->stiffness(*linear_solver, x, rows, state.stiffness);
   }
 
 
@@ -1189,8 +1418,11 @@ namespace palpate
     else if (impl->settings.compute_stiffness)
       {
         const auto stiffness_start = Clock::now();
-        state.has_stiffness        = impl->active_stiffness(state);
-        state.stiffness_time       = seconds_since(stiffness_start);
+        state.has_stiffness =
+          impl->settings.condensed_contact && impl->system->has_contact() ?
+            impl->condensed_stiffness(state) :
+            impl->active_stiffness(state);
+        state.stiffness_time = seconds_since(stiffness_start);
       }
     state.wall_time = seconds_since(start);
     return state;

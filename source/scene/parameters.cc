@@ -930,6 +930,20 @@ namespace palpate
                           "which the kept factorisation counts as too old "
                           "and the tangent is factorised anew "
                           "(dimensionless).");
+        prm.declare_entry(
+          "Contact solver",
+          "in matrix",
+          Patterns::Selection("in matrix|condensed"),
+          "How a sphere's frictionless contact enters each Newton step. 'in "
+          "matrix': the contact rows of the nodes touching it are part of the "
+          "tangent that is factorised (Alart and Curnier's semi-smooth "
+          "Newton), so every change of the contact set changes the matrix. "
+          "'condensed': the factorised tangent leaves the contact out; the "
+          "contact is solved on the compliance W = C K^-1 C^T of the surface "
+          "nodes near the sphere (a small dense complementarity problem) and "
+          "the kept factorisation serves while the contact set moves. Both "
+          "converge to the same states (Residual tolerance). Ignored without "
+          "a sphere (doc/benchmarks/organ-speed.md).");
       }
       prm.leave_subsection();
     }
@@ -954,6 +968,7 @@ namespace palpate
         reuse_by_size           = reuse == "by size";
         reuse_factorization     = reuse != "false";
         max_krylov_iterations   = prm.get_integer("Maximum Krylov iterations");
+        condensed_contact       = prm.get("Contact solver") == "condensed";
       }
       prm.leave_subsection();
     }

@@ -173,6 +173,36 @@ namespace palpate
     contact(const State &state) const;
 
     /**
+     * One contact candidate as the condensed contact solver sees it at
+     * some unknowns: where its rows are and how it touches the sphere.
+     */
+    struct ContactRow
+    {
+      /** The equations of the node's x, y, z displacements (-1: fixed). */
+      std::array<int, 3> eq;
+      /** The equation of its multiplier. */
+      unsigned int multiplier_eq;
+      /** Unit normal from the sphere's centre to the node (deformed). */
+      Utilities::Point3 n;
+      /** Distance of the node from the centre (m) and from the sphere's
+       * surface, rho - R (m; negative: inside). */
+      double rho, gap;
+      /** The contact force the residual applies, lambda_hat = beta
+       * max(0, x_lambda - gap) (N). */
+      double lambda_hat;
+    };
+
+    /**
+     * Every contact candidate's row data at unknowns @p x with the HIP
+     * displaced by @p target, into @p rows (resized to the number of
+     * candidates; no allocation once it has that size).
+     */
+    void
+    contact_rows(const std::vector<double> &x,
+                 const Utilities::Point3   &target,
+                 std::vector<ContactRow>   &rows) const;
+
+    /**
      * The force the body exerts on the probe (N) at unknowns @p x with the
      * HIP displaced by @p target: the sum of the probe's multipliers for a
      * point probe or glued tip, the resultant of the contact forces,
@@ -277,13 +307,21 @@ namespace palpate
      * convergence test (N): the largest of the norm of the internal forces
      * at all DoFs (which includes the reactions), the norm of the
      * multipliers, and 1e-12 E L^2.
+     *
+     * With @p contact_in_matrix false the tangent leaves the sphere's
+     * contact out: every contact row is that of a candidate out of
+     * contact (-beta on the diagonal, no coupling), whatever the active
+     * set. Its factors then stay valid while the contact set moves, and
+     * the condensed contact solver handles contact on the candidates'
+     * compliance instead. The residual is the same either way.
      */
     bool
     assemble(const std::vector<double> &x,
              const Utilities::Point3   &target,
              std::vector<double>       &residual,
              std::vector<double>       *matrix,
-             double                    *force_scale = nullptr) const;
+             double                    *force_scale       = nullptr,
+             const bool                 contact_in_matrix = true) const;
 
     /** Euclidean norm of the displacement rows of @p residual (N). */
     double

@@ -75,6 +75,16 @@ namespace palpate
     solve(std::vector<double> &rhs) = 0;
 
     /**
+     * Solve A X = B in place for @p n_rhs right-hand sides stored one
+     * after the other in @p block (column-major, n_rows each). The
+     * default solves them one by one; MUMPS solves them in one pass over
+     * its factors, which is several times cheaper per column than single
+     * solves (the triangular solves become matrix-matrix products).
+     */
+    virtual bool
+    solve_many(std::vector<double> &block, const unsigned int n_rhs);
+
+    /**
      * Whether solve() solves A x = b to round-off. False for a
      * mixed-precision solver ("MUMPS single": single-precision factors),
      * whose solve() is only an approximate inverse: the Newton method then

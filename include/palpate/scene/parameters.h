@@ -257,6 +257,11 @@ namespace palpate
       bool                          reuse_by_size = false;
       static constexpr unsigned int reuse_from    = 1500;
       unsigned int                  max_krylov_iterations;
+      /** Contact solver = condensed: with a sphere, the factorised tangent
+       * leaves the contact out and each Newton step solves the contact on
+       * the candidates' compliance (a small dense problem); false: the
+       * contact rows are in the factorised tangent (the reference). */
+      bool condensed_contact = false;
 
       /** Fix reuse_factorization to @p on (no choice by size). */
       void
