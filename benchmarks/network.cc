@@ -79,7 +79,8 @@ namespace
 
   const std::string scene =
     std::string(PALPATE_SOURCE_DIR) + "/parameters/liver-stvk-mpi.prm";
-  const std::string palpate = std::string(PALPATE_BINARY_DIR) + "/palpate";
+  const std::string palpate_program =
+    std::string(PALPATE_BINARY_DIR) + "/palpate";
 
   /** The key,value CSV summary palpate writes (Output / Summary formats). */
   std::map<std::string, std::string>
@@ -141,7 +142,7 @@ namespace
     netns_cluster::RunOptions limited = options;
     if (limited.time_limit == 0)
       limited.time_limit = 180;
-    t.run     = cluster.run(palpate, arguments, limited);
+    t.run     = cluster.run(palpate_program, arguments, limited);
     t.status  = t.run.rank_status.empty() ? -1 : t.run.rank_status[0];
     t.summary = read_summary(directory + "/liver-stvk-mpi-summary.csv");
     {
@@ -533,9 +534,9 @@ main(int argc, char **argv)
                 << std::endl;
       return 1;
     }
-  if (!std::filesystem::exists(palpate))
+  if (!std::filesystem::exists(palpate_program))
     {
-      std::cerr << "benchmarks/run network: " << palpate
+      std::cerr << "benchmarks/run network: " << palpate_program
                 << " is missing: cmake --build build --target palpate"
                 << std::endl;
       return 1;
