@@ -56,7 +56,9 @@ namespace
     p.scheduler.cloud_radius   = radius;
     p.haptics.trajectory.type  = "straight line";
     p.haptics.trajectory.start = "after initial cloud";
-    p.haptics.trajectory.speed = 0.001;
+    // The motion only ends the run once the cloud is measured: short, but
+    // 0.2 mm, over the 0.1 mm a trajectory must move (Scene::validate()).
+    p.haptics.trajectory.speed    = 0.004;
     p.haptics.trajectory.duration = 0.05;
     p.effects.shape_output        = false;
     p.effects.force_log           = false;
