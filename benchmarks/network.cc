@@ -42,6 +42,7 @@
 
 #include "machine.h"
 #include "netns_cluster.h"
+#include "report_errors.h"
 
 namespace
 {
@@ -485,8 +486,8 @@ namespace
 
 
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   // Before any thread: SIGINT, SIGTERM, SIGHUP remove the namespaces.
   netns_cluster::remove_on_signals();
@@ -542,14 +543,15 @@ main(int argc, char **argv)
       return 1;
     }
 
-  try
-    {
-      return measure(o);
-    }
-  catch (const std::exception &e)
-    {
-      // The clusters are removed on the way here.
-      std::cerr << "benchmarks/run network: " << e.what() << std::endl;
-      return 1;
-    }
+  // An exception from measure() removes the clusters on its way out (each
+  // one's destructor) and is reported by report_errors().
+  return measure(o);
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("network", run_benchmark, argc, argv);
 }

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "mpi_child.h"
+#include "report_errors.h"
 
 using namespace palpate;
 
@@ -104,8 +105,8 @@ namespace
   };
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.size() == 5 && args[0] == "--child")
@@ -208,4 +209,12 @@ main(int argc, char **argv)
               << " radius_mm=" << std::setprecision(0) << 1000 * radius
               << " reuse=" << (reuse_used ? "yes" : "no") << "\n";
   return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("scaling", run_benchmark, argc, argv);
 }
