@@ -38,11 +38,12 @@
 #include <sstream>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   bool        quick    = false;
@@ -178,4 +179,13 @@ main(int argc, char **argv)
                 << " missing_events=" << s.missing_events << "\n";
       }
   std::cout << results.str();
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("accuracy", run_benchmark, argc, argv);
 }

@@ -51,6 +51,7 @@
 #include <vector>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 using Utilities::Point3;
@@ -293,8 +294,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   Options     o;
@@ -531,4 +532,12 @@ main(int argc, char **argv)
               << " peak_busy_unlimited=" << r.peak_unlimited
               << " state_s=" << Utilities::to_string(state_time(r), 3) << "\n";
   return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("cluster", run_benchmark, argc, argv);
 }

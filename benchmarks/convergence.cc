@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 using Utilities::Point3;
@@ -179,8 +180,8 @@ namespace
 
 
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   bool        quick = false;
@@ -374,4 +375,12 @@ main(int argc, char **argv)
               << s.extrapolated << "," << l.state_ms << "\n";
     }
   return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("convergence", run_benchmark, argc, argv);
 }

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 
@@ -125,8 +126,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment  env(argc, argv);
   bool         quick   = false;
@@ -235,4 +236,13 @@ main(int argc, char **argv)
         << "\n";
     }
   std::cout << "\n" << results.str();
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("effects", run_benchmark, argc, argv);
 }

@@ -48,6 +48,7 @@
 
 #include "machine.h"
 #include "mpi_child.h"
+#include "report_errors.h"
 
 using namespace palpate;
 using Utilities::Point3;
@@ -171,8 +172,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment  env(argc, argv);
   bool         quick    = false;
@@ -326,4 +327,13 @@ main(int argc, char **argv)
                "/usr/bin/python3 doc/images/failure_points.py "
                "failure-points.csv)\n\n"
             << results.str();
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("failure-points", run_benchmark, argc, argv);
 }

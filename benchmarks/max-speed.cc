@@ -62,6 +62,7 @@
 
 #include "machine.h"
 #include "mpi_child.h"
+#include "report_errors.h"
 
 using namespace palpate;
 using Utilities::Point3;
@@ -289,8 +290,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   if (argc == 8 && std::string(argv[1]) == "--child")
@@ -500,4 +501,12 @@ main(int argc, char **argv)
       << " run_s=" << std::setprecision(1)
       << x.t.cloud_seconds + o.length / x.t.speed << "\n";
   return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("max-speed", run_benchmark, argc, argv);
 }

@@ -38,6 +38,7 @@
 #include <sstream>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 
@@ -74,8 +75,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment  env(argc, argv);
   bool         quick   = false;
@@ -194,4 +195,13 @@ main(int argc, char **argv)
     std::filesystem::remove_all("bench-meshes");
   }
   std::cout << "\n" << results.str();
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("mesh", run_benchmark, argc, argv);
 }

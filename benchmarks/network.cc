@@ -42,6 +42,7 @@
 
 #include "machine.h"
 #include "netns_cluster.h"
+#include "report_errors.h"
 
 namespace
 {
@@ -79,7 +80,8 @@ namespace
 
   const std::string scene =
     std::string(PALPATE_SOURCE_DIR) + "/parameters/liver-stvk-mpi.prm";
-  const std::string palpate = std::string(PALPATE_BINARY_DIR) + "/palpate";
+  const std::string palpate_program =
+    std::string(PALPATE_BINARY_DIR) + "/palpate";
 
   /** The key,value CSV summary palpate writes (Output / Summary formats). */
   std::map<std::string, std::string>
@@ -141,7 +143,7 @@ namespace
     netns_cluster::RunOptions limited = options;
     if (limited.time_limit == 0)
       limited.time_limit = 180;
-    t.run     = cluster.run(palpate, arguments, limited);
+    t.run     = cluster.run(palpate_program, arguments, limited);
     t.status  = t.run.rank_status.empty() ? -1 : t.run.rank_status[0];
     t.summary = read_summary(directory + "/liver-stvk-mpi-summary.csv");
     {
@@ -484,8 +486,8 @@ namespace
 
 
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   // Before any thread: SIGINT, SIGTERM, SIGHUP remove the namespaces.
   netns_cluster::remove_on_signals();
@@ -533,22 +535,23 @@ main(int argc, char **argv)
                 << std::endl;
       return 1;
     }
-  if (!std::filesystem::exists(palpate))
+  if (!std::filesystem::exists(palpate_program))
     {
-      std::cerr << "benchmarks/run network: " << palpate
+      std::cerr << "benchmarks/run network: " << palpate_program
                 << " is missing: cmake --build build --target palpate"
                 << std::endl;
       return 1;
     }
 
-  try
-    {
-      return measure(o);
-    }
-  catch (const std::exception &e)
-    {
-      // The clusters are removed on the way here.
-      std::cerr << "benchmarks/run network: " << e.what() << std::endl;
-      return 1;
-    }
+  // An exception from measure() removes the clusters on its way out (each
+  // one's destructor) and is reported by report_errors().
+  return measure(o);
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("network", run_benchmark, argc, argv);
 }

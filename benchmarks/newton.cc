@@ -44,6 +44,8 @@
 #include <random>
 #include <sstream>
 
+#include "report_errors.h"
+
 using namespace palpate;
 using Utilities::Point3;
 
@@ -409,8 +411,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment environment(argc, argv);
   Options     o;
@@ -800,4 +802,13 @@ main(int argc, char **argv)
 
   for (const auto &r : results)
     std::cout << r << "\n";
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("newton", run_benchmark, argc, argv);
 }

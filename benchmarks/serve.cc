@@ -36,6 +36,7 @@
 #include <thread>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 
@@ -137,8 +138,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   bool        quick = false;
@@ -210,4 +211,13 @@ main(int argc, char **argv)
   std::cout << "\n";
   for (const auto &line : results)
     std::cout << line << "\n";
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("serve", run_benchmark, argc, argv);
 }

@@ -35,6 +35,7 @@
 #include <thread>
 
 #include "machine.h"
+#include "report_errors.h"
 
 using namespace palpate;
 
@@ -60,8 +61,8 @@ namespace
   }
 } // namespace
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   bool        quick = false;
@@ -173,4 +174,13 @@ main(int argc, char **argv)
       std::filesystem::remove(p.state_space.store);
     }
   std::cout << "\n" << results.str();
+  return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("store", run_benchmark, argc, argv);
 }
