@@ -262,6 +262,15 @@ namespace palpate
                      State                   &state,
                      const bool               may_cut_back);
 
+    /**
+     * Whether the next condensed Newton iteration should factorise the
+     * tangent anew, after the iteration @p record (its relative residual
+     * before and after) and the rate of the one before it.
+     */
+    bool
+    worth_refactorizing(const NewtonIteration &record,
+                        const double           previous_rate) const;
+
     /** Assemble the contact-free tangent at @p x and factorise it; the
      * compliance columns of the old factors are dropped. */
     bool
@@ -461,7 +470,16 @@ namespace palpate
     // Condensed contact: whether the kept factors are of a contact-free
     // tangent (only then do the compliance columns of `condensed` hold),
     // and the candidates' rows at the current iterate.
-    bool                                        contact_free_factors = false;
+    bool contact_free_factors = false;
+    // Whether they were made in the last Newton solve (the state's last
+    // increment), and the relative residual of the iterate they were made
+    // at.
+    bool   factors_of_state  = false;
+    double factored_residual = 0;
+    // Seconds of a condensed Newton iteration on kept factors and of one
+    // that factorises (with the compliance columns after it): running
+    // averages, 0 until measured.
+    double iteration_cost = 0, refactorization_cost = 0;
     std::vector<HyperelasticSystem::ContactRow> rows;
     std::unique_ptr<CondensedContact>           condensed;
 
@@ -860,6 +878,43 @@ namespace palpate
 
 
   bool
+  StateSolver::Impl::worth_refactorizing(const NewtonIteration &record,
+                                         const double previous_rate) const
+  {
+    if (record.factorized)
+      return false;
+    const double r    = record.residual_after;
+    const double rate = std::max(r / record.residual_before, previous_rate);
+    // A state whose stiffness is wanted needs factors of an iterate one
+    // Newton step from it (condensed_stiffness()): made as soon as the
+    // residual is that close, they also make the last steps exact.
+    if (settings.compute_stiffness && !factors_of_state && r <= 1e-4)
+      return true;
+    // Factors of an older tangent cut the residual by a fixed ratio per
+    // step. The relative residual's ratio, because once the sphere lets go
+    // the residual is the internal force itself and stays at 1 relative
+    // to it under any fixed factors, while exact steps reach rest in a few.
+    if (previous_rate == 0)
+      return false; // one ratio measured is no rate yet
+    if (rate >= 0.9)
+      return true;
+    // Otherwise: when the iterations left at this rate cost more than a
+    // factorisation (and its columns) and the two or three exact steps
+    // after it.
+    const double left =
+      std::log(settings.residual_tolerance / std::max(r, 1e-300)) /
+      std::log(rate);
+    // With the stiffness wanted, factors made this far from the state
+    // will be made again at its end: they cost twice.
+    const double factorization =
+      (refactorization_cost > 0 ? refactorization_cost : 20 * iteration_cost) *
+      (settings.compute_stiffness ? 2 : 1);
+    return left * iteration_cost > factorization + 2 * iteration_cost;
+  }
+
+
+
+  bool
   StateSolver::Impl::factorize_contact_free(const std::vector<double> &x,
                                             const Utilities::Point3   &target)
   {
@@ -903,9 +958,14 @@ namespace palpate
       }
     double       assembly_time   = seconds_since(start);
     double       last_correction = -1;
-    unsigned int short_steps = 0, slow = 0;
-    bool         refactorize = !contact_free_factors;
-    const double beta        = system->constraint_scale();
+    unsigned int short_steps     = 0;
+    double       previous_rate   = 0;
+    bool         refactorize     = !contact_free_factors;
+    const double beta            = system->constraint_scale();
+    // Factors count as the state's only if made in its last increment
+    // (this Newton solve): those of an increment before are of another
+    // target.
+    factors_of_state = false;
     for (unsigned int iteration = 0;; ++iteration)
       {
         if (converged(residual, scale, last_correction))
@@ -922,6 +982,11 @@ namespace palpate
         record.assembly_time   = assembly_time;
         record.factorized      = refactorize;
         start                  = Clock::now();
+        if (refactorize)
+          {
+            factors_of_state  = true;
+            factored_residual = record.residual_before;
+          }
         if (refactorize && !factorize_contact_free(x, target))
           {
             outcome.status  = SolveStatus::linear_solver_failure;
@@ -963,6 +1028,12 @@ namespace palpate
         start                               = Clock::now();
         const auto [best_alpha, best_scale] = line_search(x, target, 1);
         record.line_search_time             = seconds_since(start);
+        // What an iteration and a refactorisation cost on this machine and
+        // body, as worth_refactorizing() weighs them.
+        const double spent = record.solve_time + record.line_search_time;
+        double      &cost =
+          record.factorized ? refactorization_cost : iteration_cost;
+        cost = cost > 0 ? 0.7 * cost + 0.3 * spent : spent;
         if (best_alpha < 0)
           {
             record.step_length      = 0;
@@ -1004,19 +1075,10 @@ namespace palpate
             outcome.message    = why;
             return outcome;
           }
-        // The factors of an older tangent make each step cut the residual
-        // by a fixed ratio; when that ratio is poor twice in a row (the
-        // material has moved on), a new factorisation is cheaper than the
-        // iterations it saves.
-        // The ratio is that of the relative residual: once the sphere
-        // lets go, the residual is the internal force itself and stays at
-        // 1 relative to it under any fixed factors, while exact Newton
-        // steps reach rest in a few iterations.
-        slow =
-          record.residual_after > 0.25 * record.residual_before ? slow + 1 : 0;
-        refactorize = slow >= 2 && !record.factorized;
-        if (refactorize)
-          slow = 0;
+        refactorize   = worth_refactorizing(record, previous_rate);
+        previous_rate = record.factorized ?
+                          0 :
+                          record.residual_after / record.residual_before;
         assembly_time = 0;
       }
   }
@@ -1031,6 +1093,16 @@ namespace palpate
     if (!contact_free_factors)
       return false;
     const std::vector<double> x = system->from_state(state);
+    // The stiffness is exact for the tangent the factors are of: within
+    // one Newton step of the state it is within that step's distance, as
+    // active_stiffness() is; older factors (another state's, an early
+    // iterate's) give it only to their quasi-Newton distance: 1 % on the
+    // liver, a factor 2 under one node pushed 1.5 mm into the coarse beam
+    // (tests/hyperelastic/condensed_contact). New factors here also start
+    // the neighbouring state.
+    if (!(factors_of_state && factored_residual <= 1e-4) &&
+        !factorize_contact_free(x, state.active_displacement))
+      return false;
     system->contact_rows(x, state.active_displacement, rows);
     return condensed->stiffness(*linear_solver, x, rows, state.stiffness);
   }
