@@ -191,6 +191,7 @@ namespace
                 break; // the rest of this line has no neighbour
               }
             m.newton += s.newton_iterations;
+            m.factorizations += s.stiffness_factorizations;
             if (trace)
               {
                 std::cout << "    state " << m.ms.size() << " at ("
@@ -246,6 +247,9 @@ namespace
   {
     double spacing = 0; // m
     bool   hermite = false;
+    /** Contact solver = condensed (--stroke-contact condensed, the
+     * default) or in matrix (--stroke-contact matrix). */
+    bool condensed = true;
   } stroke_grid;
 
   /** The stroke's settings: the best lever configuration, the engine. */
@@ -263,6 +267,7 @@ namespace
     p.state_space.interpolation =
       stroke_grid.hermite ? "tricubic Hermite" : "trilinear";
     p.nonlinear_solver.max_increment_length = p.state_space.grid_spacing;
+    p.nonlinear_solver.condensed_contact    = stroke_grid.condensed;
     // The accuracy study's residual tolerance (part 1's last lever).
     p.nonlinear_solver.residual_tolerance = 1e-3;
     p.engine.type                         = engine;
@@ -305,7 +310,7 @@ namespace
         std::ostringstream a;
         a << std::setprecision(17) << "--child " << fine_size << " " << material
           << " " << speed << " " << stroke_grid.spacing << " "
-          << stroke_grid.hermite;
+          << stroke_grid.hermite << " " << stroke_grid.condensed;
         const auto v = mpi_child::run(mpi_child::command(3, a.str()));
         Trial      t;
         t.speed           = speed;
@@ -390,6 +395,7 @@ namespace
     const double fine_size = std::stod(a[0]);
     stroke_grid.spacing    = std::stod(a[3]);
     stroke_grid.hermite    = a[4] == "1";
+    stroke_grid.condensed  = a.size() > 5 && a[5] == "1";
     if (mpi_rank() > 0)
       {
         const Scene         scene = stroke_scene(fine_size, a[1], "mpi");
@@ -415,7 +421,7 @@ int
 main(int argc, char **argv)
 {
   Environment env(argc, argv);
-  if (argc == 7 && std::string(argv[1]) == "--child")
+  if (argc == 8 && std::string(argv[1]) == "--child")
     return child(std::vector<std::string>(argv + 2, argv + argc));
   Options o;
   for (int i = 1; i < argc; ++i)
@@ -460,6 +466,8 @@ main(int argc, char **argv)
         stroke_grid.spacing = 1e-3 * std::stod(argv[++i]);
       else if (a == "--hermite")
         stroke_grid.hermite = true;
+      else if (a == "--stroke-contact" && i + 1 < argc)
+        stroke_grid.condensed = std::string(argv[++i]) != "matrix";
       else if (a == "--cores" && i + 1 < argc)
         {
           o.cores  = std::stoul(argv[++i]);
@@ -471,7 +479,8 @@ main(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K] [--spacing MM] [--hermite]\n";
+               "[--cores K] [--spacing MM] [--hermite] "
+               "[--stroke-contact condensed|matrix]\n";
           return 2;
         }
     }
@@ -686,8 +695,11 @@ main(int argc, char **argv)
                     << 1e3 *
                          (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
                     << "mm"
-                    << " state_ms=" << state_ms
+                    << " contact="
+                    << (stroke_grid.condensed ? "condensed" : "matrix")
+                    << " online=yes state_ms=" << state_ms
                     << " speed_mm_s=" << (best.passed ? 1e3 * best.speed : 0)
+                    << " missing_data=" << shown.missing
                     << " deadline_misses=" << shown.deadline_misses
                     << " bare_loop_misses=" << bare.first
                     << " ticks=" << shown.ticks << "\n";

@@ -93,6 +93,8 @@ namespace palpate
     bool                  has_stiffness = false;
     /** Seconds of wall_time spent on the stiffness. */
     double stiffness_time = 0;
+    /** Factorisations the stiffness made (beside those in history). */
+    unsigned int stiffness_factorizations = 0;
 
     /** Nodal solution in deal.II DoF order (displacements, m). */
     std::vector<double> solution;
