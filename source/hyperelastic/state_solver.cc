@@ -252,15 +252,16 @@ namespace palpate
            const bool               may_cut_back = false);
 
     /**
-     * newton() with Contact solver = condensed: the factorised tangent
-     * leaves the sphere's contact out, and each step solves the contact
-     * on the compliance of the candidates near the sphere.
+     * The Newton step of Contact solver = condensed into `step` (from
+     * `residual` at @p x), with the factors renewed first if
+     * @p refactorize; fills @p record's solver fields. False if the linear
+     * solver failed.
      */
-    Outcome
-    newton_condensed(std::vector<double>     &x,
-                     const Utilities::Point3 &target,
-                     State                   &state,
-                     const bool               may_cut_back);
+    bool
+    condensed_step(const std::vector<double> &x,
+                   const Utilities::Point3   &target,
+                   NewtonIteration           &record,
+                   const bool                 refactorize);
 
     /**
      * Whether the next condensed Newton iteration should factorise the
@@ -731,14 +732,21 @@ namespace palpate
                             State                   &state,
                             const bool               may_cut_back)
   {
-    if (settings.condensed_contact && system->has_contact())
-      return newton_condensed(x, target, state, may_cut_back);
-    Outcome outcome;
-    double  scale = 0;
+    // With Contact solver = condensed the same equilibrium (this residual,
+    // this convergence test) is reached another way: the factors leave
+    // the sphere's contact out and are kept while it moves
+    // (condensed_step()). Each iteration then costs a residual, a
+    // triangular solve, the compliance columns of candidates that joined
+    // and a dense contact problem on a few dozen nodes; no tangent is
+    // assembled unless it is factorised.
+    const bool condensed_path = settings.condensed_contact && condensed;
+    Outcome    outcome;
+    double     scale = 0;
 
     auto start         = Clock::now();
     factorized_current = false;
-    if (!system->assemble(x, target, residual, &matrix, &scale))
+    if (!system->assemble(
+          x, target, residual, condensed_path ? nullptr : &matrix, &scale))
       {
         // The starting state is a converged neighbour, so this is only
         // reachable with a corrupt input state.
@@ -749,6 +757,12 @@ namespace palpate
     double       assembly_time   = seconds_since(start);
     double       last_correction = -1;
     unsigned int short_steps     = 0;
+    double       previous_rate   = 0;
+    bool         refactorize     = condensed_path && !contact_free_factors;
+    // Factors count as the state's only if made in its last increment
+    // (this Newton solve): those of an increment before are of another
+    // target.
+    factors_of_state = false;
 
     for (unsigned int iteration = 0;; ++iteration)
       {
@@ -766,7 +780,8 @@ namespace palpate
         record.assembly_time   = assembly_time;
 
         start = Clock::now();
-        if (!newton_step(record))
+        if (!(condensed_path ? condensed_step(x, target, record, refactorize) :
+                               newton_step(record)))
           {
             outcome.status     = SolveStatus::linear_solver_failure;
             outcome.iterations = iteration;
@@ -777,9 +792,21 @@ namespace palpate
           }
         record.solve_time = seconds_since(start);
 
-        start                               = Clock::now();
-        const auto [best_alpha, best_scale] = line_search(x, target, iteration);
-        record.line_search_time             = seconds_since(start);
+        // (The condensed step is never the predictor that only moves the
+        // probe: its first step is already the contact's Newton step.)
+        start = Clock::now();
+        const auto [best_alpha, best_scale] =
+          line_search(x, target, condensed_path ? 1 : iteration);
+        record.line_search_time = seconds_since(start);
+        if (condensed_path)
+          {
+            // What an iteration and a refactorisation cost on this machine
+            // and body, as worth_refactorizing() weighs them.
+            const double spent = record.solve_time + record.line_search_time;
+            double      &cost =
+              record.factorized ? refactorization_cost : iteration_cost;
+            cost = cost > 0 ? 0.7 * cost + 0.3 * spent : spent;
+          }
         if (best_alpha < 0)
           {
             record.step_length      = 0;
@@ -804,8 +831,17 @@ namespace palpate
         record.correction       = best_alpha * system->max_displacement(step);
         state.history.push_back(record);
         // The round-off test of converged() looks at the full Newton step:
-        // a short line-search step says nothing about being close.
-        last_correction = system->max_displacement(step);
+        // a short line-search step says nothing about being close. Nor
+        // does a quasi-Newton step on older factors: it is short while the
+        // residual is still well above the tolerance.
+        last_correction = !condensed_path || record.factorized ?
+                            system->max_displacement(step) :
+                            -1;
+        // A multiplier the line search left between two forces is still a
+        // force: never negative.
+        if (condensed_path)
+          for (const auto &r : rows)
+            x[r.multiplier_eq] = std::max(0.0, x[r.multiplier_eq]);
 
         // Stagnation (a start outside the basin, or a line search that
         // gets nowhere): give up this Newton solve early.
@@ -823,6 +859,15 @@ namespace palpate
           {
             outcome.iterations = iteration + 1;
             return outcome;
+          }
+        if (condensed_path)
+          {
+            refactorize   = worth_refactorizing(record, previous_rate);
+            previous_rate = record.factorized ?
+                              0 :
+                              record.residual_after / record.residual_before;
+            assembly_time = 0;
+            continue;
           }
         start              = Clock::now();
         factorized_current = false;
@@ -935,153 +980,47 @@ namespace palpate
 
 
 
-  StateSolver::Impl::Outcome
-  StateSolver::Impl::newton_condensed(std::vector<double>     &x,
-                                      const Utilities::Point3 &target,
-                                      State                   &state,
-                                      const bool               may_cut_back)
+  bool
+  StateSolver::Impl::condensed_step(const std::vector<double> &x,
+                                    const Utilities::Point3   &target,
+                                    NewtonIteration           &record,
+                                    const bool                 refactorize)
   {
-    // The same equilibrium as newton() (its residual, its convergence
-    // test), reached another way: the factors are of the contact-free
-    // tangent of some earlier iterate, possibly of an earlier state, and
-    // are renewed only when the iteration slows down. Each iteration then
-    // costs a residual, a triangular solve, the compliance columns of
-    // candidates that joined, and a dense contact problem on a few dozen
-    // nodes; a change of the contact set no longer costs a factorisation.
-    Outcome outcome;
-    double  scale = 0;
-    auto    start = Clock::now();
-    if (!system->assemble(x, target, residual, nullptr, &scale))
+    // The factors are of the contact-free tangent of some earlier iterate,
+    // possibly of an earlier state, renewed only where that pays
+    // (worth_refactorizing()). The step is then K^-1 (-R) with the
+    // candidates' forces lambda = beta x_lambda held, the residual's
+    // contact forces lambda_hat replaced by lambda (they differ where the
+    // last step left a gap open or closed) and nothing on the contact rows,
+    // turned by CondensedContact into the step with the contact solved.
+    record.factorized = refactorize;
+    if (refactorize)
       {
-        outcome.status  = SolveStatus::not_finite;
-        outcome.message = "the starting state is not admissible";
-        return outcome;
+        factors_of_state  = true;
+        factored_residual = record.residual_before;
+        if (!factorize_contact_free(x, target))
+          return false;
       }
-    double       assembly_time   = seconds_since(start);
-    double       last_correction = -1;
-    unsigned int short_steps     = 0;
-    double       previous_rate   = 0;
-    bool         refactorize     = !contact_free_factors;
-    const double beta            = system->constraint_scale();
-    // Factors count as the state's only if made in its last increment
-    // (this Newton solve): those of an increment before are of another
-    // target.
-    factors_of_state = false;
-    for (unsigned int iteration = 0;; ++iteration)
+    const double beta = system->constraint_scale();
+    system->contact_rows(x, target, rows);
+    step = residual;
+    for (const auto &r : rows)
       {
-        if (converged(residual, scale, last_correction))
-          {
-            outcome.iterations = iteration;
-            return outcome;
-          }
-        if (halt(iteration, scale, outcome))
-          return outcome;
-
-        NewtonIteration record;
-        record.increment       = state.increments;
-        record.residual_before = system->force_residual_norm(residual) / scale;
-        record.assembly_time   = assembly_time;
-        record.factorized      = refactorize;
-        start                  = Clock::now();
-        if (refactorize)
-          {
-            factors_of_state  = true;
-            factored_residual = record.residual_before;
-          }
-        if (refactorize && !factorize_contact_free(x, target))
-          {
-            outcome.status  = SolveStatus::linear_solver_failure;
-            outcome.message = linear_solver->message();
-            return outcome;
-          }
-        refactorize = false;
-
-        // du_0 = -K^-1 R with the candidates' forces lambda = beta x_lambda
-        // held: the residual's contact forces lambda_hat are replaced by
-        // lambda (they differ where the last step left a gap open or
-        // closed), and the contact rows carry nothing.
-        system->contact_rows(x, target, rows);
-        step = residual;
-        for (const auto &r : rows)
-          {
-            const double lambda = beta * x[r.multiplier_eq];
-            for (unsigned int a = 0; a < 3; ++a)
-              if (r.eq[a] >= 0)
-                step[r.eq[a]] += (r.lambda_hat - lambda) * r.n[a];
-            step[r.multiplier_eq] = 0;
-          }
-        for (double &v : step)
-          v = -v;
-        if (!linear_solver->solve(step) ||
-            !condensed->step(*linear_solver,
-                             x,
-                             rows,
-                             step,
-                             1e-3 * settings.increment_tolerance *
-                               system->length_scale()))
-          {
-            outcome.status  = SolveStatus::linear_solver_failure;
-            outcome.message = linear_solver->message();
-            return outcome;
-          }
-        record.solve_time = seconds_since(start);
-
-        start                               = Clock::now();
-        const auto [best_alpha, best_scale] = line_search(x, target, 1);
-        record.line_search_time             = seconds_since(start);
-        // What an iteration and a refactorisation cost on this machine and
-        // body, as worth_refactorizing() weighs them.
-        const double spent = record.solve_time + record.line_search_time;
-        double      &cost =
-          record.factorized ? refactorization_cost : iteration_cost;
-        cost = cost > 0 ? 0.7 * cost + 0.3 * spent : spent;
-        if (best_alpha < 0)
-          {
-            record.step_length      = 0;
-            record.correction       = 0;
-            record.residual_after   = record.residual_before;
-            record.constraint_after = system->constraint_violation(residual);
-            state.history.push_back(record);
-            outcome.status     = SolveStatus::inverted_element;
-            outcome.iterations = iteration + 1;
-            outcome.message    = "every step the line search tried inverts "
-                                 "an element";
-            return outcome;
-          }
-        x.swap(best_x);
-        residual.swap(best_residual);
-        scale                   = best_scale;
-        record.residual_after   = system->force_residual_norm(residual) / scale;
-        record.constraint_after = system->constraint_violation(residual);
-        record.step_length      = best_alpha;
-        record.correction       = best_alpha * system->max_displacement(step);
-        state.history.push_back(record);
-        // The round-off test of converged() trusts a negligible step only
-        // from the factors of this iterate's tangent: a quasi-Newton step
-        // with older factors is short while the residual is still well
-        // above the tolerance (it shrinks by a fixed ratio).
-        last_correction =
-          record.factorized ? system->max_displacement(step) : -1;
-        // A multiplier the line search left between two forces is still a
-        // force: never negative.
-        for (const auto &r : rows)
-          x[r.multiplier_eq] = std::max(0.0, x[r.multiplier_eq]);
-
-        if (const std::string why =
-              stagnation(state, record, iteration, may_cut_back, short_steps);
-            !why.empty())
-          {
-            outcome.status     = SolveStatus::max_iterations;
-            outcome.iterations = iteration + 1;
-            outcome.message    = why;
-            return outcome;
-          }
-        refactorize   = worth_refactorizing(record, previous_rate);
-        previous_rate = record.factorized ?
-                          0 :
-                          record.residual_after / record.residual_before;
-        assembly_time = 0;
+        const double lambda = beta * x[r.multiplier_eq];
+        for (unsigned int a = 0; a < 3; ++a)
+          if (r.eq[a] >= 0)
+            step[r.eq[a]] += (r.lambda_hat - lambda) * r.n[a];
+        step[r.multiplier_eq] = 0;
       }
+    for (double &v : step)
+      v = -v;
+    return linear_solver->solve(step) &&
+           condensed->step(*linear_solver,
+                           x,
+                           rows,
+                           step,
+                           1e-3 * settings.increment_tolerance *
+                             system->length_scale());
   }
 
 

@@ -93,8 +93,6 @@ namespace palpate
     bool                  has_stiffness = false;
     /** Seconds of wall_time spent on the stiffness. */
     double stiffness_time = 0;
-    /** Factorisations the stiffness made (beside those in history). */
-    unsigned int stiffness_factorizations = 0;
 
     /** Nodal solution in deal.II DoF order (displacements, m). */
     std::vector<double> solution;
@@ -120,6 +118,9 @@ namespace palpate
 
     /** Most Newton iterations one increment needed. */
     unsigned int max_increment_iterations = 0;
+
+    /** Factorisations the stiffness made (beside those in history). */
+    unsigned int stiffness_factorizations = 0;
 
     /** Every Newton iteration, in order. */
     std::vector<NewtonIteration> history;
