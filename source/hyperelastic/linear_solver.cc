@@ -369,6 +369,28 @@ namespace palpate
       bool
       solve_many(std::vector<double> &rhs, const unsigned int n_rhs) override
       {
+        const std::size_t n = n_rhs > 0 ? rhs.size() / n_rhs : 0;
+        // Several right-hand sides that are mostly zero (a unit force at
+        // one node each: the condensed contact's compliance columns) go in
+        // as a sparse matrix (ICNTL(20) = 1): MUMPS then prunes the forward
+        // elimination to the branches of the elimination tree they touch.
+        const bool sparse = n_rhs > 1 && sparse_enough(rhs);
+        if (sparse)
+          {
+            sparse_pointer.assign(1, 1);
+            sparse_row.clear();
+            sparse_value.clear();
+            for (unsigned int j = 0; j < n_rhs; ++j)
+              {
+                for (std::size_t i = 0; i < n; ++i)
+                  if (const double v = rhs[j * n + i]; v != 0)
+                    {
+                      sparse_row.push_back(i + 1);
+                      sparse_value.push_back(v);
+                    }
+                sparse_pointer.push_back(sparse_row.size() + 1);
+              }
+          }
         {
           if constexpr (!Precision::exact)
             work.assign(rhs.begin(), rhs.end());
@@ -378,10 +400,19 @@ namespace palpate
           else
             id.rhs = work.data();
           id.nrhs = n_rhs;
-          id.lrhs = n_rhs > 0 ? rhs.size() / n_rhs : 0;
-          id.job  = 3;
+          id.lrhs = n;
+          if (sparse)
+            {
+              id.icntl[19]   = 1;
+              id.nz_rhs      = sparse_row.size();
+              id.irhs_ptr    = sparse_pointer.data();
+              id.irhs_sparse = sparse_row.data();
+              id.rhs_sparse  = sparse_value.data();
+            }
+          id.job = 3;
           Precision::call(&id);
-          id.nrhs = 1;
+          id.nrhs      = 1;
+          id.icntl[19] = 0;
         }
         if constexpr (!Precision::exact)
           std::copy(work.begin(), work.end(), rhs.begin());
@@ -465,6 +496,18 @@ namespace palpate
       std::vector<MUMPS_INT>     irn, jcn, permutation;
       std::vector<std::size_t>   upper;
       std::vector<Real>          values, work;
+      // A block of right-hand sides in compressed columns (1-based).
+      std::vector<MUMPS_INT> sparse_pointer, sparse_row;
+      std::vector<Real>      sparse_value;
+
+      /** Whether at most one entry in 100 of @p block is non-zero. */
+      static bool
+      sparse_enough(const std::vector<double> &block)
+      {
+        const std::size_t nonzero =
+          block.size() - std::count(block.begin(), block.end(), 0.0);
+        return 100 * nonzero <= block.size();
+      }
     };
 
     // ------------------------------------------------------------------
