@@ -51,6 +51,7 @@
 #include "machine.h"
 #include "ml_preconditioner.h"
 #include "mpi_child.h"
+#include "report_errors.h"
 
 using namespace palpate;
 using Utilities::Point3;
@@ -417,8 +418,8 @@ namespace
 
 
 
-int
-main(int argc, char **argv)
+static int
+run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
   if (argc == 8 && std::string(argv[1]) == "--child")
@@ -707,4 +708,12 @@ main(int argc, char **argv)
       }
   std::cout << "\n" << results.str();
   return 0;
+}
+
+
+
+int
+main(int argc, char **argv)
+{
+  return report_errors("organ-speed", run_benchmark, argc, argv);
 }

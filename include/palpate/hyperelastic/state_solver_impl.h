@@ -1,0 +1,375 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_hyperelastic_state_solver_impl_h
+#define palpate_hyperelastic_state_solver_impl_h
+
+// Not an interface: StateSolver's implementation, shared by its source
+// files (state_solver.cc: Newton's method and the staging's driver;
+// state_solver_staging.cc: the staging's checks and predictors;
+// state_solver_condensed.cc: the condensed contact's Newton steps).
+
+#include <palpate/hyperelastic/condensed_contact.h>
+#include <palpate/hyperelastic/effect.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/linear_solver.h>
+#include <palpate/hyperelastic/state_solver.h>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace palpate
+{
+  namespace internal
+  {
+    /**
+     * GMRES with right preconditioning for A x = b, from x = 0: Arnoldi
+     * with modified Gram-Schmidt and Givens rotations, no restart.
+     * @p precondition applies M^-1 in place (the kept factorisation of an
+     * earlier tangent). On success @p b holds x with |b - A x| <= @p
+     * tolerance |b|, and the number of iterations is returned; 0 if it
+     * did not converge in @p max_iterations (then @p b is unchanged) or the
+     * preconditioner failed.
+     *
+     * Why GMRES: the tangent with the multiplier rows is symmetric but
+     * indefinite, and so is an LDL^T preconditioner, which rules out CG and
+     * MINRES; GMRES needs neither property, and with a preconditioner
+     * from a nearby state it converges in a few iterations.
+     */
+    unsigned int
+    gmres(const SparsityCSR                                &pattern,
+          const std::vector<double>                        &matrix,
+          const std::function<bool(std::vector<double> &)> &precondition,
+          std::vector<double>                              &b,
+          const double                                      tolerance,
+          const unsigned int                                max_iterations,
+          std::vector<std::vector<double>>                 &V,
+          std::vector<std::vector<double>>                 &Z);
+  } // namespace internal
+
+
+
+  struct StateSolver::Impl
+  {
+    Impl(const Mesh                      &mesh,
+         const NodeSelection             &nodes,
+         const Parameters::AllParameters &p)
+      : settings(p.nonlinear_solver)
+    {
+      settings.compute_stiffness =
+        settings.compute_stiffness ||
+        p.state_space.interpolation == "tricubic Hermite";
+      const auto start = std::chrono::steady_clock::now();
+      system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
+      // The load effects the scene switches on, and only those.
+      for (const auto &effect : Effect::create_enabled(p.effects))
+        effect->apply(*system, p);
+      settings.reuse_factorization = settings.reuse_for(system->n_equations());
+      settings.reuse_by_size       = false;
+      // The ordering by the system's size unless the scene fixes it: the
+      // fill of nested dissection grows more slowly with the mesh than
+      // AMF's, which is cheaper to compute and as good on small meshes.
+      ordering = p.linear_solver.ordering_for(system->n_equations());
+      Parameters::LinearSolver chosen = p.linear_solver;
+      chosen.ordering                 = ordering;
+      linear_solver = LinearSolver::create(chosen, system->n_equations());
+      linear_solver->analyze(system->sparsity());
+      if (system->has_contact())
+        condensed = std::make_unique<CondensedContact>(*system);
+      setup_time = Utilities::seconds_since(start);
+    }
+
+    /** What one Newton solve of one increment ended with. */
+    struct Outcome
+    {
+      SolveStatus  status = SolveStatus::converged;
+      std::string  message;
+      unsigned int iterations = 0;
+    };
+
+    /** s = R_u . dx_u: the derivative of the energy along the step dx
+     * once the constraints hold. */
+    double
+    directional_derivative(const std::vector<double> &residual,
+                           const std::vector<double> &dx) const
+    {
+      const unsigned int n = system->n_equations() - system->n_multipliers();
+      double             s = 0;
+      for (unsigned int i = 0; i < n; ++i)
+        s += residual[i] * dx[i];
+      return s;
+    }
+
+    /**
+     * Newton's method for the active node at @p target, from @p x. With
+     * @p may_cut_back (the increment can still be halved), a Newton
+     * iteration that stagnates is given up early, so that the halved
+     * increment gets the iterations instead.
+     */
+    Outcome
+    newton(std::vector<double>     &x,
+           const Utilities::Point3 &target,
+           State                   &state,
+           const bool               may_cut_back = false);
+
+    /**
+     * The Newton step of Contact solver = condensed into `step` (from
+     * `residual` at @p x), with the factors renewed first if
+     * @p refactorize; fills @p record's solver fields. False if the linear
+     * solver failed.
+     */
+    bool
+    condensed_step(const std::vector<double> &x,
+                   const Utilities::Point3   &target,
+                   NewtonIteration           &record,
+                   const bool                 refactorize);
+
+    /**
+     * Whether the next condensed Newton iteration should factorise the
+     * tangent anew, after the iteration @p record (its relative residual
+     * before and after) and the rate of the one before it.
+     */
+    bool
+    worth_refactorizing(const NewtonIteration &record,
+                        const double           previous_rate) const;
+
+    /** Assemble the contact-free tangent at @p x and factorise it; the
+     * compliance columns of the old factors are dropped. */
+    bool
+    factorize_contact_free(const std::vector<double> &x,
+                           const Utilities::Point3   &target);
+
+    /** The active-node stiffness of a converged state from the condensed
+     * contact problem on the kept factors (Contact solver = condensed). */
+    bool
+    condensed_stiffness(State &state);
+
+    /** Whether Newton must stop before iteration @p iteration (the
+     * residual in `residual`, its force scale @p scale): not finite, a
+     * stop asked for, or out of iterations; @p outcome then says so. */
+    bool
+    halt(const unsigned int iteration,
+         const double       scale,
+         Outcome           &outcome) const;
+
+    /** The failure of a solve that used up its Newton work. */
+    static Outcome
+    out_of_work(const unsigned int iterations);
+
+    /** How many increments a path of @p length takes: Number of
+     * increments, more if they would be longer than Maximum increment
+     * length or (with a sphere) its radius. */
+    double
+    increments_needed(const double length) const;
+
+    /** Whether @p from is a start for a solve to @p target: a finite
+     * target, and a converged, finite state of this body. If not, @p state
+     * is the failure point that says so. */
+    bool
+    admissible_start(const State             &from,
+                     const Utilities::Point3 &target,
+                     State                   &state) const;
+
+    /** A converged state behind @p from on the line to @p target (and a
+     * second one behind it, for one increment) as the increment before the
+     * first: sets @p previous and @p previous_t for the secant predictor,
+     * or leaves them empty. */
+    void
+    predictor_from_behind(const State               &from,
+                          const Utilities::Point3   &target,
+                          const State               *behind,
+                          const State               *behind2,
+                          const unsigned int         n,
+                          const std::vector<double> &x,
+                          std::vector<double>       &previous,
+                          double                    &previous_t) const;
+
+    /** Whether the converged end @p x (in @p state) is one to hand out: a
+     * finite force and, with a sphere, a sphere still outside the deformed
+     * surface. Otherwise @p failure says why. */
+    bool
+    acceptable_end(const std::vector<double> &x,
+                   State                     &state,
+                   Outcome                   &failure) const;
+
+    /** The Newton step K dx = -R into `step` (from `residual`), exactly or
+     * by GMRES on a kept factorisation; fills @p record's solver fields.
+     * False if the linear solver failed. */
+    bool
+    newton_step(NewtonIteration &record);
+
+    /** The step length along `step` from @p x: the accepted trial is left
+     * in best_x and best_residual. Returns (alpha, force scale there);
+     * alpha < 0 when every step tried inverts an element. */
+    /** Why the Newton solve stagnates after @p record (its last
+     * accepted step), or "": no progress from a start outside the basin,
+     * or a line search cutting every step short (counted in
+     * @p short_steps). */
+    std::string
+    stagnation(const State           &state,
+               const NewtonIteration &record,
+               const unsigned int     iteration,
+               const bool             may_cut_back,
+               unsigned int          &short_steps) const;
+
+    std::pair<double, double>
+    line_search(const std::vector<double> &x,
+                const Utilities::Point3   &target,
+                const unsigned int         iteration);
+
+    /**
+     * Whether @p residual is an equilibrium: force residual below the
+     * tolerance relative to the force scale and the constraints satisfied;
+     * or, where round-off keeps the residual from going lower, a negligible
+     * last full Newton step and a residual within 1000 times the tolerance.
+     */
+    bool
+    converged(const std::vector<double> &residual,
+              const double               force_scale,
+              const double               last_correction) const
+    {
+      // Nothing non-finite is ever an equilibrium: with an infinite force
+      // scale (E = 1e300) every residual would pass the relative test.
+      const double L         = system->length_scale();
+      const double violation = system->constraint_violation(residual);
+      const double r         = system->force_residual_norm(residual);
+      if (!std::isfinite(force_scale) || !(force_scale > 0) ||
+          !std::isfinite(violation) || !std::isfinite(r))
+        return false;
+      if (violation > settings.increment_tolerance * L)
+        return false;
+      if (r <= settings.residual_tolerance * force_scale)
+        return true;
+      return last_correction >= 0 &&
+             last_correction <= settings.increment_tolerance * L &&
+             r <= 1e3 * settings.residual_tolerance * force_scale;
+    }
+
+    /**
+     * GMRES on the tangent in matrix to @p tolerance, preconditioned by the
+     * linear solver's factors (of this tangent or an earlier one): @p rhs
+     * holds b on entry and x on success. The iterations; 0 if it failed,
+     * and then @p rhs is unchanged.
+     */
+    unsigned int
+    preconditioned_gmres(std::vector<double> &rhs, const double tolerance)
+    {
+      return internal::gmres(
+        system->sparsity(),
+        matrix,
+        [this](std::vector<double> &v) { return linear_solver->solve(v); },
+        rhs,
+        tolerance,
+        settings.max_krylov_iterations,
+        krylov_v,
+        krylov_z);
+    }
+
+    /**
+     * Factorise the tangent in matrix and solve with it in place: a direct
+     * solve, or with mixed precision GMRES to @p tolerance preconditioned
+     * by the fresh factors (one to three iterations, counted in
+     * @p krylov_iterations); if the single-precision factors fail, MUMPS in
+     * double from then on. False if the linear solver fails.
+     */
+    bool
+    factorize_and_solve(std::vector<double> &rhs,
+                        const double         tolerance,
+                        unsigned int        &krylov_iterations)
+    {
+      factorized = factorized_current = contact_free_factors = false;
+      krylov_iterations                                      = 0;
+      bool solved = linear_solver->factorize(matrix);
+      if (solved && linear_solver->exact())
+        solved = linear_solver->solve(rhs);
+      else if (solved)
+        {
+          krylov_iterations = preconditioned_gmres(rhs, tolerance);
+          solved            = krylov_iterations > 0;
+        }
+      // rhs is still b after a failed factorisation or GMRES.
+      if (!solved && fall_back_to_double())
+        solved = linear_solver->factorize(matrix) && linear_solver->solve(rhs);
+      factorized = factorized_current = solved;
+      return solved;
+    }
+
+    /**
+     * A mixed-precision solver whose GMRES failed on a tangent (single
+     * precision too coarse for it): replace it by MUMPS in double for the
+     * rest of this solver's life. True if it did (the caller retries).
+     */
+    bool
+    fall_back_to_double()
+    {
+      if (linear_solver->exact())
+        return false;
+      linear_solver = LinearSolver::create("MUMPS", ordering);
+      linear_solver->analyze(system->sparsity());
+      factorized = factorized_current = contact_free_factors = false;
+      return true;
+    }
+
+    std::unique_ptr<HyperelasticSystem>        system;
+    std::unique_ptr<LinearSolver>              linear_solver;
+    std::string                                ordering;
+    Parameters::NonlinearSolver                settings;
+    double                                     setup_time = 0;
+    std::function<void(const State &, double)> observer;
+    std::function<bool()>                      stop_check;
+
+    // Work vectors, reused from solve to solve.
+    std::vector<double> residual, trial_residual, best_residual, matrix, step,
+      trial, best_x;
+    // Whether the linear solver holds a factorisation (of the tangent of
+    // an earlier Newton step, in this state or an earlier one), and the
+    // Krylov bases of GMRES.
+    bool factorized = false;
+    // Whether that factorisation is of the tangent in matrix.
+    bool                             factorized_current = false;
+    std::vector<std::vector<double>> krylov_v, krylov_z;
+
+    // Condensed contact: whether the kept factors are of a contact-free
+    // tangent (only then do the compliance columns of `condensed` hold),
+    // and the candidates' rows at the current iterate.
+    bool contact_free_factors = false;
+    // Whether they were made in the last Newton solve (the state's last
+    // increment), and the relative residual of the iterate they were made
+    // at.
+    bool   factors_of_state  = false;
+    double factored_residual = 0;
+    // Seconds of a condensed Newton iteration on kept factors and of one
+    // that factorises (with the compliance columns after it): running
+    // averages, 0 until measured.
+    double iteration_cost = 0, refactorization_cost = 0;
+    std::vector<HyperelasticSystem::ContactRow> rows;
+    std::unique_ptr<CondensedContact>           condensed;
+
+    /**
+     * The active-node stiffness of a converged @p state, from the tangent
+     * of its last Newton step (in matrix). That tangent is one iterate
+     * behind the converged state, which Newton's quadratic convergence
+     * puts within about 1e-4 of the state's own stiffness (measured
+     * against finite differences on liver501: 1.4e-4 StVK, 3.8e-4
+     * neo-Hookean): far below what interpolation on a grid can resolve,
+     * for no assembly and, after an exact Newton step, no factorisation.
+     * Moving the probe by dg changes the residual by dR = -probe_load dg
+     * (for a point probe -beta dg at its constraint rows; for a sphere the
+     * rows of the nodes in contact), so K dx = probe_load dg gives the
+     * change of the state, probe_force_change() turns it into df, and
+     * -df/dg is the stiffness: three solves
+     * with the factorisation (direct if it is of this tangent, else GMRES
+     * to 1e-6 preconditioned by it, else - when GMRES needs more than
+     * Maximum Krylov iterations - a new factorisation, which then also
+     * preconditions the next states). False if the linear solver fails.
+     */
+    bool
+    active_stiffness(State &state);
+  };
+} // namespace palpate
+
+#endif

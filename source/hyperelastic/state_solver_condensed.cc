@@ -1,0 +1,141 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// The Newton steps of Contact solver = condensed (StateSolver::Impl): when
+// to renew the contact-free factors, the step with the contact solved on
+// the candidates' compliance, and the probe's stiffness from it.
+
+#include <palpate/hyperelastic/state_solver_impl.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace palpate
+{
+  bool
+  StateSolver::Impl::worth_refactorizing(const NewtonIteration &record,
+                                         const double previous_rate) const
+  {
+    if (record.factorized)
+      return false;
+    const double r    = record.residual_after;
+    const double rate = std::max(r / record.residual_before, previous_rate);
+    // A state whose stiffness is wanted needs factors of an iterate one
+    // Newton step from it (condensed_stiffness()): made as soon as the
+    // residual is that close, they also make the last steps exact.
+    if (settings.compute_stiffness && !factors_of_state && r <= 1e-4)
+      return true;
+    // Factors of an older tangent cut the residual by a fixed ratio per
+    // step. The relative residual's ratio, because once the sphere lets go
+    // the residual is the internal force itself and stays at 1 relative
+    // to it under any fixed factors, while exact steps reach rest in a few.
+    if (previous_rate == 0)
+      return false; // one ratio measured is no rate yet
+    if (rate >= 0.9)
+      return true;
+    // Otherwise: when the iterations left at this rate cost more than a
+    // factorisation (and its columns) and the two or three exact steps
+    // after it.
+    const double left =
+      std::log(settings.residual_tolerance / std::max(r, 1e-300)) /
+      std::log(rate);
+    // With the stiffness wanted, factors made this far from the state
+    // will be made again at its end: they cost twice.
+    const double factorization =
+      (refactorization_cost > 0 ? refactorization_cost : 20 * iteration_cost) *
+      (settings.compute_stiffness ? 2 : 1);
+    return left * iteration_cost > factorization + 2 * iteration_cost;
+  }
+
+
+
+  bool
+  StateSolver::Impl::factorize_contact_free(const std::vector<double> &x,
+                                            const Utilities::Point3   &target)
+  {
+    // The tangent without the contact rows (every candidate's row is that
+    // of a node out of contact): the same matrix whatever the active set,
+    // so its factors serve while the sphere's contact set moves.
+    if (!system->assemble(x, target, trial_residual, &matrix, nullptr, false))
+      return false;
+    factorized = factorized_current = contact_free_factors = false;
+    bool ok = linear_solver->factorize(matrix);
+    if (!ok && fall_back_to_double())
+      ok = linear_solver->factorize(matrix);
+    factorized = contact_free_factors = ok;
+    condensed->reset();
+    return ok;
+  }
+
+
+
+  bool
+  StateSolver::Impl::condensed_step(const std::vector<double> &x,
+                                    const Utilities::Point3   &target,
+                                    NewtonIteration           &record,
+                                    const bool                 refactorize)
+  {
+    // The factors are of the contact-free tangent of some earlier iterate,
+    // possibly of an earlier state, renewed only where that pays
+    // (worth_refactorizing()). The step is then K^-1 (-R) with the
+    // candidates' forces lambda = beta x_lambda held, the residual's
+    // contact forces lambda_hat replaced by lambda (they differ where the
+    // last step left a gap open or closed) and nothing on the contact rows,
+    // turned by CondensedContact into the step with the contact solved.
+    record.factorized = refactorize;
+    if (refactorize)
+      {
+        factors_of_state  = true;
+        factored_residual = record.residual_before;
+        if (!factorize_contact_free(x, target))
+          return false;
+      }
+    const double beta = system->constraint_scale();
+    system->contact_rows(x, target, rows);
+    step = residual;
+    for (const auto &r : rows)
+      {
+        const double lambda = beta * x[r.multiplier_eq];
+        for (unsigned int a = 0; a < 3; ++a)
+          if (r.eq[a] >= 0)
+            step[r.eq[a]] += (r.lambda_hat - lambda) * r.n[a];
+        step[r.multiplier_eq] = 0;
+      }
+    for (double &v : step)
+      v = -v;
+    return linear_solver->solve(step) &&
+           condensed->step(*linear_solver,
+                           x,
+                           rows,
+                           step,
+                           1e-3 * settings.increment_tolerance *
+                             system->length_scale());
+  }
+
+
+
+  bool
+  StateSolver::Impl::condensed_stiffness(State &state)
+  {
+    // From the kept contact-free factors, like the Newton steps: within
+    // their quasi-Newton distance of the converged tangent.
+    if (!contact_free_factors)
+      return false;
+    const std::vector<double> x = system->from_state(state);
+    // The stiffness is exact for the tangent the factors are of: within
+    // one Newton step of the state it is within that step's distance, as
+    // active_stiffness() is; older factors (another state's, an early
+    // iterate's) give it only to their quasi-Newton distance: 1 % on the
+    // liver, a factor 2 under one node pushed 1.5 mm into the coarse beam
+    // (tests/hyperelastic/condensed_contact). New factors here also start
+    // the neighbouring state.
+    if (!(factors_of_state && factored_residual <= 1e-4))
+      {
+        ++state.stiffness_factorizations;
+        if (!factorize_contact_free(x, state.active_displacement))
+          return false;
+      }
+    system->contact_rows(x, state.active_displacement, rows);
+    return condensed->stiffness(*linear_solver, x, rows, state.stiffness);
+  }
+} // namespace palpate
