@@ -677,12 +677,19 @@ run_benchmark(int argc, char **argv)
              o.quick ? std::vector<std::string>{"threads"} :
                        std::vector<std::string>{"threads", "mpi"})
           {
-            const auto [best, last] = search(size,
-                                             material,
-                                             engine,
-                                             state_ms < 300 ? 0.028 : 0.004,
-                                             o.quick ? 2 : 6);
-            const Trial &shown      = best.passed ? best : last;
+            // --quick has two trials: it starts where two workers of this
+            // state time can plausibly keep up (a grid step's cell ahead
+            // needs about four new states, two per worker), so that its
+            // line names a speed; the full search starts at a hand's speed.
+            const double h =
+              stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005;
+            const double start =
+              o.quick ? std::clamp(h / (4e-3 * state_ms), 0.0005, 0.028) :
+              state_ms < 300 ? 0.028 :
+                               0.004;
+            const auto [best, last] =
+              search(size, material, engine, start, o.quick ? 2 : 6);
+            const Trial &shown = best.passed ? best : last;
             // The platform's own misses in as many ticks, with the
             // solvers' load beside it.
             const auto bare =
