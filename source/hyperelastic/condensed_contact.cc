@@ -112,7 +112,7 @@ namespace palpate
   {
     const unsigned int m = candidates.size(), M = 3 * m;
     G.assign(9 * m, 0.0);
-    bool curved = false;
+    curved = false;
     for (unsigned int i = 0; with_curvature && i < m; ++i)
       {
         const auto  &r = rows[candidates[i]];
@@ -169,16 +169,6 @@ namespace palpate
     // A compliance is positive definite; check it as the contact problem
     // will use it.
     return true;
-  }
-
-
-
-  bool
-  CondensedContact::curved() const
-  {
-    return std::any_of(G.begin(), G.end(), [](const double g) {
-      return g != 0;
-    });
   }
 
 
@@ -272,7 +262,7 @@ namespace palpate
     // candidates move by v0 - H y, y = A^-1 G v0.
     const unsigned int m = candidates.size(), M = 3 * m;
     y.assign(M, 0.0);
-    if (curved())
+    if (curved)
       {
         for (unsigned int i = 0; i < m; ++i)
           for (unsigned int a = 0; a < 3; ++a)
@@ -302,7 +292,7 @@ namespace palpate
       for (unsigned int j = 0; j < m; ++j)
         q[i] -= W[i * m + j] * lambda[j];
     lambda_old = lambda;
-    if (!lcp.solve(W, q, lambda, tolerance, !curved()) && settled_only)
+    if (!lcp.solve(W, q, lambda, tolerance, !curved) && settled_only)
       return false;
 
     // step += Z (S (lambda' - lambda) - y): the forces' change, and G.
@@ -360,7 +350,7 @@ namespace palpate
         for (unsigned int i = 0; i < m; ++i)
           for (unsigned int a = 0; a < 3; ++a)
             load[3 * i + a] = G[9 * i + 3 * a + j];
-        if (curved())
+        if (curved)
           lu_solve(A, M, pivot, load.data());
         for (unsigned int i = 0; i < m; ++i)
           {

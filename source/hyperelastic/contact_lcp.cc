@@ -10,54 +10,6 @@
 namespace palpate
 {
   bool
-  cholesky_factorize(std::vector<double> &A, const unsigned int m)
-  {
-    for (unsigned int j = 0; j < m; ++j)
-      {
-        double d = A[j * m + j];
-        for (unsigned int k = 0; k < j; ++k)
-          d -= A[j * m + k] * A[j * m + k];
-        if (!(d > 0))
-          return false;
-        d            = std::sqrt(d);
-        A[j * m + j] = d;
-        for (unsigned int i = j + 1; i < m; ++i)
-          {
-            double s = A[i * m + j];
-            for (unsigned int k = 0; k < j; ++k)
-              s -= A[i * m + k] * A[j * m + k];
-            A[i * m + j] = s / d;
-          }
-      }
-    return true;
-  }
-
-
-
-  void
-  cholesky_solve(const std::vector<double> &L,
-                 const unsigned int         m,
-                 std::vector<double>       &b)
-  {
-    for (unsigned int i = 0; i < m; ++i)
-      {
-        double s = b[i];
-        for (unsigned int k = 0; k < i; ++k)
-          s -= L[i * m + k] * b[k];
-        b[i] = s / L[i * m + i];
-      }
-    for (int i = int(m) - 1; i >= 0; --i)
-      {
-        double s = b[i];
-        for (unsigned int k = i + 1; k < m; ++k)
-          s -= L[k * m + i] * b[k];
-        b[i] = s / L[i * m + i];
-      }
-  }
-
-
-
-  bool
   lu_factorize(std::vector<double>       &A,
                const unsigned int         m,
                std::vector<unsigned int> &pivot)

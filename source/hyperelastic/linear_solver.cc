@@ -374,23 +374,21 @@ namespace palpate
         // one node each: the condensed contact's compliance columns) go in
         // as a sparse matrix (ICNTL(20) = 1): MUMPS then prunes the forward
         // elimination to the branches of the elimination tree they touch.
-        const bool sparse = n_rhs > 1 && sparse_enough(rhs);
-        if (sparse)
+        // (Built first, used if at most one entry in 100 is non-zero.)
+        sparse_pointer.assign(1, 1);
+        sparse_row.clear();
+        sparse_value.clear();
+        for (unsigned int j = 0; n_rhs > 1 && j < n_rhs; ++j)
           {
-            sparse_pointer.assign(1, 1);
-            sparse_row.clear();
-            sparse_value.clear();
-            for (unsigned int j = 0; j < n_rhs; ++j)
-              {
-                for (std::size_t i = 0; i < n; ++i)
-                  if (const double v = rhs[j * n + i]; v != 0)
-                    {
-                      sparse_row.push_back(i + 1);
-                      sparse_value.push_back(v);
-                    }
-                sparse_pointer.push_back(sparse_row.size() + 1);
-              }
+            for (std::size_t i = 0; i < n; ++i)
+              if (const double v = rhs[j * n + i]; v != 0)
+                {
+                  sparse_row.push_back(i + 1);
+                  sparse_value.push_back(v);
+                }
+            sparse_pointer.push_back(sparse_row.size() + 1);
           }
+        const bool sparse = n_rhs > 1 && 100 * sparse_row.size() <= rhs.size();
         {
           if constexpr (!Precision::exact)
             work.assign(rhs.begin(), rhs.end());
@@ -499,15 +497,6 @@ namespace palpate
       // A block of right-hand sides in compressed columns (1-based).
       std::vector<MUMPS_INT> sparse_pointer, sparse_row;
       std::vector<Real>      sparse_value;
-
-      /** Whether at most one entry in 100 of @p block is non-zero. */
-      static bool
-      sparse_enough(const std::vector<double> &block)
-      {
-        const std::size_t nonzero =
-          block.size() - std::count(block.begin(), block.end(), 0.0);
-        return 100 * nonzero <= block.size();
-      }
     };
 
     // ------------------------------------------------------------------

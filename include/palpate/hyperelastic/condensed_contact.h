@@ -116,10 +116,6 @@ namespace palpate
                   const double                                       tolerance,
                   const bool settled_only);
 
-    /** Whether G is not zero (some candidate carries a force). */
-    bool
-    curved() const;
-
     /** step += Z v for a vector @p v of the candidates' 3m DoFs. */
     void
     add_columns(const std::vector<double> &v, std::vector<double> &step) const;
@@ -134,7 +130,9 @@ namespace palpate
     std::vector<double> fresh, H, G, A, S, W, factors, q, lambda, lambda_old, v,
       v0, y;
     std::vector<unsigned int> pivot, pivot_W;
-    ContactLCP                lcp;
+    /** Whether G, made by the last assemble_W(), is not zero. */
+    bool       curved = false;
+    ContactLCP lcp;
   };
 } // namespace palpate
 

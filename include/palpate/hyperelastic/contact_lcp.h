@@ -8,19 +8,6 @@
 
 namespace palpate
 {
-  /** Cholesky factorisation A = L L^T in place of the m x m row-major
-   * symmetric @p A (L in its lower triangle); false if A is not positive
-   * definite. */
-  bool
-  cholesky_factorize(std::vector<double> &A, const unsigned int m);
-
-  /** Solve L L^T x = b in place of @p b with the factors from
-   * cholesky_factorize(). */
-  void
-  cholesky_solve(const std::vector<double> &L,
-                 const unsigned int         m,
-                 std::vector<double>       &b);
-
   /** LU factorisation with partial pivoting of the m x m row-major @p A in
    * place, the row exchanges in @p pivot; false if A is singular. */
   bool
