@@ -94,6 +94,7 @@ namespace palpate
   interpolation_from_name(const std::string &name)
   {
     return name == "tricubic Hermite" ? Interpolation::hermite :
+           name == "contact patch"    ? Interpolation::contact_patch :
                                         Interpolation::trilinear;
   }
 

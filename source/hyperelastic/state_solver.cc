@@ -621,6 +621,11 @@ namespace palpate
         impl->factorized_current = false;
         state.has_stiffness      = impl->active_stiffness(state);
       }
+    if (impl->patch_reach > 0 && impl->system->has_contact())
+      {
+        impl->factors_of_state = false;
+        impl->contact_patch(state, x);
+      }
     return state;
   }
 
@@ -786,6 +791,12 @@ namespace palpate
             impl->condensed_stiffness(state) :
             impl->active_stiffness(state);
         state.stiffness_time = seconds_since(stiffness_start);
+      }
+    if (ok && impl->patch_reach > 0 && impl->system->has_contact())
+      {
+        const auto patch_start = Clock::now();
+        impl->contact_patch(state, x);
+        state.contact_patch_time = seconds_since(patch_start);
       }
     state.wall_time = seconds_since(start);
     return state;

@@ -5,6 +5,7 @@
 // to renew the contact-free factors, the step with the contact solved on
 // the candidates' compliance, and the probe's stiffness from it.
 
+#include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/hyperelastic/state_solver_impl.h>
 
 #include <algorithm>
@@ -137,5 +138,26 @@ namespace palpate
       }
     system->contact_rows(x, state.active_displacement, rows);
     return condensed->stiffness(*linear_solver, x, rows, state.stiffness);
+  }
+
+
+
+  bool
+  StateSolver::Impl::contact_patch(State &state, const std::vector<double> &x)
+  {
+    // The patch's compliance is that of the state's own contact-free
+    // tangent: factors made within one Newton step of it (the condensed
+    // stiffness's) serve, any others are made anew.
+    if (!(contact_free_factors && factors_of_state && factored_residual <= 1e-4))
+      {
+        ++state.stiffness_factorizations;
+        if (!factorize_contact_free(x, state.active_displacement))
+          return false;
+        factors_of_state  = true;
+        factored_residual = 0;
+      }
+    state.contact_patch = make_contact_patch(
+      *system, *linear_solver, x, state.active_displacement, patch_reach, rows);
+    return state.contact_patch != nullptr;
   }
 } // namespace palpate

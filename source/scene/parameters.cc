@@ -1047,7 +1047,7 @@ namespace palpate
         prm.declare_entry(
           "Interpolation",
           "trilinear",
-          Patterns::Selection("trilinear|tricubic Hermite"),
+          Patterns::Selection("trilinear|tricubic Hermite|contact patch"),
           "How the haptic loop interpolates the force between grid points. "
           "trilinear: the paper's, from the 8 corners' forces; continuous, "
           "but the stiffness the hand feels jumps at every cell face. "
@@ -1055,7 +1055,14 @@ namespace palpate
           "stiffnesses (three extra solves per state with the kept "
           "factorisation) and the neighbours' stiffnesses; the force and "
           "the stiffness are continuous, so a coarser grid gives the same "
-          "accuracy (doc/accuracy-vs-time.md).");
+          "accuracy (doc/accuracy-vs-time.md). "
+          "contact patch (Tip = sphere): each state also keeps the "
+          "compliance of the surface nodes the sphere can touch from the "
+          "cells around it (one solve per node with the state's "
+          "factorisation), and the haptic loop solves the sphere's contact "
+          "against the corners' patches at every tick, for the sphere where "
+          "the hand is: zero force off the surface, the tissue's onset "
+          "between the states (doc/formulation.md).");
         prm.declare_entry(
           "Store",
           "",

@@ -38,7 +38,10 @@ namespace palpate
     trilinear,
     /** Tricubic Hermite (C1): the 8 corners' forces, their active-node
      * stiffnesses and cross derivatives from the neighbours' stiffnesses. */
-    hermite
+    hermite,
+    /** The sphere's contact solved against the 8 corners' contact
+     * patches for the actual HIP, blended trilinearly (PatchContact). */
+    contact_patch
   };
 
   /** The Interpolation named by a `State space / Interpolation` entry. */

@@ -7,11 +7,14 @@
 #include <palpate/base/utilities.h>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace palpate
 {
+  struct ContactPatch;
+
   /** How the computation of a state ended. */
   enum class SolveStatus
   {
@@ -119,8 +122,16 @@ namespace palpate
     /** Most Newton iterations one increment needed. */
     unsigned int max_increment_iterations = 0;
 
-    /** Factorisations the stiffness made (beside those in history). */
+    /** Factorisations the stiffness and the contact patch made (beside
+     * those in history). */
     unsigned int stiffness_factorizations = 0;
+
+    /** With State space / Interpolation = contact patch and a sphere: the
+     * linearised contact problem the haptic loop solves around this state
+     * (null otherwise, and for failure points). */
+    std::shared_ptr<const ContactPatch> contact_patch;
+    /** Seconds of wall_time spent on the contact patch. */
+    double contact_patch_time = 0;
 
     /** Every Newton iteration, in order. */
     std::vector<NewtonIteration> history;

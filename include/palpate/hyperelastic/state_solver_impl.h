@@ -63,6 +63,13 @@ namespace palpate
       settings.compute_stiffness =
         settings.compute_stiffness ||
         p.state_space.interpolation == "tricubic Hermite";
+      // The patch holds every node the sphere can touch from the cells
+      // around the state (their far corners are sqrt(3) h away), and a
+      // quarter radius more for the surface springing back towards the
+      // sphere when it is lifted.
+      if (p.state_space.interpolation == "contact patch")
+        patch_reach = std::sqrt(3.0) * p.state_space.grid_spacing +
+                      0.25 * p.boundary_conditions.active_node.tip_radius;
       const auto start = std::chrono::steady_clock::now();
       system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
       // The load effects the scene switches on, and only those.
@@ -142,6 +149,12 @@ namespace palpate
     bool
     factorize_contact_free(const std::vector<double> &x,
                            const Utilities::Point3   &target);
+
+    /** The contact patch of the converged @p state at @p x, from
+     * contact-free factors of this state (made if the kept ones are not).
+     * False if the linear solver fails. */
+    bool
+    contact_patch(State &state, const std::vector<double> &x);
 
     /** The active-node stiffness of a converged state from the condensed
      * contact problem on the kept factors (Contact solver = condensed). */
@@ -321,6 +334,9 @@ namespace palpate
     double                                     setup_time = 0;
     std::function<void(const State &, double)> observer;
     std::function<bool()>                      stop_check;
+    // With Interpolation = contact patch: how far from the sphere a
+    // patch's nodes may be (m); 0: no patches.
+    double patch_reach = 0;
 
     // Work vectors, reused from solve to solve.
     std::vector<double> residual, trial_residual, best_residual, matrix, step,

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_haptics_patch_contact_h
+#define palpate_haptics_patch_contact_h
+
+#include <palpate/base/utilities.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace palpate
+{
+  struct ContactPatch;
+
+  /**
+   * The haptic loop's side of State space / Interpolation = contact patch:
+   * the sphere's frictionless contact solved, at every tick, against the
+   * contact patches (ContactPatch) of the corners of the HIP's cell, for
+   * the sphere where the HIP is.
+   *
+   * Each corner's patch gives a force F_k(x): the contact of the sphere at
+   * x with the patch's linear model of the tissue around its state, the
+   * resultant -sum lambda_i nu_i. F_k is exactly zero while the sphere is
+   * off the corner's free surface, grows as the sphere's geometry and the
+   * tissue's compliance say from the moment it touches, and is the state's
+   * own force at the corner. The rendered force is their trilinear blend:
+   * the state's force at every grid point, continuous everywhere, zero
+   * where no corner's surface is touched.
+   *
+   * The model is non-linear in the directions of the forces (they follow
+   * the sphere's normals at the moved nodes), so each tick takes one step
+   * of a fixed-point iteration from the patch's last solution: the
+   * contact problem on W (the patch's compliance along its state's
+   * normals) for the gaps at the nodes' current positions, then the nodes
+   * moved by the new forces. The sphere moves microns per tick, so the
+   * iteration follows the hand and converges where it rests. The contact
+   * problem is solved by the primal-dual active-set method, warm started
+   * from the last tick; while the set of nodes in contact stays, its LU
+   * factors are kept and a tick costs triangular solves, the gaps and the
+   * nodes' move. At most max_iterations active-set iterations per tick: a
+   * problem not settled by then gives the iterate's non-negative forces,
+   * and the next tick goes on from it.
+   *
+   * All work space is allocated by the constructor: force() and blend()
+   * never allocate. Not thread-safe: one per haptic thread.
+   */
+  class PatchContact
+  {
+  public:
+    /** For patches of up to @p max_nodes nodes, of which at most
+     * @p max_active are in contact at once. */
+    PatchContact(const unsigned int max_nodes, const unsigned int max_active);
+
+    /** The force on the sphere (N) with the HIP at @p x against @p patch
+     * alone, after one more step of its fixed-point iteration;
+     * @p stiffness (if not null) gets the normal forces' part of -dF/dx
+     * there (N/m, row-major; symmetric, positive semi-definite). Returns
+     * whether the contact problem settled. */
+    bool
+    force(const ContactPatch      &patch,
+          const Utilities::Point3 &x,
+          Utilities::Point3       &force,
+          std::array<double, 9>   *stiffness = nullptr) noexcept;
+
+    /**
+     * The rendered force at @p x: the blend by @p weights of the forces of
+     * the @p corners' patches (weight 0: not solved); @p stiffness as
+     * force(). Returns whether every problem settled.
+     */
+    bool
+    blend(const std::array<const ContactPatch *, 8> &corners,
+          const std::array<double, 8>               &weights,
+          const Utilities::Point3                   &x,
+          Utilities::Point3                         &force,
+          std::array<double, 9> *stiffness = nullptr) noexcept;
+
+    /** Active-set iterations of the last force() call. */
+    unsigned int
+    last_iterations() const noexcept
+    {
+      return iterations;
+    }
+
+    /** The most active-set iterations one call may take. */
+    static constexpr unsigned int max_iterations = 12;
+
+  private:
+    /** A patch's warm start: its last forces and active set, and the LU
+     * factors of W on that set. */
+    struct Slot
+    {
+      const ContactPatch *patch = nullptr;
+      std::uint64_t       id    = 0;
+      std::uint64_t       used  = 0;
+      std::vector<double> lambda;
+      // The nodes' positions under those forces (3 per node).
+      std::vector<double> y;
+      std::vector<char>   active;
+      // The active set the factors are of (valid if factored).
+      std::vector<unsigned int> index;
+      std::vector<double>       LU;
+      std::vector<unsigned int> pivot;
+      unsigned int              n_active = 0;
+      bool                      factored = false;
+    };
+
+    /** The slot of @p patch (its warm start), or the least recently used
+     * one, reset. */
+    Slot &
+    slot_of(const ContactPatch &patch) noexcept;
+
+    /** Factorise W on the active set of @p s (into s.index, s.LU); false
+     * if it is singular or larger than the work space. */
+    bool
+    factorize_active(const ContactPatch &patch, Slot &s) noexcept;
+
+    unsigned int        max_nodes, max_active;
+    std::vector<Slot>   slots;
+    std::uint64_t       clock = 0;
+    std::vector<double>                q, rhs;
+    std::vector<std::array<double, 3>> u;
+    std::vector<unsigned int>          loaded;
+    unsigned int                       iterations = 0;
+  };
+} // namespace palpate
+
+#endif

@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#ifndef palpate_hyperelastic_contact_patch_h
+#define palpate_hyperelastic_contact_patch_h
+
+#include <palpate/base/utilities.h>
+#include <palpate/hyperelastic/hyperelastic_system.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace palpate
+{
+  class LinearSolver;
+
+  /**
+   * A state's contact patch (State space / Interpolation = contact patch):
+   * the linearised contact problem of the sphere against the state's
+   * surface, small enough to be solved again at every haptic tick for the
+   * sphere where the hand actually is (Duriez et al. 2006; SOFA's
+   * LCPForceFeedback).
+   *
+   * For the n surface nodes the sphere can touch from anywhere in the
+   * cells around the state (within `reach` of it) it holds their deformed
+   * positions x_i, the state's contact forces lambda_s (along the normals
+   * n_i from the sphere's centre) and their compliance H (3n x 3n) from
+   * the state's contact-free tangent K: H = P K^-1 P^T, how node i moves
+   * under a unit force on node j. The tissue around the sphere is then
+   * modelled as linear about the state:
+   *
+   *   y(lambda) = x_free + H f(lambda),  x_free = x - H f_s,
+   *
+   * with f the contact forces lambda_j along the directions nu_j from the
+   * sphere's centre c to the nodes (f_s the state's own), x_free the
+   * surface with the state's contact forces taken off (SOFA's "dfree"),
+   * and the sphere's geometry exact: node i's gap is
+   * |y_i - c| - R + o_i. The offset o_i closes the state's active gaps
+   * exactly and opens the others to at least zero (the Newton solution
+   * meets them to its tolerance only), so that at the state's own centre
+   * lambda_s is the solution to round-off and the force -sum lambda_i nu_i
+   * is the state's. Away from it the frictionless contact (lambda >= 0,
+   * gap >= 0, lambda gap = 0) is solved on this model (PatchContact).
+   *
+   * Immutable once made; shared by the state, the cache and the haptic
+   * loop.
+   */
+  struct ContactPatch
+  {
+    /** A number no other patch of this process has: a haptic loop's warm
+     * start for a patch is kept by it. */
+    std::uint64_t id = new_id();
+
+    /** The state's HIP displacement (m) and the sphere's centre there (m),
+     * and its radius (m). */
+    Utilities::Point3 target = {{0, 0, 0}}, center = {{0, 0, 0}};
+    double            radius = 0;
+
+    /** The patch's surface nodes (contact candidate numbers). */
+    std::vector<unsigned int> nodes;
+    /** Their deformed positions, x_i = position[3 i + a] (m), the
+     * state's normals n_i (from the centre), and the positions with the
+     * state's contact forces taken off, x_free (m). */
+    std::vector<double> position, normal, free_position;
+    /** The state's contact forces on them (N). */
+    std::vector<double> lambda;
+    /** o_i of the gaps (m). */
+    std::vector<double> offset;
+    /** H (3n x 3n, row-major, symmetric; m/N). */
+    std::vector<double> H;
+    /** W = N^T H N along the state's normals (n x n; m/N): the contact
+     * problem's matrix near the state, kept factorised by the haptic loop
+     * while the set of nodes in contact stays. */
+    std::vector<double> W;
+
+    /** The number of nodes. */
+    unsigned int
+    size() const noexcept
+    {
+      return nodes.size();
+    }
+
+    /** The state's force on the sphere, -sum lambda_i n_i (N). */
+    Utilities::Point3
+    state_force() const noexcept;
+
+    /** Bytes held. */
+    std::size_t
+    memory() const noexcept;
+
+    /** The next id. */
+    static std::uint64_t
+    new_id() noexcept;
+  };
+
+  /**
+   * The contact patch of the converged state at unknowns @p x with the
+   * HIP at @p target: the surface nodes whose gap is at most @p reach (m),
+   * and their compliance by one block solve with @p solver, which must
+   * hold factors of the contact-free tangent at (or near) @p x; @p rows is
+   * work space. Null if the solver fails.
+   */
+  std::shared_ptr<const ContactPatch>
+  make_contact_patch(const HyperelasticSystem                    &system,
+                     LinearSolver                                &solver,
+                     const std::vector<double>                   &x,
+                     const Utilities::Point3                     &target,
+                     const double                                 reach,
+                     std::vector<HyperelasticSystem::ContactRow> &rows);
+} // namespace palpate
+
+#endif

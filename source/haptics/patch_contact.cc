@@ -1,0 +1,315 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/haptics/patch_contact.h>
+#include <palpate/hyperelastic/contact_patch.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace palpate
+{
+  namespace
+  {
+    // Gaps below this count as closed: far below any gap the Newton
+    // solution leaves (its tolerance is 1e-3 of its increment tolerance),
+    // far above the round-off of metres.
+    constexpr double gap_tolerance = 1e-12;
+
+    /** LU with partial pivoting of the m x m row-major A in place. */
+    bool
+    lu_factorize(double *A, const unsigned int m, unsigned int *pivot) noexcept
+    {
+      for (unsigned int k = 0; k < m; ++k)
+        {
+          unsigned int p = k;
+          for (unsigned int i = k + 1; i < m; ++i)
+            if (std::abs(A[i * m + k]) > std::abs(A[p * m + k]))
+              p = i;
+          pivot[k] = p;
+          if (!(A[p * m + k] != 0))
+            return false;
+          if (p != k)
+            for (unsigned int j = 0; j < m; ++j)
+              std::swap(A[k * m + j], A[p * m + j]);
+          const double d = A[k * m + k];
+          for (unsigned int i = k + 1; i < m; ++i)
+            {
+              const double l = A[i * m + k] /= d;
+              if (l != 0)
+                for (unsigned int j = k + 1; j < m; ++j)
+                  A[i * m + j] -= l * A[k * m + j];
+            }
+        }
+      return true;
+    }
+
+    void
+    lu_solve(const double       *LU,
+             const unsigned int  m,
+             const unsigned int *pivot,
+             double             *b) noexcept
+    {
+      for (unsigned int k = 0; k < m; ++k)
+        std::swap(b[k], b[pivot[k]]);
+      for (unsigned int i = 0; i < m; ++i)
+        for (unsigned int k = 0; k < i; ++k)
+          b[i] -= LU[i * m + k] * b[k];
+      for (int i = int(m) - 1; i >= 0; --i)
+        {
+          for (unsigned int k = i + 1; k < m; ++k)
+            b[i] -= LU[i * m + k] * b[k];
+          b[i] /= LU[i * m + i];
+        }
+    }
+  } // namespace
+
+
+
+  PatchContact::PatchContact(const unsigned int max_nodes,
+                             const unsigned int max_active)
+    : max_nodes(max_nodes)
+    , max_active(std::min(max_active, max_nodes))
+    // The 8 corners of the HIP's cell and the 4 a move into the next cell
+    // brings: each keeps its warm start while the hand goes back and forth
+    // across a face.
+    , slots(12)
+    , q(max_nodes)
+    , rhs(3 * this->max_active)
+    , u(max_nodes)
+    , loaded(max_nodes)
+  {
+    for (Slot &s : slots)
+      {
+        s.lambda.resize(max_nodes);
+        s.y.resize(3 * std::size_t(max_nodes));
+        s.active.resize(max_nodes);
+        s.index.resize(this->max_active);
+        s.LU.resize(std::size_t(this->max_active) * this->max_active);
+        s.pivot.resize(this->max_active);
+      }
+  }
+
+
+
+  PatchContact::Slot &
+  PatchContact::slot_of(const ContactPatch &patch) noexcept
+  {
+    ++clock;
+    Slot *oldest = &slots[0];
+    for (Slot &s : slots)
+      {
+        if (s.patch == &patch && s.id == patch.id)
+          {
+            s.used = clock;
+            return s;
+          }
+        if (s.used < oldest->used)
+          oldest = &s;
+      }
+    // A patch seen for the first time starts from its state: the solution
+    // there, and the nearest guess near it.
+    Slot &s    = *oldest;
+    s.patch    = &patch;
+    s.id       = patch.id;
+    s.used     = clock;
+    s.factored = false;
+    std::copy(patch.lambda.begin(), patch.lambda.end(), s.lambda.begin());
+    std::copy(patch.position.begin(), patch.position.end(), s.y.begin());
+    for (unsigned int i = 0; i < patch.size(); ++i)
+      s.active[i] = patch.lambda[i] > 0;
+    return s;
+  }
+
+
+
+  bool
+  PatchContact::factorize_active(const ContactPatch &patch, Slot &s) noexcept
+  {
+    const unsigned int n = patch.size();
+    unsigned int       m = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      if (s.active[i])
+        {
+          if (m == max_active)
+            return false;
+          s.index[m++] = i;
+        }
+    for (unsigned int a = 0; a < m; ++a)
+      for (unsigned int b = 0; b < m; ++b)
+        s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
+    s.n_active = m;
+    s.factored = lu_factorize(s.LU.data(), m, s.pivot.data());
+    return s.factored;
+  }
+
+
+
+  bool
+  PatchContact::force(const ContactPatch      &patch,
+                      const Utilities::Point3 &x,
+                      Utilities::Point3       &force,
+                      std::array<double, 9>   *stiffness) noexcept
+  {
+    force      = {{0, 0, 0}};
+    iterations = 0;
+    if (stiffness)
+      stiffness->fill(0.0);
+    const unsigned int n = patch.size();
+    if (n == 0)
+      return true;
+    if (n > max_nodes)
+      return false;
+    Slot &s = slot_of(patch);
+
+    // The gaps at the nodes' current positions, for the sphere's centre at
+    // this HIP, and the directions nu_i of their forces.
+    Utilities::Point3 c;
+    for (unsigned int a = 0; a < 3; ++a)
+      c[a] = patch.center[a] + x[a] - patch.target[a];
+    bool         touching = false;
+    unsigned int n_loaded = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        double r2 = 0;
+        for (unsigned int a = 0; a < 3; ++a)
+          {
+            u[i][a] = s.y[3 * i + a] - c[a];
+            r2 += u[i][a] * u[i][a];
+          }
+        const double rho = std::sqrt(r2);
+        for (unsigned int a = 0; a < 3; ++a)
+          u[i][a] /= rho;
+        q[i]     = rho - patch.radius + patch.offset[i];
+        touching = touching || q[i] < -gap_tolerance;
+        if (s.lambda[i] > 0)
+          loaded[n_loaded++] = i;
+      }
+    // Off the surface and nothing pressed: no force, exactly, for the cost
+    // of the gaps.
+    if (!touching && n_loaded == 0)
+      return true;
+
+    // The gaps linear in the new forces about the current ones: q = g - W
+    // lambda, so that the contact problem is W lambda' + q >= 0.
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        const double *Wi = patch.W.data() + std::size_t(i) * n;
+        double        g  = q[i];
+        for (unsigned int l = 0; l < n_loaded; ++l)
+          g -= Wi[loaded[l]] * s.lambda[loaded[l]];
+        q[i] = g;
+      }
+
+    // Primal-dual active set: the forces of the nodes in contact close
+    // their gaps, the others carry none; nodes pulled leave, nodes inside
+    // join.
+    bool settled = false;
+    while (!settled && iterations < max_iterations)
+      {
+        ++iterations;
+        if (!s.factored && !factorize_active(patch, s))
+          break;
+        const unsigned int m = s.n_active;
+        for (unsigned int a = 0; a < m; ++a)
+          rhs[a] = -q[s.index[a]];
+        lu_solve(s.LU.data(), m, s.pivot.data(), rhs.data());
+        std::fill(s.lambda.begin(), s.lambda.begin() + n, 0.0);
+        for (unsigned int a = 0; a < m; ++a)
+          s.lambda[s.index[a]] = rhs[a];
+        settled = true;
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            bool now;
+            if (s.active[i])
+              now = s.lambda[i] > 0;
+            else
+              {
+                const double *Wi = patch.W.data() + std::size_t(i) * n;
+                double        g  = q[i];
+                for (unsigned int a = 0; a < m; ++a)
+                  g += Wi[s.index[a]] * rhs[a];
+                now = g < -gap_tolerance;
+              }
+            if (now != bool(s.active[i]))
+              {
+                s.active[i] = now;
+                settled     = false;
+              }
+          }
+        if (!settled)
+          s.factored = false;
+      }
+
+    // The force, and the nodes moved by it for the next tick:
+    // y = x_free + H f.
+    std::copy(patch.free_position.begin(),
+              patch.free_position.end(),
+              s.y.begin());
+    const std::size_t M = 3 * std::size_t(n);
+    for (unsigned int j = 0; j < n; ++j)
+      {
+        s.lambda[j] = std::max(0.0, s.lambda[j]);
+        if (s.lambda[j] == 0)
+          continue;
+        for (unsigned int b = 0; b < 3; ++b)
+          {
+            const double f = s.lambda[j] * u[j][b];
+            force[b] -= f;
+            const double *h = patch.H.data() + (3 * std::size_t(j) + b) * M;
+            double       *y = s.y.data();
+            for (std::size_t r = 0; r < M; ++r)
+              y[r] += h[r] * f;
+          }
+      }
+
+    // The normal forces' growth as the gaps close, U_A^T W_AA^-1 U_A.
+    if (stiffness && settled && s.factored)
+      {
+        const unsigned int m = s.n_active;
+        for (unsigned int b = 0; b < 3; ++b)
+          {
+            double *col = rhs.data() + std::size_t(b) * m;
+            for (unsigned int a = 0; a < m; ++a)
+              col[a] = u[s.index[a]][b];
+            lu_solve(s.LU.data(), m, s.pivot.data(), col);
+          }
+        for (unsigned int a = 0; a < m; ++a)
+          for (unsigned int r = 0; r < 3; ++r)
+            for (unsigned int b = 0; b < 3; ++b)
+              (*stiffness)[3 * r + b] +=
+                u[s.index[a]][r] * rhs[std::size_t(b) * m + a];
+      }
+    return settled;
+  }
+
+
+
+  bool
+  PatchContact::blend(const std::array<const ContactPatch *, 8> &corners,
+                      const std::array<double, 8>               &weights,
+                      const Utilities::Point3                   &x,
+                      Utilities::Point3                         &force,
+                      std::array<double, 9>                     *stiffness) noexcept
+  {
+    force = {{0, 0, 0}};
+    if (stiffness)
+      stiffness->fill(0.0);
+    bool                  settled = true;
+    Utilities::Point3     f;
+    std::array<double, 9> k;
+    for (unsigned int c = 0; c < 8; ++c)
+      {
+        if (weights[c] == 0)
+          continue;
+        settled = this->force(*corners[c], x, f, stiffness ? &k : nullptr) &&
+                  settled;
+        for (unsigned int a = 0; a < 3; ++a)
+          force[a] += weights[c] * f[a];
+        if (stiffness)
+          for (unsigned int e = 0; e < 9; ++e)
+            (*stiffness)[e] += weights[c] * k[e];
+      }
+    return settled;
+  }
+} // namespace palpate

@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+#include <palpate/hyperelastic/contact_patch.h>
+#include <palpate/hyperelastic/linear_solver.h>
+
+#include <algorithm>
+#include <atomic>
+
+namespace palpate
+{
+  Utilities::Point3
+  ContactPatch::state_force() const noexcept
+  {
+    Utilities::Point3 f = {{0, 0, 0}};
+    for (unsigned int i = 0; i < size(); ++i)
+      {
+        Utilities::Point3 u;
+        for (unsigned int a = 0; a < 3; ++a)
+          u[a] = position[3 * i + a] - center[a];
+        const double rho = Utilities::norm(u);
+        for (unsigned int a = 0; a < 3; ++a)
+          f[a] -= lambda[i] * u[a] / rho;
+      }
+    return f;
+  }
+
+
+
+  std::uint64_t
+  ContactPatch::new_id() noexcept
+  {
+    static std::atomic<std::uint64_t> last{0};
+    return ++last;
+  }
+
+
+
+  std::size_t
+  ContactPatch::memory() const noexcept
+  {
+    return sizeof(ContactPatch) + nodes.size() * sizeof(unsigned int) +
+           (position.size() + normal.size() + free_position.size() +
+            lambda.size() + offset.size() + H.size() + W.size()) *
+             sizeof(double);
+  }
+
+
+
+  std::shared_ptr<const ContactPatch>
+  make_contact_patch(const HyperelasticSystem                    &system,
+                     LinearSolver                                &solver,
+                     const std::vector<double>                   &x,
+                     const Utilities::Point3                     &target,
+                     const double                                 reach,
+                     std::vector<HyperelasticSystem::ContactRow> &rows)
+  {
+    auto patch    = std::make_shared<ContactPatch>();
+    patch->target = target;
+    patch->center = system.sphere_center(target);
+    patch->radius = system.sphere_radius();
+    system.contact_rows(x, target, rows);
+    // A node fixed in every direction never moves under the sphere: its
+    // compliance row would be zero and the contact problem singular.
+    for (unsigned int k = 0; k < rows.size(); ++k)
+      if (rows[k].gap <= reach &&
+          std::any_of(rows[k].eq.begin(), rows[k].eq.end(), [](int e) {
+            return e >= 0;
+          }))
+        patch->nodes.push_back(k);
+    const unsigned int m = patch->size();
+    if (m == 0)
+      return patch;
+
+    // Three right-hand sides per node, unit forces along x, y and z.
+    const unsigned int  N = system.n_equations();
+    std::vector<double> block(std::size_t(N) * 3 * m, 0.0);
+    for (unsigned int j = 0; j < m; ++j)
+      for (unsigned int a = 0; a < 3; ++a)
+        if (const int e = rows[patch->nodes[j]].eq[a]; e >= 0)
+          block[std::size_t(3 * j + a) * N + e] = 1;
+    if (!solver.solve_many(block, 3 * m))
+      return nullptr;
+    const unsigned int M = 3 * m;
+    patch->H.assign(std::size_t(M) * M, 0.0);
+    for (unsigned int i = 0; i < m; ++i)
+      for (unsigned int a = 0; a < 3; ++a)
+        if (const int e = rows[patch->nodes[i]].eq[a]; e >= 0)
+          for (unsigned int c = 0; c < M; ++c)
+            patch->H[std::size_t(3 * i + a) * M + c] = block[std::size_t(c) * N + e];
+    for (unsigned int r = 0; r < M; ++r)
+      for (unsigned int c = 0; c < r; ++c)
+        patch->H[std::size_t(r) * M + c] = patch->H[std::size_t(c) * M + r] =
+          0.5 * (patch->H[std::size_t(r) * M + c] + patch->H[std::size_t(c) * M + r]);
+    patch->normal.resize(M);
+    for (unsigned int i = 0; i < m; ++i)
+      for (unsigned int a = 0; a < 3; ++a)
+        patch->normal[3 * i + a] = rows[patch->nodes[i]].n[a];
+    patch->W.resize(std::size_t(m) * m);
+    for (unsigned int i = 0; i < m; ++i)
+      for (unsigned int j = 0; j < m; ++j)
+        {
+          double w = 0;
+          for (unsigned int a = 0; a < 3; ++a)
+            for (unsigned int b = 0; b < 3; ++b)
+              w += patch->normal[3 * i + a] *
+                   patch->H[std::size_t(3 * i + a) * M + 3 * j + b] *
+                   patch->normal[3 * j + b];
+          patch->W[std::size_t(i) * m + j] = w;
+        }
+
+    patch->position.resize(M);
+    patch->lambda.resize(m);
+    patch->offset.resize(m);
+    for (unsigned int i = 0; i < m; ++i)
+      {
+        const auto &r = rows[patch->nodes[i]];
+        for (unsigned int a = 0; a < 3; ++a)
+          patch->position[3 * i + a] = patch->center[a] + r.rho * r.n[a];
+        patch->lambda[i] = std::max(0.0, r.lambda_hat);
+        patch->offset[i] = patch->lambda[i] > 0 ? -r.gap : std::max(0.0, -r.gap);
+      }
+    // x_free = x - H f_s, f_s the state's forces along its normals.
+    patch->free_position = patch->position;
+    for (unsigned int j = 0; j < m; ++j)
+      if (patch->lambda[j] > 0)
+        for (unsigned int b = 0; b < 3; ++b)
+          {
+            const double  f = patch->lambda[j] * patch->normal[3 * j + b];
+            const double *h = patch->H.data() + std::size_t(3 * j + b) * M;
+            for (unsigned int r = 0; r < M; ++r)
+              patch->free_position[r] -= h[r] * f;
+          }
+    return patch;
+  }
+} // namespace palpate
