@@ -5,6 +5,7 @@
 #include <palpate/engine/hip_channel.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/interaction.h>
+#include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/mesh/mesh.h>
@@ -45,6 +46,11 @@ namespace palpate
     {
       for (unsigned int p = 0; p < grid.size(); ++p)
         used[p].store(0, std::memory_order_relaxed);
+      // Work space for the largest patch there can be (every surface
+      // node), so that the haptic thread never allocates.
+      if (interpolation == Interpolation::contact_patch)
+        patch_contact =
+          std::make_unique<PatchContact>(mesh.n_vertices(), 256);
       const double radius = scene.parameters.scheduler.cloud_radius;
       const int    reach =
         std::min<int>(grid.half_width(), std::floor(radius / grid.spacing()));
@@ -160,6 +166,7 @@ namespace palpate
     std::array<double, 9> stiffness = {}; // of the last force()
     const Interpolation   interpolation =
       interpolation_from_name(scene.parameters.state_space.interpolation);
+    std::unique_ptr<PatchContact> patch_contact;
     MissingCause previous_cause = MissingCause::none;
     // Whether the last tick's missing data was held (a held stretch that
     // turns into a fade, when a server's trouble ends before its states
@@ -187,6 +194,32 @@ namespace palpate
     std::atomic<double>        event_position[3] = {};
     std::uint64_t              reported_events   = 0;
     Clock::time_point          attach_time;
+
+    /**
+     * With Interpolation = contact patch: the force of the complete
+     * @p sample at @p position from its corners' contact patches, solved
+     * for the sphere there (PatchContact), in place of the trilinear one
+     * interpolate_force() gave. A corner without a patch leaves the sample
+     * trilinear. Real-time safe.
+     */
+    void
+    render_contact_patch(const Utilities::Point3 &position,
+                         ForceSample             &sample) noexcept
+    {
+      const std::uint64_t                 generation = cache.generation();
+      std::array<const ContactPatch *, 8> patches;
+      cache.begin_patch_reads();
+      bool all = true;
+      for (unsigned int c = 0; c < 8 && all; ++c)
+        all = (patches[c] = cache.read_patch(sample.corners[c], generation));
+      if (all)
+        patch_contact->blend(patches,
+                             trilinear_weights(sample.local),
+                             position,
+                             sample.force,
+                             &sample.stiffness);
+      cache.end_patch_reads();
+    }
 
     /** Seconds since the last force() call (1 ms at the first). */
     double
@@ -345,6 +378,8 @@ namespace palpate
     if (attached && finite)
       {
         sample = interpolate_force(s.grid, s.cache, position, s.interpolation);
+        if (sample.complete && s.patch_contact)
+          s.render_contact_patch(position, sample);
         if (sample.hits > 0 || sample.complete)
           {
             s.corner_reads.fetch_add(8, std::memory_order_relaxed);

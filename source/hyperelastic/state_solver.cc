@@ -783,21 +783,8 @@ namespace palpate
         state.message   = failure.message;
         state.force     = {{0, 0, 0}};
       }
-    else if (impl->settings.compute_stiffness)
-      {
-        const auto stiffness_start = Clock::now();
-        state.has_stiffness =
-          impl->settings.condensed_contact && impl->system->has_contact() ?
-            impl->condensed_stiffness(state) :
-            impl->active_stiffness(state);
-        state.stiffness_time = seconds_since(stiffness_start);
-      }
-    if (ok && impl->patch_reach > 0 && impl->system->has_contact())
-      {
-        const auto patch_start = Clock::now();
-        impl->contact_patch(state, x);
-        state.contact_patch_time = seconds_since(patch_start);
-      }
+    else
+      impl->derivatives(state, x);
     state.wall_time = seconds_since(start);
     return state;
   }

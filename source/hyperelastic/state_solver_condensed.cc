@@ -160,4 +160,26 @@ namespace palpate
       *system, *linear_solver, x, state.active_displacement, patch_reach, rows);
     return state.contact_patch != nullptr;
   }
+
+
+
+  void
+  StateSolver::Impl::derivatives(State &state, const std::vector<double> &x)
+  {
+    using Clock = std::chrono::steady_clock;
+    if (settings.compute_stiffness)
+      {
+        const auto start    = Clock::now();
+        state.has_stiffness = settings.condensed_contact && system->has_contact() ?
+                                condensed_stiffness(state) :
+                                active_stiffness(state);
+        state.stiffness_time = Utilities::seconds_since(start);
+      }
+    if (patch_reach > 0 && system->has_contact())
+      {
+        const auto start = Clock::now();
+        contact_patch(state, x);
+        state.contact_patch_time = Utilities::seconds_since(start);
+      }
+  }
 } // namespace palpate

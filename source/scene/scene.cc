@@ -1778,6 +1778,36 @@ namespace palpate
                     "0.005 m gives 41^3 = 68921 points).",
                     {"State space/Grid spacing"});
     }
+    if (p.state_space.interpolation == "contact patch")
+      {
+        using Tip = Parameters::ActiveNode::Tip;
+        if (p.boundary_conditions.active_node.tip != Tip::sphere)
+          throw error("State space/Interpolation",
+                      "contact patch solves the contact of a sphere against "
+                      "each state's surface, but Boundary conditions / Active "
+                      "node / Tip is not sphere",
+                      "set Tip = sphere with a Tip radius, or Interpolation "
+                      "= tricubic Hermite.",
+                      {"Boundary conditions/Active node/Tip"});
+        // The patches live in the states of this process's cache: solver
+        // servers send forces only, and the store keeps no patches yet.
+        if (p.engine.type == "mpi")
+          throw error("State space/Interpolation",
+                      "contact patch needs the states' contact patches in "
+                      "the haptic process, and Engine / Type = mpi sends "
+                      "the haptic loop forces only",
+                      "use Engine / Type = threads with contact patch, or "
+                      "Interpolation = tricubic Hermite with mpi.",
+                      {"Engine/Type"});
+        if (!p.state_space.store.empty())
+          throw error("State space/Interpolation",
+                      "contact patch needs each state's contact patch, and "
+                      "a State space / Store keeps forces and shapes only",
+                      "leave Store empty (set Store =) with contact patch, "
+                      "or use Interpolation = tricubic Hermite with a "
+                      "store.",
+                      {"State space/Store"});
+      }
     if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
       throw error(
         "Scheduler/Cloud radius",

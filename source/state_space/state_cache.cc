@@ -4,6 +4,8 @@
 #include <palpate/hyperelastic/state.h>
 #include <palpate/state_space/state_cache.h>
 
+#include <palpate/hyperelastic/contact_patch.h>
+
 #include <algorithm>
 
 namespace palpate
@@ -30,6 +32,17 @@ namespace palpate
     std::atomic<bool> held{false};
     /** Whether it was dropped for the budget (written under the mutex). */
     std::atomic<bool> dropped{false};
+    /** Its contact patch (written under the mutex, read by the real-time
+     * side between begin_patch_reads() and end_patch_reads()). */
+    std::atomic<const HeldPatch *> patch{nullptr};
+  };
+
+  /** A contact patch as the cache holds it: with the generation it was
+   * computed for. Freed only when no real-time read can hold it. */
+  struct StateCache::HeldPatch
+  {
+    std::shared_ptr<const ContactPatch> patch;
+    std::uint64_t                       generation;
   };
 
   static_assert(std::atomic<double>::is_always_lock_free &&
@@ -151,7 +164,72 @@ namespace palpate
 
 
 
-  StateCache::~StateCache() = default;
+  StateCache::~StateCache()
+  {
+    for (unsigned int p = 0; p < grid.size(); ++p)
+      delete entries[p].patch.load();
+    for (const auto &r : retired)
+      delete r.first;
+  }
+
+
+
+  void
+  StateCache::retire_patch(const unsigned int point)
+  {
+    // The caller holds the mutex. The reader that may still use the old
+    // patch is at most the session in progress now: it is freed once that
+    // session ended (or none is in progress).
+    const HeldPatch *old = entries[point].patch.exchange(nullptr);
+    if (old)
+      retired.emplace_back(old, reader_sessions.load());
+  }
+
+
+
+  void
+  StateCache::reclaim_patches()
+  {
+    const bool          reading  = reader_active.load();
+    const std::uint64_t sessions = reader_sessions.load();
+    auto                end      = std::remove_if(retired.begin(),
+                               retired.end(),
+                               [&](const auto &r) {
+                                 if (reading && sessions <= r.second)
+                                   return false;
+                                 delete r.first;
+                                 return true;
+                               });
+    retired.erase(end, retired.end());
+  }
+
+
+
+  void
+  StateCache::begin_patch_reads() const noexcept
+  {
+    reader_active.store(true);
+  }
+
+
+
+  void
+  StateCache::end_patch_reads() const noexcept
+  {
+    reader_sessions.fetch_add(1);
+    reader_active.store(false);
+  }
+
+
+
+  const ContactPatch *
+  StateCache::read_patch(const unsigned int  point,
+                         const std::uint64_t generation) const noexcept
+  {
+    const HeldPatch *held = entries[point].patch.load();
+    return held && held->generation == generation ? held->patch.get() :
+                                                    nullptr;
+  }
 
 
 
@@ -170,6 +248,7 @@ namespace palpate
     current_generation.fetch_add(1, std::memory_order_acq_rel);
     for (unsigned int p = 0; p < states.size(); ++p)
       {
+        retire_patch(p);
         states[p].reset();
         entries[p].held.store(false, std::memory_order_relaxed);
         entries[p].dropped.store(false, std::memory_order_relaxed);
@@ -179,6 +258,7 @@ namespace palpate
     for (const unsigned int p : wanted)
       is_wanted[p] = 0;
     wanted.clear();
+    reclaim_patches();
   }
 
 
@@ -221,6 +301,14 @@ namespace palpate
     if (generation != current_generation.load(std::memory_order_acquire))
       return; // computed for parameters that no longer hold
     Entry &e = entries[point];
+    // The patch first: a real-time read that finds the point available
+    // finds its patch too.
+    if (state->contact_patch)
+      {
+        retire_patch(point);
+        e.patch.store(new HeldPatch{state->contact_patch, generation});
+      }
+    reclaim_patches();
     // A point that is already available (a state recomputed because its
     // whole state had been dropped, or fetched from an MPI server whose
     // force arrived first) keeps its force.

@@ -150,6 +150,12 @@ namespace palpate
     factorize_contact_free(const std::vector<double> &x,
                            const Utilities::Point3   &target);
 
+    /** What a converged @p state at @p x carries beside its field: the
+     * probe's stiffness if asked for, the contact patch with
+     * Interpolation = contact patch. */
+    void
+    derivatives(State &state, const std::vector<double> &x);
+
     /** The contact patch of the converged @p state at @p x, from
      * contact-free factors of this state (made if the kept ones are not).
      * False if the linear solver fails. */

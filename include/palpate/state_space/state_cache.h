@@ -17,6 +17,7 @@
 
 namespace palpate
 {
+  struct ContactPatch;
   struct State;
 
   /** What the cache knows about a grid point. */
@@ -161,6 +162,24 @@ namespace palpate
     read_cross_derivatives(const unsigned int      point,
                            std::array<double, 12> &cross) const noexcept;
 
+    /**
+     * Real-time reads of contact patches (State space / Interpolation =
+     * contact patch): between begin_patch_reads() and end_patch_reads(),
+     * read_patch() gives the patch of @p point if it is available in
+     * @p generation (else null), and the patch stays valid until
+     * end_patch_reads() even if the point is republished or the cache
+     * invalidated meanwhile: a patch the cache lets go of is freed by a
+     * later writer once no read session can hold it (read-copy-update).
+     * One reading thread at a time. Never block, never allocate.
+     */
+    void
+    begin_patch_reads() const noexcept;
+    const ContactPatch *
+    read_patch(const unsigned int  point,
+               const std::uint64_t generation) const noexcept;
+    void
+    end_patch_reads() const noexcept;
+
     /** Number of available and of failed points in this generation. */
     std::pair<unsigned int, unsigned int>
     counts() const;
@@ -186,6 +205,17 @@ namespace palpate
 
   private:
     struct Entry;
+    struct HeldPatch;
+
+    /** Let go of the patch of @p point (mutex held): freed by
+     * reclaim_patches() once no read session can hold it. */
+    void
+    retire_patch(const unsigned int point);
+
+    /** Free the patches let go of that no read session can hold (mutex
+     * held). */
+    void
+    reclaim_patches();
 
     /**
      * Recompute the cross derivatives of @p point (if it is available with
@@ -219,6 +249,10 @@ namespace palpate
     std::size_t                       bytes = 0, budget;
     unsigned int                      held = 0, evicted = 0;
     Utilities::Point3                 focus = {{0, 0, 0}};
+    // Patches let go of, with the read sessions ended when they were.
+    std::vector<std::pair<const HeldPatch *, std::uint64_t>> retired;
+    mutable std::atomic<bool>                                reader_active{false};
+    mutable std::atomic<std::uint64_t>                       reader_sessions{0};
   };
 } // namespace palpate
 
