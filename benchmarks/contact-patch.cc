@@ -2,11 +2,12 @@
 // Copyright (C) 2026 the palpate authors
 
 // benchmarks/run contact-patch [--quick] [--body liver|blob|all]
-//                              [--spacing 5,10,20]
+//                              [--spacing 5,10,20] [--verbose]
 //
 // The force between the states with the sphere (issue 45): on the shipped
 // indenter liver (parameters/liver-indenter.prm, 2,012 nodes) and on the
-// blob generator's organ touched by the same 1 cm sphere, HIP positions on
+// blob generator's organ (3 refinements, 2,197 nodes) touched by a 15 mm
+// sphere (the smallest palpate accepts on its 18 mm surface triangles), HIP positions on
 // sweeps that cross contact onset (5 mm above the surface to 8 mm deep, on
 // the normal and beside it), slide along the surface at 2, 4 and 6 mm
 // depth, and press deep along the scene's stroke. At each, the force a
@@ -84,7 +85,11 @@ namespace
       for (const std::string s :
            {"Mesh/Source=blob",
             "Mesh/Blob/Semi-axes=0.125, 0.09, 0.07",
-            "Mesh/Blob/Refinements=2",
+            "Mesh/File name=",
+            "Mesh/Blob/Refinements=3",
+            // The smallest sphere palpate accepts on this mesh's 18 mm
+            // surface triangles (a 1 cm sphere would slip between nodes).
+            "Boundary conditions/Active node/Tip radius=0.015",
             "Boundary conditions/Fixed nodes/Half-space point=0, 0, -0.04",
             "Boundary conditions/Active node/Point=0, 0, 0.07"})
         settings.push_back(s);
@@ -355,6 +360,8 @@ namespace
             row.p95     = percentile(err, 0.95);
             row.max     = percentile(err, 1.0);
             rows.push_back(row);
+            std::cout << "  " << row.interpolation << ": p95 " << row.p95
+                      << " %, max " << row.max << " %" << std::endl;
           }
 
         // The contact patch keeps a warm start from tick to tick: the
@@ -418,11 +425,13 @@ namespace
         row.max       = percentile(err, 1.0);
         row.tick_p999 = percentile(tick_us, 0.999);
         rows.push_back(row);
+        std::cout << "  contact_patch: p95 " << row.p95 << " %, max " << row.max
+                  << " %" << std::endl;
         std::cout << "  contact patch: " << tick_us.size() << " ticks ("
                   << unsettled << " not settled), p50 "
                   << percentile(tick_us, 0.5) << " us, p99 "
                   << percentile(tick_us, 0.99) << " us, p999 "
-                  << percentile(tick_us, 0.999) << " us\n";
+                  << percentile(tick_us, 0.999) << " us" << std::endl;
       }
   }
 

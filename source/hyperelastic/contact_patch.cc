@@ -41,8 +41,9 @@ namespace palpate
   {
     return sizeof(ContactPatch) + nodes.size() * sizeof(unsigned int) +
            (position.size() + normal.size() + free_position.size() +
-            lambda.size() + offset.size() + H.size() + W.size()) *
-             sizeof(double);
+            lambda.size() + offset.size() + W.size()) *
+             sizeof(double) +
+           H.size() * sizeof(float);
   }
 
 
@@ -81,17 +82,20 @@ namespace palpate
           block[std::size_t(3 * j + a) * N + e] = 1;
     if (!solver.solve_many(block, 3 * m))
       return nullptr;
-    const unsigned int M = 3 * m;
-    patch->H.assign(std::size_t(M) * M, 0.0);
+    const unsigned int  M = 3 * m;
+    std::vector<double> H(std::size_t(M) * M, 0.0);
     for (unsigned int i = 0; i < m; ++i)
       for (unsigned int a = 0; a < 3; ++a)
         if (const int e = rows[patch->nodes[i]].eq[a]; e >= 0)
           for (unsigned int c = 0; c < M; ++c)
-            patch->H[std::size_t(3 * i + a) * M + c] = block[std::size_t(c) * N + e];
+            H[std::size_t(3 * i + a) * M + c] = block[std::size_t(c) * N + e];
+    // Symmetric as the tangent is, up to the factors' round-off: made
+    // exactly so, so that the contact problem is that of an energy.
     for (unsigned int r = 0; r < M; ++r)
       for (unsigned int c = 0; c < r; ++c)
-        patch->H[std::size_t(r) * M + c] = patch->H[std::size_t(c) * M + r] =
-          0.5 * (patch->H[std::size_t(r) * M + c] + patch->H[std::size_t(c) * M + r]);
+        H[std::size_t(r) * M + c] = H[std::size_t(c) * M + r] =
+          0.5 * (H[std::size_t(r) * M + c] + H[std::size_t(c) * M + r]);
+    patch->H.assign(H.begin(), H.end());
     patch->normal.resize(M);
     for (unsigned int i = 0; i < m; ++i)
       for (unsigned int a = 0; a < 3; ++a)
@@ -104,7 +108,7 @@ namespace palpate
           for (unsigned int a = 0; a < 3; ++a)
             for (unsigned int b = 0; b < 3; ++b)
               w += patch->normal[3 * i + a] *
-                   patch->H[std::size_t(3 * i + a) * M + 3 * j + b] *
+                   H[std::size_t(3 * i + a) * M + 3 * j + b] *
                    patch->normal[3 * j + b];
           patch->W[std::size_t(i) * m + j] = w;
         }
@@ -127,7 +131,7 @@ namespace palpate
         for (unsigned int b = 0; b < 3; ++b)
           {
             const double  f = patch->lambda[j] * patch->normal[3 * j + b];
-            const double *h = patch->H.data() + std::size_t(3 * j + b) * M;
+            const float *h = patch->H.data() + std::size_t(3 * j + b) * M;
             for (unsigned int r = 0; r < M; ++r)
               patch->free_position[r] -= h[r] * f;
           }

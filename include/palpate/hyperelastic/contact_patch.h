@@ -68,8 +68,12 @@ namespace palpate
     std::vector<double> lambda;
     /** o_i of the gaps (m). */
     std::vector<double> offset;
-    /** H (3n x 3n, row-major, symmetric; m/N). */
-    std::vector<double> H;
+    /** H (3n x 3n, row-major, symmetric; m/N), in single precision: the
+     * haptic tick moves the nodes by it (H f), and single precision
+     * halves both the memory it streams through and the patch. x_free is
+     * computed with these values, so that the state's own forces still
+     * give its positions to double round-off. */
+    std::vector<float> H;
     /** W = N^T H N along the state's normals (n x n; m/N): the contact
      * problem's matrix near the state, kept factorised by the haptic loop
      * while the set of nodes in contact stays. */
