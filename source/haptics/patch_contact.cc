@@ -61,6 +61,62 @@ namespace palpate
         y[r] += h[r] * f;
     }
 
+    /** Cholesky factor L (lower, in place) of the symmetric m x m A;
+     * false if A is not positive definite. */
+    bool
+    cholesky(double *A, const unsigned int m) noexcept
+    {
+      for (unsigned int j = 0; j < m; ++j)
+        {
+          double d = A[j * m + j];
+          for (unsigned int k = 0; k < j; ++k)
+            d -= A[j * m + k] * A[j * m + k];
+          if (!(d > 0))
+            return false;
+          d            = std::sqrt(d);
+          A[j * m + j] = d;
+          for (unsigned int i = j + 1; i < m; ++i)
+            {
+              double v = A[i * m + j];
+              for (unsigned int k = 0; k < j; ++k)
+                v -= A[i * m + k] * A[j * m + k];
+              A[i * m + j] = v / d;
+            }
+        }
+      return true;
+    }
+
+    /** Solve L L^T x = b in place of @p b. */
+    void
+    cholesky_solve(const double *L, const unsigned int m, double *b) noexcept
+    {
+      for (unsigned int i = 0; i < m; ++i)
+        {
+          double v = b[i];
+          for (unsigned int k = 0; k < i; ++k)
+            v -= L[i * m + k] * b[k];
+          b[i] = v / L[i * m + i];
+        }
+      for (int i = int(m) - 1; i >= 0; --i)
+        {
+          double v = b[i];
+          for (unsigned int k = i + 1; k < m; ++k)
+            v -= L[k * m + i] * b[k];
+          b[i] = v / L[i * m + i];
+        }
+    }
+
+    /** y += f w over @p n entries: a row of W (symmetric: a column). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+    __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+    void
+    add_row(double *y, const double *w, const double f, const std::size_t n) noexcept
+    {
+      for (std::size_t i = 0; i < n; ++i)
+        y[i] += w[i] * f;
+    }
+
     void
     lu_solve(const double       *LU,
              const unsigned int  m,
@@ -92,6 +148,7 @@ namespace palpate
     // across a face.
     , slots(12)
     , q(max_nodes)
+    , w(max_nodes)
     , rhs(3 * this->max_active)
     , u(max_nodes)
     , loaded(max_nodes)
@@ -156,8 +213,31 @@ namespace palpate
       for (unsigned int b = 0; b < m; ++b)
         s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
     s.n_active = m;
-    s.factored = lu_factorize(s.LU.data(), m, s.pivot.data());
+    // W is a compliance, symmetric positive definite at a stable state:
+    // Cholesky, half the work of LU. LU where round-off (or an unstable
+    // state's tangent) makes the block indefinite.
+    s.cholesky = cholesky(s.LU.data(), m);
+    if (!s.cholesky)
+      {
+        for (unsigned int a = 0; a < m; ++a)
+          for (unsigned int b = 0; b < m; ++b)
+            s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
+        s.factored = lu_factorize(s.LU.data(), m, s.pivot.data());
+      }
+    else
+      s.factored = true;
     return s.factored;
+  }
+
+
+
+  void
+  PatchContact::solve_active(const Slot &s, double *b) const noexcept
+  {
+    if (s.cholesky)
+      cholesky_solve(s.LU.data(), s.n_active, b);
+    else
+      lu_solve(s.LU.data(), s.n_active, s.pivot.data(), b);
   }
 
 
@@ -208,15 +288,13 @@ namespace palpate
       return true;
 
     // The gaps linear in the new forces about the current ones: q = g - W
-    // lambda, so that the contact problem is W lambda' + q >= 0.
-    for (unsigned int i = 0; i < n; ++i)
-      {
-        const double *Wi = patch.W.data() + std::size_t(i) * n;
-        double        g  = q[i];
-        for (unsigned int l = 0; l < n_loaded; ++l)
-          g -= Wi[loaded[l]] * s.lambda[loaded[l]];
-        q[i] = g;
-      }
+    // lambda, so that the contact problem is W lambda' + q >= 0 (by rows
+    // of W, which is symmetric: contiguous, vectorised).
+    for (unsigned int l = 0; l < n_loaded; ++l)
+      add_row(q.data(),
+              patch.W.data() + std::size_t(loaded[l]) * n,
+              -s.lambda[loaded[l]],
+              n);
 
     // Primal-dual active set: the forces of the nodes in contact close
     // their gaps, the others carry none; nodes pulled leave, nodes inside
@@ -230,24 +308,22 @@ namespace palpate
         const unsigned int m = s.n_active;
         for (unsigned int a = 0; a < m; ++a)
           rhs[a] = -q[s.index[a]];
-        lu_solve(s.LU.data(), m, s.pivot.data(), rhs.data());
+        solve_active(s, rhs.data());
         std::fill(s.lambda.begin(), s.lambda.begin() + n, 0.0);
         for (unsigned int a = 0; a < m; ++a)
           s.lambda[s.index[a]] = rhs[a];
+        // The gaps the new forces leave, w = q + W lambda.
+        std::copy(q.begin(), q.begin() + n, w.begin());
+        for (unsigned int a = 0; a < m; ++a)
+          add_row(w.data(),
+                  patch.W.data() + std::size_t(s.index[a]) * n,
+                  rhs[a],
+                  n);
         settled = true;
         for (unsigned int i = 0; i < n; ++i)
           {
-            bool now;
-            if (s.active[i])
-              now = s.lambda[i] > 0;
-            else
-              {
-                const double *Wi = patch.W.data() + std::size_t(i) * n;
-                double        g  = q[i];
-                for (unsigned int a = 0; a < m; ++a)
-                  g += Wi[s.index[a]] * rhs[a];
-                now = g < -gap_tolerance;
-              }
+            const bool now =
+              s.active[i] ? s.lambda[i] > 0 : w[i] < -gap_tolerance;
             if (now != bool(s.active[i]))
               {
                 s.active[i] = now;
@@ -289,7 +365,7 @@ namespace palpate
             double *col = rhs.data() + std::size_t(b) * m;
             for (unsigned int a = 0; a < m; ++a)
               col[a] = u[s.index[a]][b];
-            lu_solve(s.LU.data(), m, s.pivot.data(), col);
+            solve_active(s, col);
           }
         for (unsigned int a = 0; a < m; ++a)
           for (unsigned int r = 0; r < 3; ++r)

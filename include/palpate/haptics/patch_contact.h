@@ -104,12 +104,18 @@ namespace palpate
       std::vector<unsigned int> pivot;
       unsigned int              n_active = 0;
       bool                      factored = false;
+      // Whether LU holds a Cholesky factor (else LU with pivot).
+      bool cholesky = false;
     };
 
     /** The slot of @p patch (its warm start), or the least recently used
      * one, reset. */
     Slot &
     slot_of(const ContactPatch &patch) noexcept;
+
+    /** Solve W_AA x = b in place with the factors of @p s. */
+    void
+    solve_active(const Slot &s, double *b) const noexcept;
 
     /** Factorise W on the active set of @p s (into s.index, s.LU); false
      * if it is singular or larger than the work space. */
@@ -119,7 +125,7 @@ namespace palpate
     unsigned int        max_nodes, max_active;
     std::vector<Slot>   slots;
     std::uint64_t       clock = 0;
-    std::vector<double>                q, rhs;
+    std::vector<double>                q, w, rhs;
     std::vector<std::array<double, 3>> u;
     std::vector<unsigned int>          loaded;
     unsigned int                       iterations = 0;
