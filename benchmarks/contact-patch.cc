@@ -7,9 +7,9 @@
 // The force between the states with the sphere (issue 45): on the shipped
 // indenter liver (parameters/liver-indenter.prm, 2,012 nodes) and on the
 // blob generator's organ (3 refinements, 2,197 nodes) touched by a 15 mm
-// sphere (the smallest palpate accepts on its 18 mm surface triangles), HIP positions on
-// sweeps that cross contact onset (5 mm above the surface to 8 mm deep, on
-// the normal and beside it), slide along the surface at 2, 4 and 6 mm
+// sphere (the smallest palpate accepts on its 18 mm surface triangles), HIP
+// positions on sweeps that cross contact onset (5 mm above the surface to 8 mm
+// deep, on the normal and beside it), slide along the surface at 2, 4 and 6 mm
 // depth, and press deep along the scene's stroke. At each, the force a
 // haptic loop renders from grid states (trilinear, tricubic Hermite,
 // contact patch) against a direct solve there:
@@ -45,9 +45,9 @@
 #include <palpate/state_space/state_grid.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -66,9 +66,9 @@ namespace
 {
   struct Options
   {
-    bool                quick = false, verbose = false;
-    std::vector<std::string> bodies = {"liver", "blob"};
-    std::vector<double> spacings    = {0.005, 0.01, 0.02};
+    bool                     quick = false, verbose = false;
+    std::vector<std::string> bodies   = {"liver", "blob"};
+    std::vector<double>      spacings = {0.005, 0.01, 0.02};
   };
 
   Scene
@@ -115,14 +115,14 @@ namespace
   sweeps(const Point3 &normal, const Point3 &stroke, const bool quick)
   {
     // Tangents of the surface at the touching point.
-    Point3 t1 = std::abs(normal[0]) < 0.9 ? Point3{{1, 0, 0}} :
-                                            Point3{{0, 1, 0}};
-    t1        = unit(add(t1, normal, -Utilities::dot(t1, normal)));
-    const Point3 t2 = Utilities::cross(normal, t1);
-    const double mm = 1e-3, step = (quick ? 1.5 : 0.5) * mm;
+    Point3 t1 =
+      std::abs(normal[0]) < 0.9 ? Point3{{1, 0, 0}} : Point3{{0, 1, 0}};
+    t1 = unit(add(t1, normal, -Utilities::dot(t1, normal)));
+    const Point3                     t2 = Utilities::cross(normal, t1);
+    const double                     mm = 1e-3, step = (quick ? 1.5 : 0.5) * mm;
     std::vector<std::vector<Point3>> all;
     auto line = [&](const Point3 &from, const Point3 &to) {
-      const unsigned int   n = std::ceil(Utilities::distance(from, to) / step);
+      const unsigned int  n = std::ceil(Utilities::distance(from, to) / step);
       std::vector<Point3> s;
       for (unsigned int i = 0; i <= n; ++i)
         s.push_back(add(from, add(to, from, -1), double(i) / n));
@@ -184,15 +184,15 @@ namespace
   struct Row
   {
     std::string body, interpolation;
-    double      spacing_mm = 0, p95 = 0, max = 0, tick_p999 = 0,
-           states_per_cm = 0;
+    double spacing_mm = 0, p95 = 0, max = 0, tick_p999 = 0, states_per_cm = 0;
     unsigned int samples = 0, uncovered = 0;
   };
 
   /** Everything measured on one body. */
   void
-  measure_body(const std::string &body, const Options &o,
-               std::vector<Row> &rows)
+  measure_body(const std::string &body,
+               const Options     &o,
+               std::vector<Row>  &rows)
   {
     const Scene         scene = body_scene(body, "contact patch");
     const Mesh          mesh  = Mesh::create(scene);
@@ -200,21 +200,20 @@ namespace
     std::cout << "== " << body << ": " << mesh.n_vertices() << " nodes\n";
 
     // The direct solves, along each sweep from its previous sample.
-    auto direct_params = scene.parameters;
+    auto direct_params                      = scene.parameters;
     direct_params.state_space.interpolation = "trilinear";
     StateSolver direct(mesh, nodes, direct_params);
-    const auto &sys    = direct.system();
-    const State rest   = direct.rest_state();
+    const auto &sys  = direct.system();
+    const State rest = direct.rest_state();
     std::vector<HyperelasticSystem::ContactRow> contact;
     sys.contact_rows(sys.from_state(rest), {{0, 0, 0}}, contact);
     unsigned int touching = 0;
     for (unsigned int k = 1; k < contact.size(); ++k)
       if (contact[k].gap < contact[touching].gap)
         touching = k;
-    const Point3 normal = Utilities::scaled(contact[touching].n, -1.0);
-    const auto  &stroke_dir =
-      scene.parameters.haptics.trajectory.direction;
-    const auto lines = sweeps(normal, unit(stroke_dir), o.quick);
+    const Point3 normal     = Utilities::scaled(contact[touching].n, -1.0);
+    const auto  &stroke_dir = scene.parameters.haptics.trajectory.direction;
+    const auto   lines      = sweeps(normal, unit(stroke_dir), o.quick);
 
     std::vector<Point3>              samples;
     std::vector<Point3>              f_direct;
@@ -242,13 +241,13 @@ namespace
           }
       }
     std::cout << "  " << samples.size() << " samples on " << lines.size()
-              << " sweeps, direct solve median "
-              << percentile(direct_ms, 0.5) << " ms\n";
+              << " sweeps, direct solve median " << percentile(direct_ms, 0.5)
+              << " ms\n";
 
     for (const double h : o.spacings)
       {
-        auto p                         = scene.parameters;
-        p.state_space.grid_spacing     = h;
+        auto p                               = scene.parameters;
+        p.state_space.grid_spacing           = h;
         p.nonlinear_solver.compute_stiffness = true;
         StateSolver     solver(mesh, nodes, p);
         const StateGrid grid(h, std::max(p.state_space.extent, 0.03));
@@ -280,10 +279,10 @@ namespace
           return Utilities::norm(grid.position(a)) <
                  Utilities::norm(grid.position(b));
         });
-        const State                                  rest_h = solver.rest_state();
+        const State rest_h = solver.rest_state();
         std::map<unsigned int, std::shared_ptr<const State>> done;
-        std::vector<double>                          state_ms, patch_nodes, patch_ms;
-        unsigned int                                 failures = 0;
+        std::vector<double> state_ms, patch_nodes, patch_ms;
+        unsigned int        failures = 0;
         for (const unsigned int q : order)
           {
             const State *from = &rest_h;
@@ -293,7 +292,8 @@ namespace
                     Utilities::distance(grid.position(r), grid.position(q));
                   d < best)
                 best = d, from = s.get();
-            auto s = std::make_shared<State>(solver.solve(*from, grid.position(q)));
+            auto s =
+              std::make_shared<State>(solver.solve(*from, grid.position(q)));
             if (!s->converged)
               {
                 ++failures;
@@ -320,7 +320,7 @@ namespace
         for (const auto &[q, st] : done)
           if (st->contact_patch)
             {
-              Point3 f;
+              Point3                f;
               std::array<double, 9> K;
               patch_contact.force(*st->contact_patch, grid.position(q), f, &K);
               grid_point_error =
@@ -337,7 +337,7 @@ namespace
              {Interpolation::trilinear, Interpolation::hermite})
           {
             Row row;
-            row.body          = body;
+            row.body = body;
             row.interpolation =
               scheme == Interpolation::trilinear ? "trilinear" : "hermite";
             row.spacing_mm    = 1e3 * h;
@@ -354,7 +354,10 @@ namespace
                   }
                 err.push_back(error_pct(s.force, f_direct[i]));
                 if (o.verbose)
-                  print_sample(row.interpolation, samples[i], f_direct[i], s.force);
+                  print_sample(row.interpolation,
+                               samples[i],
+                               f_direct[i],
+                               s.force);
               }
             row.samples = err.size();
             row.p95     = percentile(err, 0.95);
@@ -376,12 +379,12 @@ namespace
         std::vector<double> err, tick_us;
         unsigned int        unsettled = 0;
         std::size_t         sample    = 0;
-        auto tick = [&](const Point3 &x, Point3 &f) {
+        auto                tick      = [&](const Point3 &x, Point3 &f) {
           GridIndex             lower;
           std::array<double, 3> local;
           if (!grid.locate(x, lower, local))
             return false;
-          const auto corners = grid.corners(lower);
+          const auto                          corners = grid.corners(lower);
           std::array<const ContactPatch *, 8> patches;
           for (unsigned int c = 0; c < 8; ++c)
             {
@@ -407,10 +410,11 @@ namespace
                   covered = tick(samples[sample], f);
               else
                 for (unsigned int t = 1; t <= 20; ++t)
-                  covered = tick(add(samples[sample - 1],
-                                     add(samples[sample], samples[sample - 1], -1),
-                                     t / 20.0),
-                                 f);
+                  covered =
+                    tick(add(samples[sample - 1],
+                             add(samples[sample], samples[sample - 1], -1),
+                             t / 20.0),
+                         f);
               if (!covered)
                 {
                   ++row.uncovered;
@@ -418,7 +422,10 @@ namespace
                 }
               err.push_back(error_pct(f, f_direct[sample]));
               if (o.verbose)
-                print_sample(row.interpolation, samples[sample], f_direct[sample], f);
+                print_sample(row.interpolation,
+                             samples[sample],
+                             f_direct[sample],
+                             f);
             }
         row.samples   = err.size();
         row.p95       = percentile(err, 0.95);
@@ -450,8 +457,8 @@ namespace
         else if (a == "--body" && i + 1 < argc)
           {
             const std::string b = argv[++i];
-            o.bodies            = b == "all" ? std::vector<std::string>{"liver", "blob"} :
-                                               std::vector<std::string>{b};
+            o.bodies = b == "all" ? std::vector<std::string>{"liver", "blob"} :
+                                    std::vector<std::string>{b};
           }
         else if (a == "--spacing" && i + 1 < argc)
           {
@@ -477,7 +484,8 @@ namespace
     for (const auto &b : o.bodies)
       measure_body(b, o, rows);
 
-    std::cout << "\n" << std::left << std::setw(7) << "body" << std::setw(15)
+    std::cout << "\n"
+              << std::left << std::setw(7) << "body" << std::setw(15)
               << "interpolation" << std::right << std::setw(6) << "h mm"
               << std::setw(9) << "samples" << std::setw(10) << "uncovered"
               << std::setw(10) << "p95 %" << std::setw(10) << "max %"
@@ -485,20 +493,19 @@ namespace
               << "\n";
     for (const Row &r : rows)
       std::cout << std::left << std::setw(7) << r.body << std::setw(15)
-                << r.interpolation << std::right << std::setw(6)
-                << r.spacing_mm << std::setw(9) << r.samples << std::setw(10)
-                << r.uncovered << std::setw(10) << std::setprecision(3)
-                << r.p95 << std::setw(10) << r.max << std::setw(10)
-                << r.states_per_cm << std::setw(12)
+                << r.interpolation << std::right << std::setw(6) << r.spacing_mm
+                << std::setw(9) << r.samples << std::setw(10) << r.uncovered
+                << std::setw(10) << std::setprecision(3) << r.p95
+                << std::setw(10) << r.max << std::setw(10) << r.states_per_cm
+                << std::setw(12)
                 << (r.interpolation == "contact_patch" ? r.tick_p999 : 0.0)
                 << "\n";
     std::cout << "\n";
     for (const Row &r : rows)
       std::cout << "RESULT contact-patch mesh=" << r.body
                 << " interpolation=" << r.interpolation
-                << " spacing_mm=" << r.spacing_mm
-                << " err_p95_pct=" << r.p95 << " err_max_pct=" << r.max
-                << " tick_us_p999="
+                << " spacing_mm=" << r.spacing_mm << " err_p95_pct=" << r.p95
+                << " err_max_pct=" << r.max << " tick_us_p999="
                 << (r.interpolation == "contact_patch" ? r.tick_p999 : 0.0)
                 << " states_per_cm=" << r.states_per_cm
                 << " samples=" << r.samples << " uncovered=" << r.uncovered

@@ -49,8 +49,7 @@ namespace palpate
       // Work space for the largest patch there can be (every surface
       // node), so that the haptic thread never allocates.
       if (interpolation == Interpolation::contact_patch)
-        patch_contact =
-          std::make_unique<PatchContact>(mesh.n_vertices(), 256);
+        patch_contact = std::make_unique<PatchContact>(mesh.n_vertices(), 256);
       const double radius = scene.parameters.scheduler.cloud_radius;
       const int    reach =
         std::min<int>(grid.half_width(), std::floor(radius / grid.spacing()));
@@ -167,7 +166,7 @@ namespace palpate
     const Interpolation   interpolation =
       interpolation_from_name(scene.parameters.state_space.interpolation);
     std::unique_ptr<PatchContact> patch_contact;
-    MissingCause previous_cause = MissingCause::none;
+    MissingCause                  previous_cause = MissingCause::none;
     // Whether the last tick's missing data was held (a held stretch that
     // turns into a fade, when a server's trouble ends before its states
     // came, is a new event: the summary counts fades and holds apart).

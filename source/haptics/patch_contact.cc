@@ -55,7 +55,10 @@ namespace palpate
     __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
     void
-    add_column(double *y, const float *h, const double f, const std::size_t M) noexcept
+    add_column(double           *y,
+               const float      *h,
+               const double      f,
+               const std::size_t M) noexcept
     {
       for (std::size_t r = 0; r < M; ++r)
         y[r] += h[r] * f;
@@ -111,7 +114,10 @@ namespace palpate
     __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
     void
-    add_row(double *y, const double *w, const double f, const std::size_t n) noexcept
+    add_row(double           *y,
+            const double     *w,
+            const double      f,
+            const std::size_t n) noexcept
     {
       for (std::size_t i = 0; i < n; ++i)
         y[i] += w[i] * f;
@@ -383,7 +389,7 @@ namespace palpate
                       const std::array<double, 8>               &weights,
                       const Utilities::Point3                   &x,
                       Utilities::Point3                         &force,
-                      std::array<double, 9>                     *stiffness) noexcept
+                      std::array<double, 9> *stiffness) noexcept
   {
     force = {{0, 0, 0}};
     if (stiffness)
@@ -395,8 +401,8 @@ namespace palpate
       {
         if (weights[c] == 0)
           continue;
-        settled = this->force(*corners[c], x, f, stiffness ? &k : nullptr) &&
-                  settled;
+        settled =
+          this->force(*corners[c], x, f, stiffness ? &k : nullptr) && settled;
         for (unsigned int a = 0; a < 3; ++a)
           force[a] += weights[c] * f[a];
         if (stiffness)

@@ -64,10 +64,9 @@ namespace palpate
     // A node fixed in every direction never moves under the sphere: its
     // compliance row would be zero and the contact problem singular.
     for (unsigned int k = 0; k < rows.size(); ++k)
-      if (rows[k].gap <= reach &&
-          std::any_of(rows[k].eq.begin(), rows[k].eq.end(), [](int e) {
-            return e >= 0;
-          }))
+      if (rows[k].gap <= reach && std::any_of(rows[k].eq.begin(),
+                                              rows[k].eq.end(),
+                                              [](int e) { return e >= 0; }))
         patch->nodes.push_back(k);
     const unsigned int m = patch->size();
     if (m == 0)
@@ -122,7 +121,8 @@ namespace palpate
         for (unsigned int a = 0; a < 3; ++a)
           patch->position[3 * i + a] = patch->center[a] + r.rho * r.n[a];
         patch->lambda[i] = std::max(0.0, r.lambda_hat);
-        patch->offset[i] = patch->lambda[i] > 0 ? -r.gap : std::max(0.0, -r.gap);
+        patch->offset[i] =
+          patch->lambda[i] > 0 ? -r.gap : std::max(0.0, -r.gap);
       }
     // x_free = x - H f_s, f_s the state's forces along its normals.
     patch->free_position = patch->position;
@@ -130,7 +130,7 @@ namespace palpate
       if (patch->lambda[j] > 0)
         for (unsigned int b = 0; b < 3; ++b)
           {
-            const double  f = patch->lambda[j] * patch->normal[3 * j + b];
+            const double f = patch->lambda[j] * patch->normal[3 * j + b];
             const float *h = patch->H.data() + std::size_t(3 * j + b) * M;
             for (unsigned int r = 0; r < M; ++r)
               patch->free_position[r] -= h[r] * f;

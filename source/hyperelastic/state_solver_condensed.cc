@@ -148,7 +148,8 @@ namespace palpate
     // The patch's compliance is that of the state's own contact-free
     // tangent: factors made within one Newton step of it (the condensed
     // stiffness's) serve, any others are made anew.
-    if (!(contact_free_factors && factors_of_state && factored_residual <= 1e-4))
+    if (!(contact_free_factors && factors_of_state &&
+          factored_residual <= 1e-4))
       {
         ++state.stiffness_factorizations;
         if (!factorize_contact_free(x, state.active_displacement))
@@ -169,10 +170,11 @@ namespace palpate
     using Clock = std::chrono::steady_clock;
     if (settings.compute_stiffness)
       {
-        const auto start    = Clock::now();
-        state.has_stiffness = settings.condensed_contact && system->has_contact() ?
-                                condensed_stiffness(state) :
-                                active_stiffness(state);
+        const auto start = Clock::now();
+        state.has_stiffness =
+          settings.condensed_contact && system->has_contact() ?
+            condensed_stiffness(state) :
+            active_stiffness(state);
         state.stiffness_time = Utilities::seconds_since(start);
       }
     if (patch_reach > 0 && system->has_contact())

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
+#include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/state_space/state_cache.h>
-
-#include <palpate/hyperelastic/contact_patch.h>
 
 #include <algorithm>
 
@@ -192,14 +191,13 @@ namespace palpate
   {
     const bool          reading  = reader_active.load();
     const std::uint64_t sessions = reader_sessions.load();
-    auto                end      = std::remove_if(retired.begin(),
-                               retired.end(),
-                               [&](const auto &r) {
-                                 if (reading && sessions <= r.second)
-                                   return false;
-                                 delete r.first;
-                                 return true;
-                               });
+    auto                end =
+      std::remove_if(retired.begin(), retired.end(), [&](const auto &r) {
+        if (reading && sessions <= r.second)
+          return false;
+        delete r.first;
+        return true;
+      });
     retired.erase(end, retired.end());
   }
 
@@ -227,8 +225,7 @@ namespace palpate
                          const std::uint64_t generation) const noexcept
   {
     const HeldPatch *held = entries[point].patch.load();
-    return held && held->generation == generation ? held->patch.get() :
-                                                    nullptr;
+    return held && held->generation == generation ? held->patch.get() : nullptr;
   }
 
 

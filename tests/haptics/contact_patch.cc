@@ -2,8 +2,8 @@
 // Copyright (C) 2026 the palpate authors
 
 // State space / Interpolation = contact patch on the beam (2.5 mm
-// neo-Hookean elements) touched by a 1 cm sphere, 5 mm grid: the states' patches solved by PatchContact as
-// the haptic loop does, tick by tick.
+// neo-Hookean elements) touched by a 1 cm sphere, 5 mm grid: the states'
+// patches solved by PatchContact as the haptic loop does, tick by tick.
 // - At a grid point the force is the state's (1e-9 relative).
 // - Above the surface it is exactly zero.
 // - Along a line through contact onset (between grid lines) it is
@@ -87,7 +87,7 @@ namespace
       for (const unsigned int q : points)
         {
           const palpate::State *from = &start;
-          double                best = palpate::Utilities::norm(grid.position(q));
+          double best = palpate::Utilities::norm(grid.position(q));
           for (const auto &[r, s] : states)
             if (const double d = palpate::Utilities::distance(grid.position(r),
                                                               grid.position(q));
@@ -112,14 +112,14 @@ namespace
       std::array<double, 3> local;
       if (!grid.locate(x, lower, local))
         return false;
-      const auto                                   corners = grid.corners(lower);
+      const auto corners = grid.corners(lower);
       std::array<const palpate::ContactPatch *, 8> patches;
       counting = true;
       cache.begin_patch_reads();
       bool all = true;
       for (unsigned int c = 0; c < 8; ++c)
-        all = all && (patches[c] = cache.read_patch(corners[c],
-                                                    cache.generation()));
+        all = all &&
+              (patches[c] = cache.read_patch(corners[c], cache.generation()));
       if (all)
         contact.blend(patches, palpate::trilinear_weights(local), x, f);
       cache.end_patch_reads();
@@ -127,12 +127,12 @@ namespace
       return all;
     }
 
-    Body                                                     body;
-    palpate::StateSolver                                     solver, direct;
-    palpate::StateGrid                                       grid;
-    palpate::StateCache                                      cache;
-    palpate::PatchContact                                    contact;
-    palpate::State                                           rest;
+    Body                  body;
+    palpate::StateSolver  solver, direct;
+    palpate::StateGrid    grid;
+    palpate::StateCache   cache;
+    palpate::PatchContact contact;
+    palpate::State        rest;
     std::map<unsigned int, std::shared_ptr<const palpate::State>> states;
   };
 
@@ -166,10 +166,10 @@ main(int argc, char **argv)
   p.material_model.model_name = "Neo-Hookean";
   p.material_model.set("Neo-Hookean", "Young's modulus", 1e5);
   p.material_model.set("Neo-Hookean", "Poisson's ratio", 0.3);
-  p.state_space.interpolation             = "contact patch";
-  p.state_space.grid_spacing              = 0.005;
-  p.nonlinear_solver.condensed_contact    = true;
-  p.nonlinear_solver.residual_tolerance   = 1e-10;
+  p.state_space.interpolation           = "contact patch";
+  p.state_space.grid_spacing            = 0.005;
+  p.nonlinear_solver.condensed_contact  = true;
+  p.nonlinear_solver.residual_tolerance = 1e-10;
   Patches patches(scene);
   deallog << "states with a patch: " << patches.states.size() << " of 27"
           << std::endl;
@@ -211,7 +211,8 @@ main(int argc, char **argv)
   {
     Point3       last = {{0, 0, 0}}, f;
     double       jump = 0, largest = 0, decrease = 0, onset = 1;
-    const Point3 from = {{0.0013, 0.0007, 0.0005}}, to = {{0.0013, 0.0007, -0.0045}};
+    const Point3 from    = {{0.0013, 0.0007, 0.0005}},
+                 to      = {{0.0013, 0.0007, -0.0045}};
     const unsigned int n = 250;
     for (unsigned int t = 0; t <= n; ++t)
       {
@@ -236,16 +237,16 @@ main(int argc, char **argv)
 
   // Inside cells against direct solves: approached by ticks along a line.
   {
-    const std::vector<Point3> at = {{{0.0013, 0.0007, -0.002}},
-                                    {{0.0025, -0.0012, -0.0035}},
-                                    {{-0.0018, 0.0011, -0.0042}},
-                                    {{-0.0031, -0.0024, -0.0027}},
-                                    {{0.0004, 0.0036, -0.0046}}};
-    double worst = 0;
+    const std::vector<Point3> at    = {{{0.0013, 0.0007, -0.002}},
+                                       {{0.0025, -0.0012, -0.0035}},
+                                       {{-0.0018, 0.0011, -0.0042}},
+                                       {{-0.0031, -0.0024, -0.0027}},
+                                       {{0.0004, 0.0036, -0.0046}}};
+    double                    worst = 0;
     for (const Point3 &x : at)
       {
         const palpate::State d = patches.direct.solve(patches.rest, x);
-        Point3 f;
+        Point3               f;
         for (unsigned int t = 0; t <= 200; ++t)
           patches.tick(between({{0, 0, 0}}, x, std::min(1.0, t / 150.0)), f);
         worst = std::max(worst,
@@ -268,8 +269,9 @@ main(int argc, char **argv)
     for (unsigned int t = 1; t <= n; ++t)
       {
         const double a  = 2 * M_PI * t / n;
-        const Point3 x1 = {{0.0025 * std::cos(a), 0.0007, -0.003 + 0.0025 * std::sin(a)}};
-        Point3       f1;
+        const Point3 x1 = {
+          {0.0025 * std::cos(a), 0.0007, -0.003 + 0.0025 * std::sin(a)}};
+        Point3 f1;
         patches.tick(x1, f1);
         for (unsigned int d = 0; d < 3; ++d)
           {

@@ -122,9 +122,9 @@ namespace palpate
     bool
     factorize_active(const ContactPatch &patch, Slot &s) noexcept;
 
-    unsigned int        max_nodes, max_active;
-    std::vector<Slot>   slots;
-    std::uint64_t       clock = 0;
+    unsigned int                       max_nodes, max_active;
+    std::vector<Slot>                  slots;
+    std::uint64_t                      clock = 0;
     std::vector<double>                q, w, rhs;
     std::vector<std::array<double, 3>> u;
     std::vector<unsigned int>          loaded;

@@ -251,8 +251,8 @@ namespace palpate
     Utilities::Point3                 focus = {{0, 0, 0}};
     // Patches let go of, with the read sessions ended when they were.
     std::vector<std::pair<const HeldPatch *, std::uint64_t>> retired;
-    mutable std::atomic<bool>                                reader_active{false};
-    mutable std::atomic<std::uint64_t>                       reader_sessions{0};
+    mutable std::atomic<bool>          reader_active{false};
+    mutable std::atomic<std::uint64_t> reader_sessions{0};
   };
 } // namespace palpate
 
