@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/haptics/patch_contact.h>
+#include <palpate/hyperelastic/contact_lcp.h>
 #include <palpate/hyperelastic/contact_patch.h>
 
 #include <algorithm>
@@ -15,54 +16,6 @@ namespace palpate
     // solution leaves (its tolerance is 1e-3 of its increment tolerance),
     // far above the round-off of metres.
     constexpr double gap_tolerance = 1e-12;
-
-    /** LU with partial pivoting of the m x m row-major A in place. */
-    bool
-    lu_factorize(double *A, const unsigned int m, unsigned int *pivot) noexcept
-    {
-      for (unsigned int k = 0; k < m; ++k)
-        {
-          unsigned int p = k;
-          for (unsigned int i = k + 1; i < m; ++i)
-            if (std::abs(A[i * m + k]) > std::abs(A[p * m + k]))
-              p = i;
-          pivot[k] = p;
-          if (!(A[p * m + k] != 0))
-            return false;
-          if (p != k)
-            for (unsigned int j = 0; j < m; ++j)
-              std::swap(A[k * m + j], A[p * m + j]);
-          const double d = A[k * m + k];
-          for (unsigned int i = k + 1; i < m; ++i)
-            {
-              const double l = A[i * m + k] /= d;
-              if (l != 0)
-                for (unsigned int j = k + 1; j < m; ++j)
-                  A[i * m + j] -= l * A[k * m + j];
-            }
-        }
-      return true;
-    }
-
-    /**
-     * y += f h over @p M entries: the nodes moved by one column of the
-     * compliance, the tick's largest loop (nine per node in contact and
-     * node of the patch). Compiled for AVX-512, AVX2 and plain x86-64,
-     * chosen when the library is loaded, so that any x86-64 runs it and a
-     * recent one at 4-8 doubles an instruction.
-     */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-    __attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
-    void
-    add_column(double           *y,
-               const float      *h,
-               const double      f,
-               const std::size_t M) noexcept
-    {
-      for (std::size_t r = 0; r < M; ++r)
-        y[r] += h[r] * f;
-    }
 
     /** Cholesky factor L (lower, in place) of the symmetric m x m A;
      * false if A is not positive definite. */
@@ -109,6 +62,26 @@ namespace palpate
         }
     }
 
+    /**
+     * y += f h over @p M entries: the nodes moved by one column of the
+     * compliance, the tick's largest loop (nine per node in contact and
+     * node of the patch). Compiled for AVX-512, AVX2 and plain x86-64,
+     * chosen when the library is loaded, so that any x86-64 runs it and a
+     * recent one at 4-8 doubles an instruction.
+     */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+    __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+    void
+    add_column(double           *y,
+               const float      *h,
+               const double      f,
+               const std::size_t M) noexcept
+    {
+      for (std::size_t r = 0; r < M; ++r)
+        y[r] += h[r] * f;
+    }
+
     /** y += f w over @p n entries: a row of W (symmetric: a column). */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
     __attribute__((target_clones("avx512f", "avx2", "default")))
@@ -123,24 +96,6 @@ namespace palpate
         y[i] += w[i] * f;
     }
 
-    void
-    lu_solve(const double       *LU,
-             const unsigned int  m,
-             const unsigned int *pivot,
-             double             *b) noexcept
-    {
-      for (unsigned int k = 0; k < m; ++k)
-        std::swap(b[k], b[pivot[k]]);
-      for (unsigned int i = 0; i < m; ++i)
-        for (unsigned int k = 0; k < i; ++k)
-          b[i] -= LU[i * m + k] * b[k];
-      for (int i = int(m) - 1; i >= 0; --i)
-        {
-          for (unsigned int k = i + 1; k < m; ++k)
-            b[i] -= LU[i * m + k] * b[k];
-          b[i] /= LU[i * m + i];
-        }
-    }
   } // namespace
 
 

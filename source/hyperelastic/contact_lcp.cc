@@ -10,11 +10,8 @@
 namespace palpate
 {
   bool
-  lu_factorize(std::vector<double>       &A,
-               const unsigned int         m,
-               std::vector<unsigned int> &pivot)
+  lu_factorize(double *A, const unsigned int m, unsigned int *pivot) noexcept
   {
-    pivot.resize(m);
     for (unsigned int k = 0; k < m; ++k)
       {
         unsigned int p = k;
@@ -42,10 +39,10 @@ namespace palpate
 
 
   void
-  lu_solve(const std::vector<double>       &LU,
-           const unsigned int               m,
-           const std::vector<unsigned int> &pivot,
-           double                          *b)
+  lu_solve(const double       *LU,
+           const unsigned int  m,
+           const unsigned int *pivot,
+           double             *b) noexcept
   {
     for (unsigned int k = 0; k < m; ++k)
       std::swap(b[k], b[pivot[k]]);
@@ -58,6 +55,28 @@ namespace palpate
           b[i] -= LU[i * m + k] * b[k];
         b[i] /= LU[i * m + i];
       }
+  }
+
+
+
+  bool
+  lu_factorize(std::vector<double>       &A,
+               const unsigned int         m,
+               std::vector<unsigned int> &pivot)
+  {
+    pivot.resize(m);
+    return lu_factorize(A.data(), m, pivot.data());
+  }
+
+
+
+  void
+  lu_solve(const std::vector<double>       &LU,
+           const unsigned int               m,
+           const std::vector<unsigned int> &pivot,
+           double                          *b)
+  {
+    lu_solve(LU.data(), m, pivot.data(), b);
   }
 
 

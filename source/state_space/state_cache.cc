@@ -177,11 +177,11 @@ namespace palpate
   StateCache::retire_patch(const unsigned int point)
   {
     // The caller holds the mutex. The reader that may still use the old
-    // patch is at most the session in progress now: it is freed once that
-    // session ended (or none is in progress).
+    // patch is at most the read section in progress now: it is freed once that
+    // section ended (or none is in progress).
     const HeldPatch *old = entries[point].patch.exchange(nullptr);
     if (old)
-      retired.emplace_back(old, reader_sessions.load());
+      retired.emplace_back(old, reader_sections.load());
   }
 
 
@@ -190,10 +190,10 @@ namespace palpate
   StateCache::reclaim_patches()
   {
     const bool          reading  = reader_active.load();
-    const std::uint64_t sessions = reader_sessions.load();
+    const std::uint64_t sections = reader_sections.load();
     auto                end =
       std::remove_if(retired.begin(), retired.end(), [&](const auto &r) {
-        if (reading && sessions <= r.second)
+        if (reading && sections <= r.second)
           return false;
         delete r.first;
         return true;
@@ -214,7 +214,7 @@ namespace palpate
   void
   StateCache::end_patch_reads() const noexcept
   {
-    reader_sessions.fetch_add(1);
+    reader_sections.fetch_add(1);
     reader_active.store(false);
   }
 

@@ -9,13 +9,25 @@
 namespace palpate
 {
   /** LU factorisation with partial pivoting of the m x m row-major @p A in
-   * place, the row exchanges in @p pivot; false if A is singular. */
+   * place, the row exchanges in @p pivot (m entries); false if A is
+   * singular. No allocation: the haptic loop uses it too. */
+  bool
+  lu_factorize(double *A, const unsigned int m, unsigned int *pivot) noexcept;
+
+  /** Solve A x = b in place of @p b with the factors of lu_factorize(). */
+  void
+  lu_solve(const double       *LU,
+           const unsigned int  m,
+           const unsigned int *pivot,
+           double             *b) noexcept;
+
+  /** lu_factorize() for vectors; @p pivot is resized to m. */
   bool
   lu_factorize(std::vector<double>       &A,
                const unsigned int         m,
                std::vector<unsigned int> &pivot);
 
-  /** Solve A x = b in place of @p b with the factors of lu_factorize(). */
+  /** lu_solve() for vectors. */
   void
   lu_solve(const std::vector<double>       &LU,
            const unsigned int               m,

@@ -169,7 +169,7 @@ namespace palpate
      * @p generation (else null), and the patch stays valid until
      * end_patch_reads() even if the point is republished or the cache
      * invalidated meanwhile: a patch the cache lets go of is freed by a
-     * later writer once no read session can hold it (read-copy-update).
+     * later writer once no read section can hold it (read-copy-update).
      * One reading thread at a time. Never block, never allocate.
      */
     void
@@ -208,11 +208,11 @@ namespace palpate
     struct HeldPatch;
 
     /** Let go of the patch of @p point (mutex held): freed by
-     * reclaim_patches() once no read session can hold it. */
+     * reclaim_patches() once no read section can hold it. */
     void
     retire_patch(const unsigned int point);
 
-    /** Free the patches let go of that no read session can hold (mutex
+    /** Free the patches let go of that no read section can hold (mutex
      * held). */
     void
     reclaim_patches();
@@ -249,10 +249,10 @@ namespace palpate
     std::size_t                       bytes = 0, budget;
     unsigned int                      held = 0, evicted = 0;
     Utilities::Point3                 focus = {{0, 0, 0}};
-    // Patches let go of, with the read sessions ended when they were.
+    // Patches let go of, with the read sections ended when they were.
     std::vector<std::pair<const HeldPatch *, std::uint64_t>> retired;
     mutable std::atomic<bool>          reader_active{false};
-    mutable std::atomic<std::uint64_t> reader_sessions{0};
+    mutable std::atomic<std::uint64_t> reader_sections{0};
   };
 } // namespace palpate
 
