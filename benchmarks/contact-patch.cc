@@ -47,7 +47,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -79,8 +78,6 @@ namespace
       "State space/Interpolation=" + interpolation,
       "Nonlinear solver/Contact solver=condensed",
       "Nonlinear solver/Assembly threads=1"};
-    if (const char *solver = std::getenv("CONTACT_PATCH_SOLVER"))
-      settings.push_back(std::string("Linear solver/Solver=") + solver);
     if (body == "blob")
       for (const std::string s :
            {"Mesh/Source=blob",

@@ -9,24 +9,6 @@
 
 namespace palpate
 {
-  Utilities::Point3
-  ContactPatch::state_force() const noexcept
-  {
-    Utilities::Point3 f = {{0, 0, 0}};
-    for (unsigned int i = 0; i < size(); ++i)
-      {
-        Utilities::Point3 u;
-        for (unsigned int a = 0; a < 3; ++a)
-          u[a] = position[3 * i + a] - center[a];
-        const double rho = Utilities::norm(u);
-        for (unsigned int a = 0; a < 3; ++a)
-          f[a] -= lambda[i] * u[a] / rho;
-      }
-    return f;
-  }
-
-
-
   std::uint64_t
   ContactPatch::new_id() noexcept
   {

@@ -86,10 +86,6 @@ namespace palpate
       return nodes.size();
     }
 
-    /** The state's force on the sphere, -sum lambda_i n_i (N). */
-    Utilities::Point3
-    state_force() const noexcept;
-
     /** Bytes held. */
     std::size_t
     memory() const noexcept;
