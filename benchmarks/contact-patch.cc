@@ -278,7 +278,7 @@ namespace
         });
         const State rest_h = solver.rest_state();
         std::map<unsigned int, std::shared_ptr<const State>> done;
-        std::vector<double> state_ms, patch_nodes, patch_ms;
+        std::vector<double> state_ms, patch_nodes, patch_ms, patch_kib;
         unsigned int        failures = 0;
         for (const unsigned int q : order)
           {
@@ -299,7 +299,10 @@ namespace
               }
             state_ms.push_back(1e3 * s->wall_time);
             if (s->contact_patch)
-              patch_nodes.push_back(s->contact_patch->size());
+              {
+                patch_nodes.push_back(s->contact_patch->size());
+                patch_kib.push_back(s->contact_patch->memory() / 1024.0);
+              }
             patch_ms.push_back(1e3 * s->contact_patch_time);
             cache.publish(q, s, cache.generation());
             done[q] = s;
@@ -309,7 +312,9 @@ namespace
                   << percentile(state_ms, 0.5) << " ms (patch "
                   << percentile(patch_ms, 0.5) << " ms), patch nodes median "
                   << percentile(patch_nodes, 0.5) << ", max "
-                  << percentile(patch_nodes, 1.0) << "\n";
+                  << percentile(patch_nodes, 1.0) << ", patch KiB median "
+                  << percentile(patch_kib, 0.5) << ", max "
+                  << percentile(patch_kib, 1.0) << "\n";
 
         PatchContact patch_contact(contact.size(), 256);
         // At a grid point the patch must give the state's force.

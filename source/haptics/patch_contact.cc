@@ -209,8 +209,7 @@ namespace palpate
                       Utilities::Point3       &force,
                       std::array<double, 9>   *stiffness) noexcept
   {
-    force      = {{0, 0, 0}};
-    iterations = 0;
+    force = {{0, 0, 0}};
     if (stiffness)
       stiffness->fill(0.0);
     const unsigned int n = patch.size();
@@ -260,7 +259,8 @@ namespace palpate
     // Primal-dual active set: the forces of the nodes in contact close
     // their gaps, the others carry none; nodes pulled leave, nodes inside
     // join.
-    bool settled = false;
+    bool         settled    = false;
+    unsigned int iterations = 0;
     while (!settled && iterations < max_iterations)
       {
         ++iterations;

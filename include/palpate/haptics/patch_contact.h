@@ -76,13 +76,6 @@ namespace palpate
           Utilities::Point3                         &force,
           std::array<double, 9> *stiffness = nullptr) noexcept;
 
-    /** Active-set iterations of the last force() call. */
-    unsigned int
-    last_iterations() const noexcept
-    {
-      return iterations;
-    }
-
     /** The most active-set iterations one call may take. */
     static constexpr unsigned int max_iterations = 12;
 
@@ -128,7 +121,6 @@ namespace palpate
     std::vector<double>                q, w, rhs;
     std::vector<std::array<double, 3>> u;
     std::vector<unsigned int>          loaded;
-    unsigned int                       iterations = 0;
   };
 } // namespace palpate
 
