@@ -7,10 +7,9 @@
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
-#include <palpate/state_space/state_store.h>
+#include <palpate/state_space/state_store_impl.h>
 
 #include <fcntl.h>
-#include <hdf5.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -27,51 +26,29 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <memory>
 #include <mutex>
-#include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace palpate
 {
+  using internal::acquire_lock;
+  using internal::check_store_file;
+  using internal::dataset_names;
+  using internal::file_access;
+  using internal::Hash;
+  using internal::hdf5_error;
+  using internal::hdf5_system_error;
+  using internal::Record;
+  using internal::store_error;
+  using internal::WriteFailure;
+
+
+
   namespace
   {
-    /** FNV-1a over bytes: the checksum of a record, and content hashes. */
-    class Hash
-    {
-    public:
-      void
-      add(const void *data, const std::size_t n)
-      {
-        const auto *b = static_cast<const unsigned char *>(data);
-        for (std::size_t i = 0; i < n; ++i)
-          h = (h ^ b[i]) * 1099511628211ull;
-      }
-
-      template <typename T>
-      void
-      add(const std::vector<T> &v)
-      {
-        add(v.data(), v.size() * sizeof(T));
-      }
-
-      std::uint64_t
-      value() const
-      {
-        return h;
-      }
-
-      std::string
-      hex() const
-      {
-        char s[17];
-        std::snprintf(s, sizeof(s), "%016llx", (unsigned long long)h);
-        return s;
-      }
-
-    private:
-      std::uint64_t h = 1469598103934665603ull;
-    };
-
     std::string
     exact(const double x)
     {
@@ -80,40 +57,6 @@ namespace palpate
       s << x;
       return s.str();
     }
-
-    /** One record's values, in the order the checksum covers them. */
-    struct Record
-    {
-      std::int32_t        point    = 0;
-      std::int32_t        status   = 0; // SolveStatus, as a number
-      double              force[3] = {0, 0, 0};
-      double              stiffness[9];
-      double              wall_time = 0;
-      std::vector<double> solution, multipliers;
-
-      std::uint64_t
-      checksum() const
-      {
-        Hash h;
-        h.add(&point, sizeof(point));
-        h.add(&status, sizeof(status));
-        h.add(force, sizeof(force));
-        h.add(stiffness, sizeof(stiffness));
-        h.add(&wall_time, sizeof(wall_time));
-        h.add(solution);
-        h.add(multipliers);
-        return h.value();
-      }
-    };
-
-    const char *const dataset_names[] = {"point",
-                                         "status",
-                                         "force",
-                                         "stiffness",
-                                         "wall_time",
-                                         "solution",
-                                         "multipliers",
-                                         "checksum"};
   } // namespace
 
 
@@ -207,9 +150,6 @@ namespace palpate
 
 
 
-  // ------------------------------------------------------------------
-  // The writer's lock.
-  //
   // Why a lock file of our own, with flock: HDF5 1.10 locks the file it
   // opens, but a SWMR writer drops that lock as soon as it has marked the
   // superblock "open for writing"; a second writer then finds the mark and
@@ -224,28 +164,18 @@ namespace palpate
   // it, which would release ours (flock is per open file, and a process may
   // have the store open twice). fcntl locks would not survive that either:
   // they go when the process closes any descriptor of the file.
-  // ------------------------------------------------------------------
 
-  struct StoreLock::Held
+  StoreLock::Held::~Held()
   {
-    std::string        store, lock_file;
-    int                fd  = -1;
-    pid_t              pid = 0;
-    mutable std::mutex mutex;
-    std::string        failure;
-
-    ~Held()
-    {
-      // Removed while still locked, so that nobody takes a lock on a file
-      // about to vanish unseen (acquire() checks that the file it locked is
-      // still the one at the path). A process forked from the holder shares
-      // its lock but leaves the file alone.
-      if (pid == getpid())
-        unlink(lock_file.c_str());
-      if (fd >= 0)
-        close(fd);
-    }
-  };
+    // Removed while still locked, so that nobody takes a lock on a file
+    // about to vanish unseen (acquire() checks that the file it locked is
+    // still the one at the path). A process forked from the holder shares
+    // its lock but leaves the file alone.
+    if (pid == getpid())
+      unlink(lock_file.c_str());
+    if (fd >= 0)
+      close(fd);
+  }
 
 
 
@@ -307,26 +237,12 @@ namespace palpate
       return "";
     }
 
-    /** "mode -r--r--r--, owner uid 0" of @p st. */
-    std::string
-    describe_mode(const struct stat &st)
-    {
-      std::string m = "-rwxrwxrwx";
-      for (unsigned int i = 0; i < 9; ++i)
-        if ((st.st_mode & (0400 >> i)) == 0)
-          m[1 + i] = '-';
-      return "mode " + m + ", owner uid " + std::to_string(st.st_uid) +
-             ", this process uid " + std::to_string(geteuid());
-    }
+  } // namespace
 
-    [[noreturn]] void
-    store_error(const std::string &store,
-                const std::string &problem,
-                const std::string &fix)
-    {
-      throw InputError(store, 0, "State space / Store", problem, fix);
-    }
 
+
+  namespace internal
+  {
     std::shared_ptr<StoreLock::Held>
     acquire_lock(const std::string &store)
     {
@@ -462,83 +378,67 @@ namespace palpate
                   "check what else makes and removes files there, then run "
                   "again.");
     }
-  } // namespace
+  } // namespace internal
+
+
+
+  StoreLock::StoreLock(const std::string &store)
+  {
+    // What is wrong with the store itself is said before any lock: a
+    // directory, no permission, not a store.
+    check_store_file(store, true);
+    held = acquire_lock(store);
+  }
+
+
+
+  StoreLock::~StoreLock() = default;
+
+
+
+  const std::string &
+  StoreLock::lock_file() const
+  {
+    return held->lock_file;
+  }
+
+
+
+  std::string
+  StoreLock::failure() const
+  {
+    std::lock_guard<std::mutex> lock(held->mutex);
+    return held->failure;
+  }
+
+
+
+  namespace internal
+  {
+    [[noreturn]] void
+    store_error(const std::string &store,
+                const std::string &problem,
+                const std::string &fix)
+    {
+      throw InputError(store, 0, "State space / Store", problem, fix);
+    }
+  } // namespace internal
 
 
 
   namespace
   {
-    /**
-     * The file access properties of every store file: the latest format
-     * (SWMR needs it), and HDF5's own file locking off. That lock cannot
-     * serve: a SWMR writer drops it once the file is open, while a reader
-     * holds its shared lock for as long as it has the file open, so that a
-     * writer opening the store while a reader reads it failed with "Resource
-     * temporarily unavailable". One writer per store is the StoreLock's
-     * job; readers need no lock (SWMR).
-     */
-    hid_t
-    file_access()
-    {
-      const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-      H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
-      H5Pset_file_locking(fapl, false, true);
-      return fapl;
-    }
-
-    /** The system's error message if HDF5 failed in a system call (the
-     * sec2 driver's "error message = '...'"), else "". */
+    /** "mode -r--r--r--, owner uid 0" of @p st. */
     std::string
-    hdf5_system_error()
+    describe_mode(const struct stat &st)
     {
-      std::string found;
-      H5Ewalk2(
-        H5E_DEFAULT,
-        H5E_WALK_UPWARD,
-        [](unsigned int, const H5E_error2_t *e, void *data) -> herr_t {
-          auto &f = *static_cast<std::string *>(data);
-          if (e->desc != nullptr && f.empty())
-            {
-              const std::string m  = e->desc;
-              const auto        at = m.find("error message = '");
-              if (at != std::string::npos)
-                f = m.substr(at + 17, m.find('\'', at + 17) - at - 17);
-            }
-          return 0;
-        },
-        &found);
-      return found;
+      std::string m = "-rwxrwxrwx";
+      for (unsigned int i = 0; i < 9; ++i)
+        if ((st.st_mode & (0400 >> i)) == 0)
+          m[1 + i] = '-';
+      return "mode " + m + ", owner uid " + std::to_string(st.st_uid) +
+             ", this process uid " + std::to_string(geteuid());
     }
-
-    /**
-     * What HDF5 said last, from its error stack: the system's error message
-     * if a system call failed (for a failed write, "No space left on
-     * device"), else the message at the stack's bottom, where the cause is;
-     * "" if the stack is empty.
-     */
-    std::string
-    hdf5_error()
-    {
-      if (std::string system = hdf5_system_error(); !system.empty())
-        return system;
-      std::vector<std::string> messages;
-      H5Ewalk2(
-        H5E_DEFAULT,
-        H5E_WALK_UPWARD,
-        [](unsigned int, const H5E_error2_t *e, void *data) -> herr_t {
-          if (e->desc != nullptr)
-            static_cast<std::vector<std::string> *>(data)->push_back(e->desc);
-          return 0;
-        },
-        &messages);
-      return messages.empty() ? std::string() : messages.front();
-    }
-
-    /** A write to the store failed: why. */
-    struct WriteFailure
-    {
-      std::string reason;
-    };
 
     /**
      * Refuse, for @p writing, a file name too long for the files a writer
@@ -769,13 +669,12 @@ namespace palpate
                       "another one.");
         }
     }
+  } // namespace
 
-    /**
-     * Before HDF5 sees @p file: what keeps it from being a store this
-     * process can open for @p writing (or reading), said as such, so that
-     * a file that is fine but not writable is never called damaged.
-     * Returns whether the file exists (a new one is created).
-     */
+
+
+  namespace internal
+  {
     bool
     check_store_file(const std::string &file, const bool writing)
     {
@@ -799,594 +698,476 @@ namespace palpate
       check_hdf5_signature(file, open_as_hdf5_will(file, writing));
       return true;
     }
-  } // namespace
+  } // namespace internal
 
 
 
-  StoreLock::StoreLock(const std::string &store)
+  namespace internal
   {
-    // What is wrong with the store itself is said before any lock: a
-    // directory, no permission, not a store.
-    check_store_file(store, true);
-    held = acquire_lock(store);
+    hid_t
+    file_access()
+    {
+      const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+      H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+      H5Pset_file_locking(fapl, false, true);
+      return fapl;
+    }
+
+    std::string
+    hdf5_system_error()
+    {
+      std::string found;
+      H5Ewalk2(
+        H5E_DEFAULT,
+        H5E_WALK_UPWARD,
+        [](unsigned int, const H5E_error2_t *e, void *data) -> herr_t {
+          auto &f = *static_cast<std::string *>(data);
+          if (e->desc != nullptr && f.empty())
+            {
+              const std::string m  = e->desc;
+              const auto        at = m.find("error message = '");
+              if (at != std::string::npos)
+                f = m.substr(at + 17, m.find('\'', at + 17) - at - 17);
+            }
+          return 0;
+        },
+        &found);
+      return found;
+    }
+
+    std::string
+    hdf5_error()
+    {
+      if (std::string system = hdf5_system_error(); !system.empty())
+        return system;
+      std::vector<std::string> messages;
+      H5Ewalk2(
+        H5E_DEFAULT,
+        H5E_WALK_UPWARD,
+        [](unsigned int, const H5E_error2_t *e, void *data) -> herr_t {
+          if (e->desc != nullptr)
+            static_cast<std::vector<std::string> *>(data)->push_back(e->desc);
+          return 0;
+        },
+        &messages);
+      return messages.empty() ? std::string() : messages.front();
+    }
+  } // namespace internal
+
+
+
+  void
+  StateStore::Impl::close_file()
+  {
+    for (unsigned int d = 0; d < 8; ++d)
+      if (datasets[d] >= 0)
+        {
+          H5Dclose(datasets[d]);
+          datasets[d] = -1;
+        }
+    if (h5 >= 0)
+      H5Fclose(h5);
+    h5 = -1;
+    if (reserve_fd >= 0)
+      close(reserve_fd);
+    reserve_fd = -1;
   }
 
 
 
-  StoreLock::~StoreLock() = default;
-
-
-
-  const std::string &
-  StoreLock::lock_file() const
+  void
+  StateStore::Impl::create(const StoreFingerprint &fingerprint,
+                           const hsize_t           n_sol,
+                           const hsize_t           n_mult)
   {
-    return held->lock_file;
+    n_solution       = n_sol;
+    n_multipliers    = n_mult;
+    const hid_t fapl = file_access();
+    // Written to a temporary name and renamed when complete: a store
+    // that exists has its fingerprint and datasets.
+    const std::string tmp = file + ".creating";
+    h5 = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (h5 < 0)
+      {
+        const int         e      = errno;
+        const std::string reason = hdf5_error();
+        throw WriteFailure{std::strerror(e) +
+                           (reason.empty() ? "" : "; HDF5: " + reason)};
+      }
+    bool ok = true;
+    // The fingerprint: one string attribute per field, on the root.
+    const hid_t space = H5Screate(H5S_SCALAR);
+    for (const auto &[field, value] : fingerprint.fields)
+      {
+        const hid_t str = H5Tcopy(H5T_C_S1);
+        H5Tset_size(str, value.size() + 1);
+        const hid_t a =
+          H5Acreate2(h5, field.c_str(), str, space, H5P_DEFAULT, H5P_DEFAULT);
+        ok = ok && a >= 0 && H5Awrite(a, str, value.c_str()) >= 0;
+        if (a >= 0)
+          H5Aclose(a);
+        H5Tclose(str);
+      }
+    H5Sclose(space);
+    for (unsigned int d = 0; d < 8; ++d)
+      {
+        const hsize_t dims[2]  = {0, columns(d)};
+        const hsize_t max[2]   = {H5S_UNLIMITED, columns(d)};
+        const hsize_t chunk[2] = {d == 5 || d == 6 ? 1u : 64u,
+                                  std::max<hsize_t>(columns(d), 1)};
+        const hid_t s    = H5Screate_simple(2, dims, max);
+        const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+        H5Pset_chunk(dcpl, 2, chunk);
+        datasets[d] = H5Dcreate2(
+          h5, dataset_names[d], type(d), s, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+        ok = ok && datasets[d] >= 0;
+        H5Pclose(dcpl);
+        H5Sclose(s);
+      }
+    for (unsigned int d = 0; d < 8; ++d)
+      if (datasets[d] >= 0)
+        H5Dclose(datasets[d]);
+    std::fill(std::begin(datasets), std::end(datasets), hid_t(-1));
+    // Closing writes it: on a full disk, this is where it fails.
+    ok = H5Fclose(h5) >= 0 && ok;
+    h5 = -1;
+    std::error_code error;
+    if (ok)
+      std::filesystem::rename(tmp, file, error);
+    if (!ok || error)
+      {
+        const int         e      = errno;
+        const std::string reason = error ? error.message() : hdf5_error();
+        std::filesystem::remove(tmp, error);
+        throw WriteFailure{reason.empty() ? std::strerror(e) : reason};
+      }
+    open();
+    first_row = 0;
+  }
+
+
+
+  int
+  StateStore::Impl::store_datasets(const hid_t f)
+  {
+    int found = 0;
+    for (unsigned int d = 0; d < 8; ++d)
+      {
+        const htri_t e = H5Lexists(f, dataset_names[d], H5P_DEFAULT);
+        if (e < 0)
+          return -1;
+        found += e > 0;
+      }
+    return found;
+  }
+
+
+
+  void
+  StateStore::Impl::not_a_store() const
+  {
+    fail("this is an HDF5 file, but not a palpate state store: it has "
+         "none of a store's datasets (point, status, force, ...)",
+         "name another store file (State space / Store); this one "
+         "belongs to something else.");
+  }
+
+
+
+  void
+  StateStore::Impl::open()
+  {
+    const bool  writing = access == Access::write;
+    const hid_t fapl    = file_access();
+    // A damaged file is damaged on every read: a writer does not retry
+    // (SWMR retries metadata reads 100 times with growing pauses,
+    // minutes). A reader may catch a piece of metadata while the writer
+    // rewrites it, and has its checksum fail: it tries again, a few times.
+    H5Pset_metadata_read_attempts(fapl, writing ? 1 : 12);
+    const unsigned int flags = writing ? H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE :
+                                         H5F_ACC_RDONLY | H5F_ACC_SWMR_READ;
+    h5                       = H5Fopen(file.c_str(), flags, fapl);
+    std::string why          = h5 < 0 ? hdf5_error() : "";
+    std::string system       = h5 < 0 ? hdf5_system_error() : "";
+    if (h5 < 0 && writing && lock)
+      {
+        // A writer that was killed leaves the superblock marked "open for
+        // writing", and HDF5 refuses to open it again. We hold the
+        // writer's lock, so no live writer has it open: the mark is a dead
+        // one's. The file itself is consistent (SWMR flushes in order):
+        // clear the mark, as HDF5's h5clear tool does, and open it again.
+        hbool_t     clear = true;
+        const hid_t fix   = H5Pcopy(fapl);
+        if (H5Pset(fix, "clear_status_flags", &clear) >= 0)
+          {
+            const hid_t cleared = H5Fopen(file.c_str(), H5F_ACC_RDWR, fix);
+            if (cleared >= 0)
+              {
+                // The killed writer's last chunks may lie beyond the end
+                // of allocation its superblock last recorded: HDF5 would
+                // then allocate new space over them, and its writes fail
+                // ("addr overflow"). Move the end of allocation to the
+                // file's end, as `h5clear --increment` does.
+                H5Fincrement_filesize(cleared, 0);
+                H5Fclose(cleared);
+                recovered = true;
+                h5        = H5Fopen(file.c_str(), flags, fapl);
+              }
+          }
+        H5Pclose(fix);
+      }
+    H5Pclose(fapl);
+    // A system call that failed (HDF5 found the file checked above and
+    // could not read it) is not damage.
+    if (h5 < 0 && !system.empty())
+      fail("HDF5 cannot open the store: " + system +
+             ". The file itself may be fine",
+           "check what else has it open and its permissions, then run "
+           "again; do not delete it for this.");
+    if (h5 < 0)
+      {
+        // HDF5 opens for SWMR only files of the latest format: a file of
+        // another program (older format) fails here, but is not damaged.
+        // Opened plainly, it shows what it is.
+        const hid_t plain = H5Pcreate(H5P_FILE_ACCESS);
+        H5Pset_file_locking(plain, false, true);
+        const hid_t probe = H5Fopen(file.c_str(), H5F_ACC_RDONLY, plain);
+        H5Pclose(plain);
+        if (probe >= 0)
+          {
+            const int found = store_datasets(probe);
+            H5Fclose(probe);
+            if (found == 0)
+              not_a_store();
+          }
+      }
+    if (h5 < 0)
+      fail("the store is damaged: it is an HDF5 file, but HDF5 cannot "
+           "read its structure (" +
+             (why.empty() ? std::string("no detail") : why) +
+             "); it was truncated or overwritten",
+           "move it away or delete it: palpate then starts a new store "
+           "(the states in it are lost).");
+    if (store_datasets(h5) == 0)
+      not_a_store();
+    for (unsigned int d = 0; d < 8; ++d)
+      {
+        datasets[d] = H5Dopen2(h5, dataset_names[d], H5P_DEFAULT);
+        if (datasets[d] < 0)
+          fail(std::string("the store is damaged: its dataset '") +
+                 dataset_names[d] + "' is missing or unreadable",
+               "move it away or delete it: palpate then starts a new "
+               "store (the states in it are lost).");
+      }
+    hsize_t     dims[2];
+    const hid_t s = H5Dget_space(datasets[5]);
+    H5Sget_simple_extent_dims(s, dims, nullptr);
+    H5Sclose(s);
+    n_solution    = dims[1];
+    const hid_t m = H5Dget_space(datasets[6]);
+    H5Sget_simple_extent_dims(m, dims, nullptr);
+    H5Sclose(m);
+    n_multipliers = dims[1];
+    // The rows: the fewest any dataset has (a record cut short by a
+    // crash, or being written, has some datasets extended, not all).
+    rows = std::numeric_limits<hsize_t>::max();
+    for (unsigned int d = 0; d < 8; ++d)
+      {
+        const hid_t sp = H5Dget_space(datasets[d]);
+        H5Sget_simple_extent_dims(sp, dims, nullptr);
+        H5Sclose(sp);
+        rows = std::min(rows, dims[0]);
+      }
+    first_row = rows;
   }
 
 
 
   std::string
-  StoreLock::failure() const
+  StateStore::Impl::attribute(const std::string &name) const
   {
-    std::lock_guard<std::mutex> lock(held->mutex);
-    return held->failure;
+    const htri_t exists = H5Aexists(h5, name.c_str());
+    if (exists < 0)
+      fail("the store is damaged: HDF5 cannot read its fingerprint (" +
+             hdf5_error() + ")",
+           "move it away or delete it: palpate then starts a new store "
+           "(the states in it are lost).");
+    if (exists == 0)
+      return "(not recorded)";
+    const hid_t a    = H5Aopen(h5, name.c_str(), H5P_DEFAULT);
+    const hid_t t    = H5Aget_type(a);
+    const auto  size = H5Tget_size(t);
+    std::string value(size, '\0');
+    const hid_t str = H5Tcopy(H5T_C_S1);
+    H5Tset_size(str, size);
+    H5Aread(a, str, value.data());
+    H5Tclose(str);
+    H5Tclose(t);
+    H5Aclose(a);
+    return value.c_str();
   }
 
 
 
-  struct StateStore::Impl
+  void
+  StateStore::Impl::read_row(const hsize_t      row,
+                             const unsigned int d,
+                             void              *data) const
   {
-    std::string            file;
-    Access                 access = Access::write;
-    hid_t                  h5     = -1;
-    hid_t                  datasets[8];
-    hsize_t                n_solution = 0, n_multipliers = 0;
-    hsize_t                rows = 0;
-    std::set<unsigned int> stored; // points with an intact record
-    // Whether the file was left open by a writer that did not finish.
-    bool recovered = false;
-    // Failure points that came before the first converged state, which
-    // fixes the record sizes.
-    std::vector<std::pair<unsigned int, State>> pending;
-    // The writer's lock (Access::write).
-    std::shared_ptr<StoreLock::Held> lock;
-    // The first row this object appended; a failed write stops appending,
-    // and `kept` is then what the file was read back to hold of ours.
-    hsize_t      first_row = 0;
-    bool         stopped   = false;
-    unsigned int kept      = 0;
-    // The descriptor reserve() takes room through.
-    int reserve_fd = -1;
-
-    Impl()
-    {
-      std::fill(std::begin(datasets), std::end(datasets), hid_t(-1));
-    }
-
-    // Also when the constructor throws (a refused store): no HDF5 handle
-    // stays open.
-    ~Impl()
-    {
-      close_file();
-    }
-
-    [[noreturn]] void
-    fail(const std::string &problem, const std::string &fix) const
-    {
-      store_error(file, problem, fix);
-    }
-
-    /** The columns of dataset @p d (1 for scalars). */
-    hsize_t
-    columns(const unsigned int d) const
-    {
-      switch (d)
-        {
-          case 2:
-            return 3;
-          case 3:
-            return 9;
-          case 5:
-            return n_solution;
-          case 6:
-            return n_multipliers;
-          default:
-            return 1;
-        }
-    }
-
-    hid_t
-    type(const unsigned int d) const
-    {
-      return d <= 1 ? H5T_NATIVE_INT32 :
-             d == 7 ? H5T_NATIVE_UINT64 :
-                      H5T_NATIVE_DOUBLE;
-    }
-
-    /** Close the file (errors ignored: after a failed write HDF5 may not
-     * manage to flush what it still holds; what lands is read back). */
-    void
-    close_file()
-    {
-      for (unsigned int d = 0; d < 8; ++d)
-        if (datasets[d] >= 0)
-          {
-            H5Dclose(datasets[d]);
-            datasets[d] = -1;
-          }
-      if (h5 >= 0)
-        H5Fclose(h5);
-      h5 = -1;
-      if (reserve_fd >= 0)
-        close(reserve_fd);
-      reserve_fd = -1;
-    }
-
-    /**
-     * Make the store with @p fingerprint and record sizes @p n_sol and
-     * @p n_mult. Throws WriteFailure if the file system refuses.
-     */
-    void
-    create(const StoreFingerprint &fingerprint,
-           const hsize_t           n_sol,
-           const hsize_t           n_mult)
-    {
-      n_solution       = n_sol;
-      n_multipliers    = n_mult;
-      const hid_t fapl = file_access();
-      // Written to a temporary name and renamed when complete: a store
-      // that exists has its fingerprint and datasets.
-      const std::string tmp = file + ".creating";
-      h5 = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-      H5Pclose(fapl);
-      if (h5 < 0)
-        {
-          const int         e      = errno;
-          const std::string reason = hdf5_error();
-          throw WriteFailure{std::strerror(e) +
-                             (reason.empty() ? "" : "; HDF5: " + reason)};
-        }
-      bool ok = true;
-      // The fingerprint: one string attribute per field, on the root.
-      const hid_t space = H5Screate(H5S_SCALAR);
-      for (const auto &[field, value] : fingerprint.fields)
-        {
-          const hid_t str = H5Tcopy(H5T_C_S1);
-          H5Tset_size(str, value.size() + 1);
-          const hid_t a =
-            H5Acreate2(h5, field.c_str(), str, space, H5P_DEFAULT, H5P_DEFAULT);
-          ok = ok && a >= 0 && H5Awrite(a, str, value.c_str()) >= 0;
-          if (a >= 0)
-            H5Aclose(a);
-          H5Tclose(str);
-        }
-      H5Sclose(space);
-      for (unsigned int d = 0; d < 8; ++d)
-        {
-          const hsize_t dims[2]  = {0, columns(d)};
-          const hsize_t max[2]   = {H5S_UNLIMITED, columns(d)};
-          const hsize_t chunk[2] = {d == 5 || d == 6 ? 1u : 64u,
-                                    std::max<hsize_t>(columns(d), 1)};
-          const hid_t s    = H5Screate_simple(2, dims, max);
-          const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-          H5Pset_chunk(dcpl, 2, chunk);
-          datasets[d] = H5Dcreate2(
-            h5, dataset_names[d], type(d), s, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-          ok = ok && datasets[d] >= 0;
-          H5Pclose(dcpl);
-          H5Sclose(s);
-        }
-      for (unsigned int d = 0; d < 8; ++d)
-        if (datasets[d] >= 0)
-          H5Dclose(datasets[d]);
-      std::fill(std::begin(datasets), std::end(datasets), hid_t(-1));
-      // Closing writes it: on a full disk, this is where it fails.
-      ok = H5Fclose(h5) >= 0 && ok;
-      h5 = -1;
-      std::error_code error;
-      if (ok)
-        std::filesystem::rename(tmp, file, error);
-      if (!ok || error)
-        {
-          const int         e      = errno;
-          const std::string reason = error ? error.message() : hdf5_error();
-          std::filesystem::remove(tmp, error);
-          throw WriteFailure{reason.empty() ? std::strerror(e) : reason};
-        }
-      open();
-      first_row = 0;
-    }
-
-    /** How many of a store's datasets the file @p f has; -1 if HDF5
-     * cannot even look (its root group is damaged). */
-    static int
-    store_datasets(const hid_t f)
-    {
-      int found = 0;
-      for (unsigned int d = 0; d < 8; ++d)
-        {
-          const htri_t e = H5Lexists(f, dataset_names[d], H5P_DEFAULT);
-          if (e < 0)
-            return -1;
-          found += e > 0;
-        }
-      return found;
-    }
-
-    [[noreturn]] void
-    not_a_store() const
-    {
-      fail("this is an HDF5 file, but not a palpate state store: it has "
-           "none of a store's datasets (point, status, force, ...)",
-           "name another store file (State space / Store); this one "
-           "belongs to something else.");
-    }
-
-    /** Open the existing store as access says; InputError if HDF5 cannot
-     * (the file was checked before: then it is damaged). */
-    void
-    open()
-    {
-      const bool  writing = access == Access::write;
-      const hid_t fapl    = file_access();
-      // A damaged file is damaged on every read: a writer does not retry
-      // (SWMR retries metadata reads 100 times with growing pauses,
-      // minutes). A reader may catch a piece of metadata while the writer
-      // rewrites it, and has its checksum fail: it tries again, a few times.
-      H5Pset_metadata_read_attempts(fapl, writing ? 1 : 12);
-      const unsigned int flags = writing ? H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE :
-                                           H5F_ACC_RDONLY | H5F_ACC_SWMR_READ;
-      h5                       = H5Fopen(file.c_str(), flags, fapl);
-      std::string why          = h5 < 0 ? hdf5_error() : "";
-      std::string system       = h5 < 0 ? hdf5_system_error() : "";
-      if (h5 < 0 && writing && lock)
-        {
-          // A writer that was killed leaves the superblock marked "open for
-          // writing", and HDF5 refuses to open it again. We hold the
-          // writer's lock, so no live writer has it open: the mark is a dead
-          // one's. The file itself is consistent (SWMR flushes in order):
-          // clear the mark, as HDF5's h5clear tool does, and open it again.
-          hbool_t     clear = true;
-          const hid_t fix   = H5Pcopy(fapl);
-          if (H5Pset(fix, "clear_status_flags", &clear) >= 0)
-            {
-              const hid_t cleared = H5Fopen(file.c_str(), H5F_ACC_RDWR, fix);
-              if (cleared >= 0)
-                {
-                  // The killed writer's last chunks may lie beyond the end
-                  // of allocation its superblock last recorded: HDF5 would
-                  // then allocate new space over them, and its writes fail
-                  // ("addr overflow"). Move the end of allocation to the
-                  // file's end, as `h5clear --increment` does.
-                  H5Fincrement_filesize(cleared, 0);
-                  H5Fclose(cleared);
-                  recovered = true;
-                  h5        = H5Fopen(file.c_str(), flags, fapl);
-                }
-            }
-          H5Pclose(fix);
-        }
-      H5Pclose(fapl);
-      // A system call that failed (HDF5 found the file checked above and
-      // could not read it) is not damage.
-      if (h5 < 0 && !system.empty())
-        fail("HDF5 cannot open the store: " + system +
-               ". The file itself may be fine",
-             "check what else has it open and its permissions, then run "
-             "again; do not delete it for this.");
-      if (h5 < 0)
-        {
-          // HDF5 opens for SWMR only files of the latest format: a file of
-          // another program (older format) fails here, but is not damaged.
-          // Opened plainly, it shows what it is.
-          const hid_t plain = H5Pcreate(H5P_FILE_ACCESS);
-          H5Pset_file_locking(plain, false, true);
-          const hid_t probe = H5Fopen(file.c_str(), H5F_ACC_RDONLY, plain);
-          H5Pclose(plain);
-          if (probe >= 0)
-            {
-              const int found = store_datasets(probe);
-              H5Fclose(probe);
-              if (found == 0)
-                not_a_store();
-            }
-        }
-      if (h5 < 0)
-        fail("the store is damaged: it is an HDF5 file, but HDF5 cannot "
-             "read its structure (" +
-               (why.empty() ? std::string("no detail") : why) +
-               "); it was truncated or overwritten",
-             "move it away or delete it: palpate then starts a new store "
-             "(the states in it are lost).");
-      if (store_datasets(h5) == 0)
-        not_a_store();
-      for (unsigned int d = 0; d < 8; ++d)
-        {
-          datasets[d] = H5Dopen2(h5, dataset_names[d], H5P_DEFAULT);
-          if (datasets[d] < 0)
-            fail(std::string("the store is damaged: its dataset '") +
-                   dataset_names[d] + "' is missing or unreadable",
-                 "move it away or delete it: palpate then starts a new "
-                 "store (the states in it are lost).");
-        }
-      hsize_t     dims[2];
-      const hid_t s = H5Dget_space(datasets[5]);
-      H5Sget_simple_extent_dims(s, dims, nullptr);
-      H5Sclose(s);
-      n_solution    = dims[1];
-      const hid_t m = H5Dget_space(datasets[6]);
-      H5Sget_simple_extent_dims(m, dims, nullptr);
-      H5Sclose(m);
-      n_multipliers = dims[1];
-      // The rows: the fewest any dataset has (a record cut short by a
-      // crash, or being written, has some datasets extended, not all).
-      rows = std::numeric_limits<hsize_t>::max();
-      for (unsigned int d = 0; d < 8; ++d)
-        {
-          const hid_t sp = H5Dget_space(datasets[d]);
-          H5Sget_simple_extent_dims(sp, dims, nullptr);
-          H5Sclose(sp);
-          rows = std::min(rows, dims[0]);
-        }
-      first_row = rows;
-    }
-
-    std::string
-    attribute(const std::string &name) const
-    {
-      const htri_t exists = H5Aexists(h5, name.c_str());
-      if (exists < 0)
-        fail("the store is damaged: HDF5 cannot read its fingerprint (" +
-               hdf5_error() + ")",
-             "move it away or delete it: palpate then starts a new store "
-             "(the states in it are lost).");
-      if (exists == 0)
-        return "(not recorded)";
-      const hid_t a    = H5Aopen(h5, name.c_str(), H5P_DEFAULT);
-      const hid_t t    = H5Aget_type(a);
-      const auto  size = H5Tget_size(t);
-      std::string value(size, '\0');
-      const hid_t str = H5Tcopy(H5T_C_S1);
-      H5Tset_size(str, size);
-      H5Aread(a, str, value.data());
-      H5Tclose(str);
-      H5Tclose(t);
-      H5Aclose(a);
-      return value.c_str();
-    }
-
-    void
-    read_row(const hsize_t row, const unsigned int d, void *data) const
-    {
-      const hsize_t start[2] = {row, 0}, count[2] = {1, columns(d)};
-      if (count[1] == 0)
-        return;
-      const hid_t file_space = H5Dget_space(datasets[d]);
-      H5Sselect_hyperslab(
-        file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
-      const hid_t memory = H5Screate_simple(2, count, nullptr);
-      H5Dread(datasets[d], type(d), memory, file_space, H5P_DEFAULT, data);
-      H5Sclose(memory);
-      H5Sclose(file_space);
-    }
-
-    /** Write row @p row of dataset @p d and flush it; false if HDF5 (the
-     * file system) refused. */
-    bool
-    write_row(const hsize_t row, const unsigned int d, const void *data)
-    {
-      const hsize_t extent[2] = {row + 1, columns(d)};
-      if (H5Dset_extent(datasets[d], extent) < 0)
-        return false;
-      if (columns(d) > 0)
-        {
-          const hsize_t start[2] = {row, 0}, count[2] = {1, columns(d)};
-          const hid_t   file_space = H5Dget_space(datasets[d]);
-          H5Sselect_hyperslab(
-            file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
-          const hid_t  memory  = H5Screate_simple(2, count, nullptr);
-          const herr_t written = H5Dwrite(
-            datasets[d], type(d), memory, file_space, H5P_DEFAULT, data);
-          H5Sclose(memory);
-          H5Sclose(file_space);
-          if (written < 0)
-            return false;
-        }
-      // The chunk cache holds the row until it is flushed: only the flush
-      // meets a full disk, so its result is what says the row is written.
-      return H5Dflush(datasets[d]) >= 0;
-    }
-
-    /**
-     * Make sure the file's blocks reach past HDF5's end of allocation by
-     * four records and 128 KiB: what one more record allocates (its rows,
-     * and the chunk index and metadata they add: pages of at most 1024
-     * addresses, 8 KiB, for each of the 8 datasets) with a margin. Returns ""
-     * on success, else why not. The blocks beyond the end of allocation stay as
-     * zeros at the end of the file (HDF5 allows a file longer than it uses) and
-     * are used by the next records.
-     */
-    std::string
-    reserve()
-    {
-      haddr_t eoa = 0;
-      if (H5Fget_eoa(h5, &eoa) < 0)
-        return "";
-      const off_t record =
-        (13 + n_solution + n_multipliers) * sizeof(double) + 16;
-      const off_t target = eoa + 4 * record + 128 * 1024;
-      // A descriptor of our own, kept while the file is open (close_file()
-      // closes it: create() renames a new file into place).
-      if (reserve_fd < 0)
-        reserve_fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC);
-      if (reserve_fd < 0)
-        return std::strerror(errno);
-      // The size each time: HDF5 may have cut the file back to its end of
-      // allocation when it flushed.
-      struct stat st
-      {};
-      int error = fstat(reserve_fd, &st) == 0 ? 0 : errno;
-      // posix_fallocate returns the error; glibc writes zeros where the
-      // file system cannot allocate.
-      if (error == 0 &&
-          static_cast<std::uint64_t>(st.st_size) < eoa + 2 * record + 64 * 1024)
-        error = posix_fallocate(reserve_fd, 0, target);
-      return error == 0 ? "" : std::strerror(error);
-    }
-
-    /** The result of reading one record. */
-    enum class Read
-    {
-      intact,
-      damaged,
-      incomplete
-    };
-
-    Read
-    read_record(const hsize_t row, Record &r) const
-    {
-      r.solution.resize(n_solution);
-      r.multipliers.resize(n_multipliers);
-      std::uint64_t checksum = 0;
-      read_row(row, 0, &r.point);
-      read_row(row, 1, &r.status);
-      read_row(row, 2, r.force);
-      read_row(row, 3, r.stiffness);
-      read_row(row, 4, &r.wall_time);
-      read_row(row, 5, r.solution.data());
-      read_row(row, 6, r.multipliers.data());
-      read_row(row, 7, &checksum);
-      // The checksum is written last: none (HDF5's fill value, 0) means
-      // the writer never got there, it was killed or is writing it now.
-      if (checksum == 0)
-        return Read::incomplete;
-      return checksum == r.checksum() && r.point >= 0 ? Read::intact :
-                                                        Read::damaged;
-    }
-
-    /**
-     * A write failed: stop appending. Close the file, open it again for
-     * reading, and count what it keeps of this object's records; record
-     * the failure with the lock and throw OutputError saying all that.
-     */
-    [[noreturn]] void
-    stop(std::string reason)
-    {
-      if (reason.empty())
-        reason = "the file system refused a write";
-      stopped = true;
-      close_file();
-      pending.clear();
-      unsigned int states = 0, failures = 0, damaged = 0, incomplete = 0;
-      kept = 0;
-      std::string unreadable;
-      access = Access::read;
-      try
-        {
-          open();
-          for (hsize_t row = 0; row < rows; ++row)
-            {
-              Record     r;
-              const Read read = read_record(row, r);
-              damaged += read == Read::damaged;
-              incomplete += read == Read::incomplete;
-              if (read == Read::intact)
-                {
-                  (r.status == 0 ? states : failures) += 1;
-                  kept += row >= first_row_before_stop;
-                }
-            }
-        }
-      catch (const InputError &e)
-        {
-          unreadable = e.problem();
-          close_file();
-        }
-      const std::string what =
-        unreadable.empty() ?
-          "it keeps " + std::to_string(states) + " states and " +
-            std::to_string(failures) + " failure points (read back), " +
-            std::to_string(kept) + " of them appended by this run" +
-            (damaged + incomplete > 0 ?
-               "; " + std::to_string(damaged + incomplete) +
-                 " records cut short or damaged are skipped" :
-               std::string()) :
-          "reading it back failed: " + unreadable;
-      const std::string message =
-        "writing the state store '" + file + "' failed (" + reason +
-        "); appending stopped: " + what +
-        ". Make room (or move the store to a disk with room) and run "
-        "again: the states kept are not computed again";
-      if (lock)
-        {
-          std::lock_guard<std::mutex> guard(lock->mutex);
-          if (lock->failure.empty())
-            lock->failure = message;
-        }
-      throw OutputError(message);
-    }
-
-    // The first row of this object's records when the write failed (open()
-    // in stop() moves first_row to the end).
-    hsize_t first_row_before_stop = 0;
-  };
-
-
-
-  StateStore::StateStore(const std::string      &file,
-                         const StoreFingerprint &fingerprint,
-                         const Access            access)
-    : impl(std::make_unique<Impl>())
-  {
-    // HDF5 prints its error stack by default; palpate reports errors itself.
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    Impl &s            = *impl;
-    s.file             = file;
-    s.access           = access;
-    const bool writing = access == Access::write;
-    // What the file is, before HDF5 sees it: a file that is fine but not
-    // writable, a directory, a text file are not "damaged".
-    check_store_file(file, writing);
-    bool exists = true;
-    if (writing)
-      {
-        // The writer's lock, before anything is written; then look again
-        // (another writer may have made the store meanwhile).
-        s.lock = acquire_lock(file);
-        exists = check_store_file(file, writing);
-      }
-    if (!exists)
-      {
-        // The sizes come with the first state: create lazily then. Until
-        // then the fingerprint is kept.
-        try
-          {
-            s.create(fingerprint, 0, 0);
-          }
-        catch (const WriteFailure &f)
-          {
-            s.fail("the store cannot be made: " + f.reason,
-                   "make room on its disk, or name a store where there is "
-                   "room and you can write (State space / Store).");
-          }
-        return;
-      }
-    s.open();
-    for (const auto &[field, value] : fingerprint.fields)
-      {
-        const std::string stored = s.attribute(field);
-        if (stored != value)
-          s.fail("the store was computed for other physics: its " + field +
-                   " is '" + stored + "', the scene's is '" + value +
-                   "'; its states would be wrong here",
-                 "use another store file for this scene (State space / "
-                 "Store), or delete this one to compute the states again.");
-      }
+    const hsize_t start[2] = {row, 0}, count[2] = {1, columns(d)};
+    if (count[1] == 0)
+      return;
+    const hid_t file_space = H5Dget_space(datasets[d]);
+    H5Sselect_hyperslab(
+      file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
+    const hid_t memory = H5Screate_simple(2, count, nullptr);
+    H5Dread(datasets[d], type(d), memory, file_space, H5P_DEFAULT, data);
+    H5Sclose(memory);
+    H5Sclose(file_space);
   }
 
 
 
-  StateStore::~StateStore() = default;
+  bool
+  StateStore::Impl::write_row(const hsize_t      row,
+                              const unsigned int d,
+                              const void        *data)
+  {
+    const hsize_t extent[2] = {row + 1, columns(d)};
+    if (H5Dset_extent(datasets[d], extent) < 0)
+      return false;
+    if (columns(d) > 0)
+      {
+        const hsize_t start[2] = {row, 0}, count[2] = {1, columns(d)};
+        const hid_t   file_space = H5Dget_space(datasets[d]);
+        H5Sselect_hyperslab(
+          file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
+        const hid_t  memory = H5Screate_simple(2, count, nullptr);
+        const herr_t written =
+          H5Dwrite(datasets[d], type(d), memory, file_space, H5P_DEFAULT, data);
+        H5Sclose(memory);
+        H5Sclose(file_space);
+        if (written < 0)
+          return false;
+      }
+    // The chunk cache holds the row until it is flushed: only the flush
+    // meets a full disk, so its result is what says the row is written.
+    return H5Dflush(datasets[d]) >= 0;
+  }
+
+
+
+  std::string
+  StateStore::Impl::reserve()
+  {
+    haddr_t eoa = 0;
+    if (H5Fget_eoa(h5, &eoa) < 0)
+      return "";
+    const off_t record =
+      (13 + n_solution + n_multipliers) * sizeof(double) + 16;
+    const off_t target = eoa + 4 * record + 128 * 1024;
+    // A descriptor of our own, kept while the file is open (close_file()
+    // closes it: create() renames a new file into place).
+    if (reserve_fd < 0)
+      reserve_fd = ::open(file.c_str(), O_WRONLY | O_CLOEXEC);
+    if (reserve_fd < 0)
+      return std::strerror(errno);
+    // The size each time: HDF5 may have cut the file back to its end of
+    // allocation when it flushed.
+    struct stat st
+    {};
+    int error = fstat(reserve_fd, &st) == 0 ? 0 : errno;
+    // posix_fallocate returns the error; glibc writes zeros where the
+    // file system cannot allocate.
+    if (error == 0 &&
+        static_cast<std::uint64_t>(st.st_size) < eoa + 2 * record + 64 * 1024)
+      error = posix_fallocate(reserve_fd, 0, target);
+    return error == 0 ? "" : std::strerror(error);
+  }
+
+
+
+  StateStore::Impl::Read
+  StateStore::Impl::read_record(const hsize_t row, Record &r) const
+  {
+    r.solution.resize(n_solution);
+    r.multipliers.resize(n_multipliers);
+    std::uint64_t checksum = 0;
+    read_row(row, 0, &r.point);
+    read_row(row, 1, &r.status);
+    read_row(row, 2, r.force);
+    read_row(row, 3, r.stiffness);
+    read_row(row, 4, &r.wall_time);
+    read_row(row, 5, r.solution.data());
+    read_row(row, 6, r.multipliers.data());
+    read_row(row, 7, &checksum);
+    // The checksum is written last: none (HDF5's fill value, 0) means
+    // the writer never got there, it was killed or is writing it now.
+    if (checksum == 0)
+      return Read::incomplete;
+    return checksum == r.checksum() && r.point >= 0 ? Read::intact :
+                                                      Read::damaged;
+  }
+
+
+
+  void
+  StateStore::Impl::stop(std::string reason)
+  {
+    if (reason.empty())
+      reason = "the file system refused a write";
+    stopped = true;
+    close_file();
+    pending.clear();
+    unsigned int states = 0, failures = 0, damaged = 0, incomplete = 0;
+    kept = 0;
+    std::string unreadable;
+    access = Access::read;
+    try
+      {
+        open();
+        for (hsize_t row = 0; row < rows; ++row)
+          {
+            Record     r;
+            const Read read = read_record(row, r);
+            damaged += read == Read::damaged;
+            incomplete += read == Read::incomplete;
+            if (read == Read::intact)
+              {
+                (r.status == 0 ? states : failures) += 1;
+                kept += row >= first_row_before_stop;
+              }
+          }
+      }
+    catch (const InputError &e)
+      {
+        unreadable = e.problem();
+        close_file();
+      }
+    const std::string what =
+      unreadable.empty() ?
+        "it keeps " + std::to_string(states) + " states and " +
+          std::to_string(failures) + " failure points (read back), " +
+          std::to_string(kept) + " of them appended by this run" +
+          (damaged + incomplete > 0 ?
+             "; " + std::to_string(damaged + incomplete) +
+               " records cut short or damaged are skipped" :
+             std::string()) :
+        "reading it back failed: " + unreadable;
+    const std::string message =
+      "writing the state store '" + file + "' failed (" + reason +
+      "); appending stopped: " + what +
+      ". Make room (or move the store to a disk with room) and run "
+      "again: the states kept are not computed again";
+    if (lock)
+      {
+        std::lock_guard<std::mutex> guard(lock->mutex);
+        if (lock->failure.empty())
+          lock->failure = message;
+      }
+    throw OutputError(message);
+  }
 
 
 
@@ -1493,23 +1274,6 @@ namespace palpate
 
 
 
-  unsigned int
-  StateStore::appended() const
-  {
-    const Impl &s = *impl;
-    return s.stopped ? s.kept : s.rows - std::min(s.rows, s.first_row);
-  }
-
-
-
-  bool
-  StateStore::stopped() const
-  {
-    return impl->stopped;
-  }
-
-
-
   std::vector<std::pair<unsigned int, State>>
   StateStore::read_all(unsigned int &damaged, unsigned int *incomplete) const
   {
@@ -1551,6 +1315,80 @@ namespace palpate
         states.emplace_back(r.point, std::move(state));
       }
     return states;
+  }
+
+
+
+  StateStore::StateStore(const std::string      &file,
+                         const StoreFingerprint &fingerprint,
+                         const Access            access)
+    : impl(std::make_unique<Impl>())
+  {
+    // HDF5 prints its error stack by default; palpate reports errors itself.
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    Impl &s            = *impl;
+    s.file             = file;
+    s.access           = access;
+    const bool writing = access == Access::write;
+    // What the file is, before HDF5 sees it: a file that is fine but not
+    // writable, a directory, a text file are not "damaged".
+    check_store_file(file, writing);
+    bool exists = true;
+    if (writing)
+      {
+        // The writer's lock, before anything is written; then look again
+        // (another writer may have made the store meanwhile).
+        s.lock = acquire_lock(file);
+        exists = check_store_file(file, writing);
+      }
+    if (!exists)
+      {
+        // The sizes come with the first state: create lazily then. Until
+        // then the fingerprint is kept.
+        try
+          {
+            s.create(fingerprint, 0, 0);
+          }
+        catch (const WriteFailure &f)
+          {
+            s.fail("the store cannot be made: " + f.reason,
+                   "make room on its disk, or name a store where there is "
+                   "room and you can write (State space / Store).");
+          }
+        return;
+      }
+    s.open();
+    for (const auto &[field, value] : fingerprint.fields)
+      {
+        const std::string stored = s.attribute(field);
+        if (stored != value)
+          s.fail("the store was computed for other physics: its " + field +
+                   " is '" + stored + "', the scene's is '" + value +
+                   "'; its states would be wrong here",
+                 "use another store file for this scene (State space / "
+                 "Store), or delete this one to compute the states again.");
+      }
+  }
+
+
+
+  StateStore::~StateStore() = default;
+
+
+
+  unsigned int
+  StateStore::appended() const
+  {
+    const Impl &s = *impl;
+    return s.stopped ? s.kept : s.rows - std::min(s.rows, s.first_row);
+  }
+
+
+
+  bool
+  StateStore::stopped() const
+  {
+    return impl->stopped;
   }
 
 
@@ -1653,6 +1491,22 @@ namespace palpate
 
 
 
+  unsigned int
+  StateStore::size() const
+  {
+    return impl->rows;
+  }
+
+
+
+  const std::string &
+  StateStore::file() const
+  {
+    return impl->file;
+  }
+
+
+
   void
   StateStore::export_vtk(const StateGrid   &grid,
                          const std::string &filename) const
@@ -1720,21 +1574,5 @@ namespace palpate
     if (!out)
       throw OutputError("writing '" + filename + "' failed (" +
                         std::strerror(errno) + ")");
-  }
-
-
-
-  unsigned int
-  StateStore::size() const
-  {
-    return impl->rows;
-  }
-
-
-
-  const std::string &
-  StateStore::file() const
-  {
-    return impl->file;
   }
 } // namespace palpate

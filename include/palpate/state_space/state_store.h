@@ -79,7 +79,8 @@ namespace palpate
     failure() const;
 
     /** The lock as this process holds it (its file descriptor, the
-     * failure); defined in state_store.cc. */
+     * failure); defined in state_store_impl.h, private to the store's
+     * sources. */
     struct Held;
 
   private:
