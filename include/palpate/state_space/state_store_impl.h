@@ -8,6 +8,7 @@
 // files:
 //   state_store.cc              StateStore's own members: open, load, append
 //                               what the cache holds
+//   state_store_lock.cc         the writer's lock (StoreLock)
 // Users of the store include state_store.h, never this header: it brings in
 // HDF5's.
 
