@@ -9,6 +9,7 @@
 //   state_store.cc              StateStore's own members: open, load, append
 //                               what the cache holds
 //   state_store_lock.cc         the writer's lock (StoreLock)
+//   state_store_checks.cc       what a file is before HDF5 sees it
 // Users of the store include state_store.h, never this header: it brings in
 // HDF5's.
 
