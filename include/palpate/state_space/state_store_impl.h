@@ -12,6 +12,7 @@
 //   state_store_checks.cc       what a file is before HDF5 sees it
 //   state_store_hdf5.cc         the HDF5 file: made, opened, its fingerprint
 //   state_store_records.cc      records appended and read back, checksummed
+//   state_store_fingerprint.cc  what a stored state depends on
 // Users of the store include state_store.h, never this header: it brings in
 // HDF5's.
 
