@@ -5,7 +5,7 @@
 #define palpate_state_space_state_store_impl_h
 
 // Not an interface: the state store's implementation, shared by its source
-// files:
+// files, one job each:
 //   state_store.cc              StateStore's own members: open, load, append
 //                               what the cache holds
 //   state_store_lock.cc         the writer's lock (StoreLock)
@@ -13,6 +13,7 @@
 //   state_store_hdf5.cc         the HDF5 file: made, opened, its fingerprint
 //   state_store_records.cc      records appended and read back, checksummed
 //   state_store_fingerprint.cc  what a stored state depends on
+//   state_store_export.cc       the ParaView export
 // Users of the store include state_store.h, never this header: it brings in
 // HDF5's.
 
