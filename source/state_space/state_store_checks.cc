@@ -105,8 +105,8 @@ namespace palpate
                     "there is no store at this path",
                     "name an existing store, or make one with palpate "
                     "precompute SCENE.prm.");
-      // A link to nowhere was replaced by a regular store, and its target
-      // never made (the thirteenth re-run).
+      // A link to nowhere: the store, made under a temporary name and
+      // renamed, would replace the link, and its target would never be made.
       if (const std::string link = dangling_link(path.string()); !link.empty())
         store_error(file,
                     link,

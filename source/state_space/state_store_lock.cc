@@ -33,17 +33,18 @@ namespace palpate
   // Why a lock file of our own, with flock: HDF5 1.10 locks the file it
   // opens, but a SWMR writer drops that lock as soon as it has marked the
   // superblock "open for writing"; a second writer then finds the mark and
-  // is refused, and palpate used to clear the mark (it is also what a
-  // killed writer leaves) and write on, which is how two writers came to
-  // interleave their rows. The mark cannot tell a live writer from a dead
-  // one; a kernel lock can: flock belongs to the open file and goes with
-  // the process, however it ends. The lock is on `STORE.lock`, not on the
-  // store: the store does not exist before its first state, is created
-  // under another name and renamed (and once more when the first state
-  // fixes the record sizes), and HDF5 takes and drops flocks of its own on
-  // it, which would release ours (flock is per open file, and a process may
-  // have the store open twice). fcntl locks would not survive that either:
-  // they go when the process closes any descriptor of the file.
+  // is refused. The mark is also what a killed writer leaves, and it cannot
+  // tell a live writer from a dead one: cleared by a writer that cannot
+  // know (open() clears it only holding this lock), two writers would
+  // interleave their rows. A kernel lock can tell them apart: flock belongs
+  // to the open file and goes with the process, however it ends. The lock
+  // is on `STORE.lock`, not on the store: the store does not exist before
+  // its first state, is created under another name and renamed (and once
+  // more when the first state fixes the record sizes), and HDF5 takes and
+  // drops flocks of its own on it, which would release ours (flock is per
+  // open file, and a process may have the store open twice). fcntl locks
+  // would not survive that either: they go when the process closes any
+  // descriptor of the file.
 
   StoreLock::Held::~Held()
   {
@@ -137,8 +138,8 @@ namespace palpate
         where = canonical;
       const std::string lock_file = where.string() + ".lock";
       // Symbolic links lead to one lock; hard links do not (each name has
-      // its own lock file), and two writers through two names damaged
-      // 196-571 records. A store with more than one name is refused.
+      // its own lock file), so two writers through two names would append
+      // to the same rows. A store with more than one name is refused.
       if (struct stat st; stat(where.c_str(), &st) == 0 &&
                           S_ISREG(st.st_mode) && st.st_nlink > 1)
         store_error(store,

@@ -140,9 +140,9 @@ namespace palpate
      * (SWMR needs it), and HDF5's own file locking off. That lock cannot
      * serve: a SWMR writer drops it once the file is open, while a reader
      * holds its shared lock for as long as it has the file open, so that a
-     * writer opening the store while a reader reads it failed with "Resource
-     * temporarily unavailable". One writer per store is the StoreLock's
-     * job; readers need no lock (SWMR).
+     * writer opening the store while a reader reads it would fail with
+     * "Resource temporarily unavailable". One writer per store is the
+     * StoreLock's job; readers need no lock (SWMR).
      */
     hid_t
     file_access();
