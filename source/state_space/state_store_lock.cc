@@ -49,7 +49,7 @@ namespace palpate
   StoreLock::Held::~Held()
   {
     // Removed while still locked, so that nobody takes a lock on a file
-    // about to vanish unseen (acquire() checks that the file it locked is
+    // about to vanish unseen (acquire_lock() checks that the file it locked is
     // still the one at the path). A process forked from the holder shares
     // its lock but leaves the file alone.
     if (pid == getpid())
