@@ -111,6 +111,7 @@ namespace palpate
     , q(max_nodes)
     , w(max_nodes)
     , rhs(3 * this->max_active)
+    , rho(max_nodes)
     , u(max_nodes)
     , loaded(max_nodes)
   {
@@ -228,16 +229,17 @@ namespace palpate
     unsigned int n_loaded = 0;
     for (unsigned int i = 0; i < n; ++i)
       {
+        // u_i from the centre to the node, normalised below only for the
+        // few nodes that carry a force: a division per node of the patch
+        // is the loop's largest cost.
         double r2 = 0;
         for (unsigned int a = 0; a < 3; ++a)
           {
             u[i][a] = s.y[3 * i + a] - c[a];
             r2 += u[i][a] * u[i][a];
           }
-        const double rho = std::sqrt(r2);
-        for (unsigned int a = 0; a < 3; ++a)
-          u[i][a] /= rho;
-        q[i]     = rho - patch.radius + patch.offset[i];
+        rho[i]   = std::sqrt(r2);
+        q[i]     = rho[i] - patch.radius + patch.offset[i];
         touching = touching || q[i] < -gap_tolerance;
         if (s.lambda[i] > 0)
           loaded[n_loaded++] = i;
@@ -294,6 +296,11 @@ namespace palpate
         if (!settled)
           s.factored = false;
       }
+
+    for (unsigned int i = 0; i < n; ++i)
+      if (s.active[i] || s.lambda[i] > 0)
+        for (unsigned int a = 0; a < 3; ++a)
+          u[i][a] /= rho[i];
 
     // The force, and the nodes moved by it for the next tick:
     // y = x_free + H f.

@@ -118,7 +118,7 @@ namespace palpate
     unsigned int                       max_nodes, max_active;
     std::vector<Slot>                  slots;
     std::uint64_t                      clock = 0;
-    std::vector<double>                q, w, rhs;
+    std::vector<double>                q, w, rhs, rho;
     std::vector<std::array<double, 3>> u;
     std::vector<unsigned int>          loaded;
   };
