@@ -101,6 +101,21 @@ namespace palpate
 
 
 
+  Utilities::Point3
+  blob_shape(const Utilities::Point3 &x, const Utilities::Point3 &a) noexcept
+  {
+    // A liver-like shape: an ellipsoid whose +x lobe is thicker and wider
+    // than the -x lobe, with a flatter underside. The map is smooth and its
+    // Jacobian stays positive on the ball (all factors are within
+    // [0.75, 1.25]).
+    const double lobe = 1.0 + 0.25 * x[0];
+    const double flat = 0.15 * (1.0 - x[0] * x[0] - x[1] * x[1]);
+    const double z    = x[2] < 0 ? x[2] * (1.0 - flat) : x[2];
+    return {{a[0] * x[0], a[1] * x[1] * (1.0 + 0.15 * x[0]), a[2] * z * lobe}};
+  }
+
+
+
   MeshData
   generate_blob(const Parameters::Mesh &p)
   {
@@ -122,19 +137,11 @@ namespace palpate
       },
       tria);
 
-    // Map the unit ball onto a liver-like shape: an ellipsoid whose +x lobe
-    // is thicker and wider than the -x lobe, with a flatter underside. The
-    // map is smooth and its Jacobian stays positive on the ball (all
-    // factors are within [0.75, 1.25]).
     const auto a = p.blob_semi_axes;
     dealii::GridTools::transform(
       [a](const dealii::Point<3> &x) {
-        const double lobe = 1.0 + 0.25 * x[0];
-        const double flat = 0.15 * (1.0 - x[0] * x[0] - x[1] * x[1]);
-        const double z    = x[2] < 0 ? x[2] * (1.0 - flat) : x[2];
-        return dealii::Point<3>(a[0] * x[0],
-                                a[1] * x[1] * (1.0 + 0.15 * x[0]),
-                                a[2] * z * lobe);
+        const Utilities::Point3 y = blob_shape({{x[0], x[1], x[2]}}, a);
+        return dealii::Point<3>(y[0], y[1], y[2]);
       },
       tria);
     for (const auto &cell : tria.active_cell_iterators())

@@ -31,6 +31,16 @@ namespace palpate
   generate_blob(const Parameters::Mesh &parameters);
 
   /**
+   * Where generate_blob() maps the point @p x of the unit ball, for
+   * @p semi_axes (m): on |x| = 1, a point of the blob's surface. A surface
+   * sampled with it can be meshed (Mesh / Source = surface) finer where a
+   * probe works than the generator's uniform tetrahedra.
+   */
+  Utilities::Point3
+  blob_shape(const Utilities::Point3 &x,
+             const Utilities::Point3 &semi_axes) noexcept;
+
+  /**
    * A block of tetrahedra on the tensor grid of the node coordinates
    * @p x, @p y, @p z (m, increasing), each grid brick split into six
    * tetrahedra along its main diagonal (Kuhn's subdivision, conforming
