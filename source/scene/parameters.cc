@@ -1163,11 +1163,13 @@ namespace palpate
           "Memory budget",
           "1024",
           Patterns::Double(1.),
-          "Memory for the whole states kept in the cache (MiB); "
-          "with Type = mpi, on each server (and on the client, for "
-          "the states its shape output fetched). Beyond it, the "
-          "states farthest from the HIP are dropped; their forces "
-          "stay.");
+          "Memory for the whole states kept in the cache (MiB), "
+          "their contact patches included; with Type = mpi, on each "
+          "server (and on the client, for the states its shape output "
+          "fetched). Beyond it, the states farthest from the HIP are "
+          "dropped with their patches; their forces stay (with "
+          "Interpolation = contact patch, a cell with such a corner is "
+          "interpolated trilinearly).");
         // At most an hour: with 1e308 servers whose client (rank 0) was
         // killed kept running (the ninth re-run).
         prm.declare_entry("Server timeout",

@@ -52,11 +52,16 @@ namespace palpate
 
   namespace
   {
+    /** A state's bytes, its contact patch's included: a patch's dense
+     * compliance outweighs the solution many times (doc/benchmarks/
+     * contact-patch.md), so a budget of solutions alone would not bound
+     * the cache. */
     std::size_t
     size_of(const State &s)
     {
       return sizeof(State) + s.solution.size() * sizeof(double) +
-             s.multipliers.size() * sizeof(double);
+             s.multipliers.size() * sizeof(double) +
+             (s.contact_patch ? s.contact_patch->memory() : 0);
     }
     /**
      * What the real-time side reads of a point, written behind its
@@ -343,6 +348,10 @@ namespace palpate
             const unsigned int p = by_distance.back().second;
             by_distance.pop_back();
             bytes -= size_of(*states[p]);
+            // The patch goes with its state (the budget counts it): the
+            // point's force stays, and cells with this corner render
+            // trilinearly until it is published again.
+            retire_patch(p);
             states[p].reset();
             entries[p].held.store(false, std::memory_order_release);
             entries[p].dropped.store(true, std::memory_order_relaxed);

@@ -8,6 +8,7 @@
 // failure points and generations that changed.
 
 #include <palpate/haptics/force_interpolation.h>
+#include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
@@ -146,4 +147,34 @@ main(int argc, char **argv)
           << (small.has_state(grid.linear({{0, 0, 1}})) ? "yes" : "NO")
           << "), forces still available (" << small.counts().first << ")"
           << std::endl;
+
+  // Contact patches count in the budget and go with their states.
+  auto patch = std::make_shared<palpate::ContactPatch>();
+  patch->H.resize(90 * 90);
+  patch->W.resize(30 * 30);
+  const std::size_t   per_state = sizeof(palpate::State) + patch->memory();
+  palpate::StateCache with_patches(grid, 10 * per_state);
+  with_patches.set_focus({{0, 0, 0}});
+  for (unsigned int p = 0; p < grid.size(); ++p)
+    {
+      auto s           = std::make_shared<palpate::State>();
+      s->force         = field(grid.position(p));
+      s->contact_patch = patch;
+      with_patches.publish(p, s, with_patches.generation());
+    }
+  const auto   held_patches = with_patches.memory();
+  unsigned int readable = 0, readable_held = 0;
+  with_patches.begin_patch_reads();
+  for (unsigned int p = 0; p < grid.size(); ++p)
+    if (with_patches.read_patch(p, with_patches.generation()))
+      {
+        ++readable;
+        readable_held += with_patches.has_state(p);
+      }
+  with_patches.end_patch_reads();
+  deallog << "budget of 10 states with patches: " << held_patches.first
+          << " held, within the budget ("
+          << (held_patches.second <= 10 * per_state ? "yes" : "NO") << "), "
+          << readable << " patches readable, all of held states ("
+          << (readable == readable_held ? "yes" : "NO") << ")" << std::endl;
 }
