@@ -725,10 +725,10 @@ namespace palpate
      * a node; the fixed nodes' box or half-space holding some nodes but
      * not all), a unit (a power of ten) or the scene's factor times one if
      * such a factor does it, else any (to three digits); of those the one
-     * that makes the body closest to a liver's 0.25 m. The eighth re-run
-     * was told 0.02743 (0.25 m exactly), the ninth 0.00039146 (the scene's
-     * factor over 100); both missed the fixed nodes of a millimetre mesh,
-     * which only 0.001 fits.
+     * that makes the body closest to a liver's 0.25 m. The scene's places
+     * come first because the size alone misleads: for a millimetre mesh a
+     * factor making it 0.25 m exactly (0.02743), or the scene's factor over
+     * 100 (0.00039146), misses the fixed nodes, which only 0.001 fits.
      */
     ScaleSuggestion
     suggest_scale_factor(const Scene &scene, const Mesh &mesh)

@@ -487,42 +487,36 @@ namespace palpate
 
 
     /**
-     * How deep a sphere may be pushed, in radii: the tissue closes over a
-     * deeper one. 6.1 mm (suggested for the graded liver's 1 cm push)
-     * failed at 1.5 - 5 cm, 8 mm held 1.5 cm and 10 mm 2 cm (the eleventh
-     * re-run); at 1.8 - 2 radii a few failed, e.g. 6.1 mm at 1.1 cm and,
-     * with Node id 38, 6.4 mm at 1.2 cm and 7.5 mm at 1.5 cm (the twelfth);
-     * at 1.7 and 1.8 radii 1.1 - 2.2 cm all converged, there and at the
-     * scene's Point (1.0 - 3.9 N). Those pushes went along -z, where the
-     * Point's outward normal has z = 0.933: what fails is the depth along
-     * the normal, 1.68 radii at 6.1 mm and 1.1 cm, so the bound weighs the
-     * push's inward component, at 1.5 radii (1.6 radii along -z there),
-     * with the margin below.
-     * A push's sideways part only slides the frictionless sphere: 2 cm
-     * along x, 4.3 mm in, converged at 0.308 N, and was refused as
-     * "pushed 0.02 m deep" while the whole length counted (the thirteenth).
+     * How deep a sphere may be pushed, in radii: deeper, the tissue closes
+     * over it, its nodes pass behind it and the state is a failure point.
+     * The depth is the push's component along the surface's inward normal
+     * at the probe: on the graded liver of liver-indenter.prm the first
+     * failures come at 1.68 radii along the normal (a 6.1 mm sphere pushed
+     * 1.1 cm along -z at the Point), and 1.5 stays below them (deeper
+     * than a radius, the sphere must also clear the margin below). A
+     * push's sideways part only slides the frictionless sphere (2 cm along
+     * x, 4.3 mm in, converges at 0.308 N).
+     * Measured with `palpate solve parameters/liver-indenter.prm --to
+     * 0,0,-D` and the radius a refusal offers.
      */
     constexpr double deepest_push = 1.5;
 
     /**
-     * The margin a sphere pushed @p depth deep must clear the node spacing
-     * by: none down to half its radius, rising to the full margin at its
-     * radius. Both checks are what a sphere needs to meet nodes at all.
-     * Pushed deeper than its radius, one that just passes them still
-     * slipped between the nodes (ninth and tenth re-runs; graded liver, 1
-     * cm: 3.6 mm passed, 4 - 5.5 mm failed, 6 mm converged; liver-stvk P2,
-     * 3 cm: 7.1 passed, 8.5 failed, 10 converged); a shallower one needs
-     * only the checks (a 1 cm sphere pressed 2 mm between the beam's 14 mm
-     * edges renders Hertz's force). Measured again with the inward depth
-     * (the nineteenth session, at Node ids 40 and 41, edges up to 4.9 mm):
-     * spheres clearing the spacing by 1.7 (5.6 mm) and 1.84 (6 mm) failed
-     * at 1.35 and 1.45 radii deep, 7 mm (2.1) held 1.45 and 8 - 13 mm held
-     * 1.54 radii at the Point and Node ids 37, 38, 40, 41. And dragged 2 cm
-     * along the surface 0.94 radii deep, a 4.2 mm sphere clearing it by 1
-     * went through the surface at Node id 37 (the fourteenth re-run),
-     * while the 1 cm sphere 0.43 radii deep converged (0.308 N): dragged
-     * along the surface, the margin rises from half a radius deep, not at
-     * one.
+     * How many times a sphere pushed deeper than its radius must clear the
+     * node spacing the checks measure. The checks alone are what a sphere
+     * needs to meet the nodes at all (a 1 cm sphere pressed 2 mm between
+     * the beam's 14 mm edges renders Hertz's force); pushed that deep, one
+     * that just passes them still slips between the nodes. On the graded
+     * liver of liver-indenter.prm (edges up to 4.9 mm at Node ids 40 and
+     * 41), spheres clearing the spacing 1.7 and 1.84 times are failure
+     * points at 1.35 and 1.45 radii deep; 2.1 times holds at 1.45 radii,
+     * and larger spheres at 1.54. Dragged along the surface the sphere
+     * needs the margin from half a radius deep (margin_at()): a 4.2 mm
+     * sphere clearing the spacing once, dragged 2 cm at 0.94 radii deep,
+     * goes through the surface at Node id 37, while a 1 cm sphere 0.43
+     * radii deep converges (0.308 N).
+     * Measured with `palpate solve parameters/liver-indenter.prm`, pushes
+     * along the inward normal.
      */
     constexpr double margin = 2.2;
 
@@ -541,25 +535,20 @@ namespace palpate
 
     /**
      * How far towards the fixed nodes a refusal still offers a radius, as
-     * a part of the distance from the active node to the nearest of them:
-     * the farthest every site measured converged with the radius offered.
-     * On the graded liver of liver-indenter.prm (fixed nodes 13 - 14 cm
-     * away), pushed along -z with the radius each refusal offered (the
-     * fifteenth re-run's S4: 10 cm at the Point was offered 6.47 cm, which
-     * stagnated at 8.4 cm), the inward depths that converged reached 0.254
-     * (Node id 30), 0.30 - 0.35 (Node ids 40, 42, 45) and 0.43 - 0.57 (the
-     * Point, Node ids 33, 36, 38), and failure points began at 0.26 (4.1 cm
-     * at Node id 30), 0.33 - 0.37 and 0.51: Newton stagnates as the contact
-     * patch of so large a sphere (its radius at least the depth over 1.5)
-     * grows. With the fixed nodes nearer (z below 0.02, 0.05: 8.3 and 5.4 cm
-     * away) the tissue is squeezed against them, and failures came at 0.60 and
-     * 0.64. Every push to 0.25 converged, at 8 sites and 3 supports (and
-     * liver-stvk.prm's 3 cm, 0.255, in the fifteenth re-run): 0.22 keeps
-     * a margin below the first failure. Such a push asks 5 - 8 N there,
-     * about what a haptic device renders (deeper, 15 - 60 N). A radius of the
-     * user's own that passes the checks is not refused deeper: a 1 cm sphere
-     * pushed 1 cm into the beam, half the way to its fixed end, converges (the
-     * indenter tests), and a deeper push's failure point says where it failed.
+     * a part of the distance from the active node to the nearest of them.
+     * Deeper, the radius the checks find (at least the depth over 1.5)
+     * makes a contact patch so large that Newton stagnates as it grows, or
+     * the tissue is squeezed against the fixed nodes. On the graded liver
+     * of liver-indenter.prm, pushed with the radius each refusal offers,
+     * every push to 0.25 of the way converges (8 sites, 3 supports; and
+     * liver-stvk.prm's 3 cm, 0.255), and failure points begin at 0.26:
+     * 0.22 keeps a margin below them. Such a push asks 5 - 8 N there,
+     * about what a haptic device renders (deeper, 15 - 60 N). A radius of
+     * the user's own that passes the checks is not refused deeper: a 1 cm
+     * sphere pushed 1 cm into the beam, half the way to its fixed end,
+     * converges (the indenter tests), and a deeper push's failure point
+     * says where it failed.
+     * Measured: doc/changes/2026-11-27-deep-sphere-pushes.md.
      */
     constexpr double towards_support = 0.22;
 
@@ -601,15 +590,14 @@ namespace palpate
                             fit.placed);
       };
       // With quadratic elements the edge midpoints are contact nodes too,
-      // and halve the spacing the checks measure; but not for a deep
-      // push: with Taylor-Hood on the graded liver of liver-indenter.prm
-      // (a 1 cm push), 3 and 4 mm spheres, which clear the midpoints'
-      // figures by 1.7 and 2.3 times, were failure points, and 6 mm,
-      // which clears the vertices' by 1.7, converged (the tenth re-run).
-      // So only for a push that needs no margin.
+      // and halve the spacing the checks measure; but only for a push that
+      // needs no margin. Pushed deep, the midpoints do not hold a sphere
+      // as the vertices do: with Taylor-Hood on the graded liver of
+      // liver-indenter.prm (a 1 cm push), 3 and 4 mm spheres, clearing the
+      // midpoints' spacing 1.7 and 2.3 times, are failure points, while
+      // 6 mm, clearing the vertices' 1.7 times, converges.
       fit.hole = place(false);
-      // A pull presses the sphere no deeper (the twelfth re-run's 3 cm pull
-      // was refused as "pushed 0.03 m deep"), and a move along the surface
+      // A pull presses the sphere no deeper, and a move along the surface
       // only as far as its inward component: the depth. Its sideways part,
       // the slide, takes the sphere over other triangles (below).
       const auto  &n      = fit.placed.active_normal;
@@ -632,10 +620,10 @@ namespace palpate
         }
       // Pushed in by a depth d, the sphere cuts the surface in a circle of
       // radius sqrt(2 R d - d^2), at most R (at d = R): a sphere smaller
-      // than the distance never meets a node. Measured on liver501 (the
-      // nearest node 4.3 mm away), a 6 mm sphere pushed 1 cm still
-      // passed between the nodes (0 N) and 1 cm rendered 0.27 N: twice
-      // the distance makes the first node touch within a quarter of it.
+      // than the distance never meets a node. On liver501 (the nearest
+      // node 4.3 mm away), a 6 mm sphere pushed 1 cm still passes between
+      // the nodes (0 N) and a 1 cm one renders 0.27 N: twice the distance
+      // makes the first node touch within a quarter of it.
       //
       // Moved along the surface, the sphere meets the triangles around
       // the anchor, not only its nearest node. Pressed onto a triangle of
@@ -643,10 +631,11 @@ namespace palpate
       // from them; held by a node it must stay half a radius out
       // (StateSolver: "sphere through the surface"), so rho <= 0.87 R, and
       // an edge L (rho >= L / sqrt(3)) at most 1.5 R. A 1 cm sphere on
-      // liver501 (edges up to 2 cm) passed the first check near a node and
-      // then every grid point beside rest was a failure point: 0 N for the
-      // whole run, exit 0 (the sixth re-run). The triangles within two
-      // radii of the anchor's path; with P2 the midpoints halve the edges.
+      // liver501 (edges up to 2 cm) passes the first check near a node,
+      // yet every grid point beside rest is a failure point: without this
+      // check the run renders 0 N throughout and exits 0. The triangles
+      // within two radii of the anchor's path; with P2 the midpoints halve
+      // the edges.
       Utilities::Point3 anchor;
       for (unsigned int d = 0; d < 3; ++d)
         anchor[d] =
@@ -740,11 +729,11 @@ namespace palpate
     {
       // At rest (an interaction's scene) the states first computed are the
       // grid points around it, the corners of the cells that touch it: the
-      // 26 one spacing away are tried. (The eighteenth re-run's F3: 0.0175
-      // m, offered untried on liver-stvk.prm, was a failure point at (0,
-      // -0.01, 0) and (0.01, 0, 0); the nineteenth's R1: 0.0171 m at Node
-      // id 36, tried at the six along the axes, failed at (0.01, 0,
-      // -0.01).) The six along the axes first: most fail there.
+      // 26 one spacing away are tried, the diagonal ones too: on
+      // liver-stvk.prm, 0.0171 m at Node id 36 converges at the six along
+      // the axes and is a failure point at (0.01, 0, -0.01). The six along
+      // the axes first: a radius that fails mostly fails there, and is
+      // dropped sooner.
       std::vector<Utilities::Point3> targets;
       if (!at_rest)
         targets.push_back(scene.parameters.boundary_conditions.active_node
@@ -818,10 +807,9 @@ namespace palpate
         return f.passes ? trial(with, mesh, f.placed) : -1.0;
       };
       // At rest a radius is tried only if it passes the checks at all the
-      // targets (the twentieth re-run's W2: one that failed them at a grid
-      // point was dropped unsolved, and on the graded liver the 10 s were
-      // gone before the next: "no sphere found here" with no radius named,
-      // at Node id 38, whose own 0.01 m converges at all 26).
+      // targets (geometric, milliseconds): solving one that cannot be
+      // offered would spend the 10 s the next radii have, and could leave
+      // no radius to name where one converges at all 26.
       const auto passes_everywhere = [&](const double r) {
         return passes_at_all(scene, mesh, selection, targets, r);
       };
@@ -973,8 +961,8 @@ namespace palpate
           selection = fit.placed;
           return;
         }
-      // Beyond the depths measured, no radius is offered: the one the
-      // checks find was a failure point (above); the push is what to
+      // Beyond towards_support no radius is offered: the one the checks
+      // find can be a failure point there (above); the push is what to
       // change.
       const double no_deeper =
         std::floor(towards_support * fit.support * 1e4) / 1e4;
@@ -1000,12 +988,12 @@ namespace palpate
             "device renders). Or fixed nodes farther from the probe "
             "(Boundary conditions / Fixed nodes).");
       // The radius to offer: the smallest that passes, found by trying
-      // radii 2 % apart from what the figures at R ask for. Worked out
-      // from R's figures alone, one in six offers was refused when used:
-      // another radius touches another patch, with another normal (the
-      // fourteenth re-run); nor is the rule monotonic (a larger sphere
-      // looks at more triangles), so the offer is "a radius that passes",
-      // not "at least".
+      // radii 2 % apart from what the figures at R ask for. R's figures
+      // alone do not say what another radius needs: it touches another
+      // patch, with another normal (worked out from them, about one offer
+      // in six fails the checks when used). Nor is the rule monotonic (a
+      // larger sphere looks at more triangles), so the offer is "a radius
+      // that passes", not "at least".
       const double largest = 0.25 * mesh.diameter();
       double       offer =
         std::ceil(
@@ -1020,19 +1008,19 @@ namespace palpate
       };
       offer = first_passing(offer);
       // Not the smallest that passes but the first from 10 % above it: the
-      // smallest, just clearing the spacing, was a failure point where 1.1
-      // times it converged (liver-stvk.prm, Node id 32, pushed (-2, 0, -2)
-      // cm: 0.0159 failed, 0.0175, 0.02 and 0.024 converged; the sixteenth
-      // re-run).
+      // smallest just clears the spacing and can be a failure point where
+      // 1.1 times it converges (liver-stvk.prm, Node id 32, pushed (-2, 0,
+      // -2) cm: 0.0159 m fails; 0.0175, 0.02 and 0.024 m converge).
       if (offer <= largest)
         if (const double above =
               first_passing(std::ceil(offer * 1.1 * 1e4) / 1e4);
             above <= largest)
           offer = above;
-      // Tried by a static solve where one can be (the seventeenth re-run:
-      // 8 of 372 offers were failure points, and at Node id 27 of
-      // liver-indenter.prm every radius from 0.9 to 2 times the offer
-      // stagnated at 0.4 of the push): what is offered has converged.
+      // Tried by a static solve where one can be, so that what is offered
+      // has converged: the checks are geometric and cannot foresee where
+      // the contact Newton stagnates (about 2 % of the offers that pass
+      // them are failure points; at Node id 27 of liver-indenter.prm every
+      // radius from 0.9 to 2 times the offer stagnates at 0.4 of the push).
       const TriedOffer tried =
         offer <= largest && trial ?
           tried_offer(scene, mesh, selection, trial, offer, first_passing) :

@@ -452,9 +452,9 @@ namespace palpate
             ::waitpid(child, &status, 0);
             break;
           }
-        // Ctrl-C or kill: the child goes, and its files with it (SIGTERM
-        // on `palpate mesh` left the child meshing for 18 s and a 14.7 MB
-        // temporary file, the ninth re-run).
+        // Ctrl-C or kill: the child goes, and its files with it (left
+        // alone, it meshes on after palpate has ended and leaves a
+        // temporary file of megabytes behind).
         if (StopRequest::pending())
           {
             ::kill(child, SIGKILL);
@@ -551,8 +551,8 @@ namespace palpate
         return std::string("it looks like ") + name + ": set " +
                Utilities::to_string(unit, 3) + " (the body is then " +
                Utilities::to_string(file_size * unit, 3) + " m across)";
-    // A factor --scale takes, or none: the ninth re-run was told "set inf"
-    // for a surface of zero extent and 1.443e-151 for one at 1e150.
+    // A factor --scale takes, or none: a surface of zero extent would be
+    // told "set inf", and one at 1e150 a factor like 1.443e-151.
     const double liver = factor * 0.25 / size;
     if (!(liver >= 1e-9 && liver <= 1e9))
       return "no scale factor from 1e-9 to 1e9 makes it an organ (the "
@@ -653,8 +653,8 @@ namespace palpate
     report.box          = s.bounding_box();
     report.area         = s.area();
     // Coordinates so large that their distances overflow (every one
-    // times 1e300): no vertex is the outlier, and the one named was a
-    // healthy one (the ninth re-run).
+    // times 1e300): no vertex is the outlier, and the outlier check below
+    // would name a healthy one.
     if (!std::isfinite(report.diameter))
       throw InputError(
         surface_file,
@@ -691,7 +691,7 @@ namespace palpate
                          "organ is 0.02 to 1 m across",
                        advice + ".");
     // A refinement centred far from the organ refines nothing, silently
-    // (--refine 100,0,0 beside a 25 cm liver gave the uniform mesh):
+    // (--refine 100,0,0 beside a 25 cm liver gives the uniform mesh):
     // the centre must lie within its radius of the bounding box.
     if (grading.fine_size > 0)
       {
@@ -723,8 +723,8 @@ namespace palpate
     report.repairs = repair_surface(s, surface_file);
     report.volume  = s.volume();
     // A closed surface that encloses (next to) nothing: a flat or folded
-    // shell. The mesher tried for the whole time limit and blamed the node
-    // count (the ninth re-run).
+    // shell. The mesher would try for the whole time limit and then blame
+    // the node count.
     if (!(std::abs(report.volume) >= 1e-6 * std::pow(report.diameter, 3)))
       throw InputError(surface_file,
                        0,
