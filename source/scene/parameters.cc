@@ -1170,8 +1170,9 @@ namespace palpate
           "dropped with their patches; their forces stay (with "
           "Interpolation = contact patch, a cell with such a corner is "
           "interpolated trilinearly).");
-        // At most an hour: with 1e308 servers whose client (rank 0) was
-        // killed kept running (the ninth re-run).
+        // At most an hour: the servers end only when the client (rank 0)
+        // has been silent this long, so with 1e308 those of a killed
+        // client would run on for good.
         prm.declare_entry("Server timeout",
                           "5",
                           Patterns::Double(0.5, 3600),

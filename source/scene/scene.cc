@@ -1363,15 +1363,16 @@ namespace palpate
       }
 
     // The largest modulus whose lambda fits with @p nu, to 3 digits rounded
-    // down: rounded to nearest, 6.006e10 (nu = 0.499) was named "6.01e+10"
-    // and that was refused again (the seventeenth re-run).
+    // down: rounded to nearest, the value named can lie above the bound
+    // (6.006e10 Pa for nu = 0.499 would read "6.01e+10"), and the modulus
+    // the refusal suggests would be refused in turn.
     const auto largest_modulus = [](const double nu) {
       const double E     = max_modulus * (1 + nu) * (1 - 2 * nu) / nu;
       const double digit = std::pow(10., std::floor(std::log10(E)) - 2);
       return std::floor(E / digit) * digit;
     };
     // A Poisson's ratio a hair below 0.5 passes its own check but makes the
-    // first Lame constant astronomical: nu = 0.49999999999999994 gave a
+    // first Lame constant astronomical: nu = 0.49999999999999994 gives a
     // 1.7e12 N force for a 1 cm push (lambda 4.6e19 Pa). Held against the
     // same bound as the moduli.
     if (const double nu = material->poissons_ratio(); nu < 0.5)
@@ -1379,8 +1380,8 @@ namespace palpate
         const double E      = material->youngs_modulus();
         const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
         // With nu <= 0.499 it is the modulus that makes lambda too large
-        // (E from 6.1e11 Pa with the liver's nu = 0.49 blamed nu, whose
-        // fix, nu <= 0.499, it already met: the sixteenth re-run).
+        // (E from 6.1e11 Pa with the liver's nu = 0.49): blaming nu would
+        // ask for a fix, nu <= 0.499, that it already meets.
         const auto moduli  = material->moduli();
         const bool modulus = nu > 0 && nu <= 0.499 && !moduli.empty() &&
                              !moduli.front().first.empty();
@@ -1835,8 +1836,8 @@ namespace palpate
                   "keep the cloud local: a radius of 4-6 grid spacings (the "
                   "default 0.025 m with 0.005 m spacing); at most Extent.",
                   {"State space/Extent"});
-    // 1e9 s was taken: the cloud went to where the HIP would be in 30
-    // years and the hand met missing data (the sixteenth re-run).
+    // Unbounded, a look-ahead of 1e9 s would centre the cloud where the
+    // HIP would be in 30 years, and the hand would meet missing data.
     if (p.scheduler.look_ahead_time > 2)
       throw error("Scheduler/Look-ahead time",
                   "at most 2 s: the cloud is centred where the HIP would be "
@@ -1954,8 +1955,8 @@ namespace palpate
                     " N: below, the device renders (nearly) no force at all "
                     "(haptic devices reach 1-40 N)",
                   "set the device's peak force in N, e.g. 8.");
-    // The limit is the device's safety: 1e308 N removed it (the sixth
-    // re-run). No haptic device renders a kilonewton.
+    // The limit is the device's safety: 1e308 N would remove it. No
+    // haptic device renders a kilonewton.
     if (h.force_limit > 1000)
       throw error("Haptics/Force limit",
                   "at most 1000 N: the limit protects the hand and the "
@@ -1984,13 +1985,14 @@ namespace palpate
     // At least 0.1 mm: below, a smooth random motion's speed scaling
     // divides by (nearly) zero and its positions are NaN.
     // A circle starts at rest and goes around through the point two radii
-    // away (Radius = Extent was offered and ran out of the state space to
-    // twice it: the fourteenth re-run); a random walk stays within Radius.
+    // away, so Radius = Extent leaves the state space (to twice it); a
+    // random walk stays within Radius.
     const double across = t.type == "circle" ? 2 : 1;
     if ((t.type == "circle" || t.type == "smooth random") &&
         across * t.radius > p.state_space.extent)
       throw error("Haptics/Trajectory/Radius",
-                  // (6 digits: 0.0501 said "goes 0.1 m", as if it fitted.)
+                  // (6 digits: with 3, 0.0501 would say "goes 0.1 m", as
+                  // if it fitted.)
                   "a " + t.type + " of radius " +
                     Utilities::to_string_exact(t.radius) + " m goes " +
                     Utilities::to_string_apart(across * t.radius,
@@ -2045,8 +2047,8 @@ namespace palpate
                   "give the speed in m/s: 0.01 is 1 cm/s, a careful "
                   "palpation; 0.03 m/s is fast.");
     // A motion that moves the probe less than 0.1 mm is no motion: with
-    // Speed = 0 (or 1e-300) the run held the probe at rest, rendered 0 N
-    // and ended with exit 0 (the eighth re-run).
+    // Speed = 0 (or 1e-300) the run would hold the probe at rest, render
+    // 0 N and end with exit 0, as if a motion had been rendered.
     if ((t.type == "straight line" || t.type == "circle" ||
          t.type == "smooth random") &&
         !(t.speed * t.duration >= min_motion_length))
@@ -2089,8 +2091,7 @@ namespace palpate
                   "give the most disk space the frames may take in MiB, "
                   "e.g. 1000.");
     // Below one megabyte not even a dozen frames of a small liver fit:
-    // with 0 the run wrote no frame and said nothing was wrong (the eighth
-    // re-run).
+    // with 0 the run would write no frame and say nothing was wrong.
     if (p.effects.shape_output &&
         !(p.effects.shape_output_limit >= min_shape_output_limit))
       throw error("Effects/Shape output limit",
