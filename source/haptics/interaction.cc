@@ -418,8 +418,8 @@ namespace palpate
     // timeout and the re-planning after it: held too, not faded.
     // Once held for that, it stays held until the cell is complete again:
     // the servers that come back (SIGCONT) still have the late states to
-    // compute, and the force faded from 8 N to 0 in 0.15 s the moment they
-    // were heard again (the sixth re-run).
+    // compute, and were the force faded the moment they are heard again,
+    // an 8 N force would drop to 0 within 0.15 s.
     const bool server_trouble =
       cause == MissingCause::not_computed &&
       (s.engine->degraded() ||
@@ -429,9 +429,9 @@ namespace palpate
     // state space's edge also before it (the HIP got there before any cell
     // was complete: zero force, with nothing to hold, is reported too); and
     // data not computed yet once the HIP has left its rest position, where
-    // the force is no longer zero (Start = immediately: the hand pushed
-    // 7 mm into the liver at 0 N before the first cell was complete, and
-    // no event was counted). At rest the zero force is the right one.
+    // the force is no longer zero (Start = immediately: the hand can push
+    // 7 mm into the liver at 0 N before the first cell is complete, and
+    // that must be counted). At rest the zero force is the right one.
     const bool moved =
       finite && Utilities::norm(position) > 1e-3 * s.grid.spacing();
     const bool event =
@@ -600,9 +600,9 @@ namespace palpate
       // What the grid, the cache, the mesh and the engine's threads were
       // built for cannot change here.
       const Parameters::AllParameters &o = scene.parameters;
-      // The Mesh subsection is compared as a whole: field by field, the
-      // surface settings were left out, and a live change of them was
-      // accepted and then ignored.
+      // The Mesh subsection is compared as a whole: a field-by-field list
+      // misses the fields nobody added to it (the surface settings), and a
+      // live change of one would be accepted and then ignored.
       const char *fixed = nullptr;
       if (o.mesh != parameters.mesh)
         fixed = "Mesh";

@@ -391,9 +391,9 @@ namespace palpate
         farthest = std::max(farthest, Utilities::norm(points[k]));
       }
     // A recording that does not move is no motion, as Speed = 0 is not
-    // (Scene::check_haptics): a single line, 2,000 lines at one position,
-    // or 2,000 lines within 0.2 ms ran with 0 N and exit 0 (the ninth
-    // re-run).
+    // (Scene::check_haptics): a single line, or many lines at one position
+    // or within a fraction of a millisecond, would replay as 0 N and exit 0,
+    // as if a motion had been rendered.
     if (times.back() < Limits::min_replay_duration)
       throw InputError(filename,
                        0,
@@ -417,13 +417,13 @@ namespace palpate
                          " m (0.1 mm) of motion are needed for the force to "
                          "change",
                        "record a motion, with the positions in metres.");
-    // Times in milliseconds read as seconds: a 2 s stroke of 2,000 lines
-    // ran as 1,999 s at micrometres per second with no word (the twelfth
-    // re-run). A device records at 100 Hz - 1 kHz: a long recording whose
-    // lines are typically half a second or more apart is one in
-    // milliseconds (1 - 10 apart). An average speed said it less well: a
-    // 99 ms stroke written in ms ran as 99 s, and a slow 61 s recording
-    // in seconds was refused (the thirteenth re-run).
+    // Times in milliseconds read as seconds would replay a 2 s stroke of
+    // 2,000 lines as 1,999 s at micrometres per second, without a word. A
+    // device records at 100 Hz - 1 kHz: a long recording whose lines are
+    // typically half a second or more apart is one in milliseconds (1 - 10
+    // apart). The median step tells them apart where an average speed
+    // cannot: a 99 ms stroke written in ms reads as a plausible 99 s one,
+    // and a slow 61 s recording in seconds looks as slow as one in ms.
     if (times.size() >= 100)
       {
         std::vector<double> steps(times.size() - 1);
