@@ -496,9 +496,9 @@ namespace palpate
                          "the volume mesh is written as Gmsh 2.2, so its "
                          "name must end in .msh",
                          "e.g. 'palpate mesh " + args[1] + " organ.msh'.");
-      // A link to nowhere was replaced by the mesh and its target made
-      // empty; a file of the user's that is no mesh was overwritten (the
-      // fifteenth re-run).
+      // A link to nowhere would be replaced by the mesh (its target left
+      // empty), and a file of the user's that is no mesh overwritten: both
+      // are refused.
       if (const std::string link = dangling_link(args[2]); !link.empty())
         throw InputError("command line",
                          0,
@@ -880,10 +880,10 @@ namespace palpate
                          "use it with a scene: 'palpate SCENE.prm --set "
                          "ENTRY=VALUE', or with solve, study, precompute or "
                          "serve.");
-      // Asked anywhere (`palpate solve --help` read it as the scene, the
-      // sixteenth re-run), or as `palpate help`: the usage, which gives
-      // every command's arguments (`palpate help solve` too: the usage
-      // is one page for all commands).
+      // Asked anywhere (else `palpate solve --help` would read --help as
+      // the scene), or as `palpate help`: the usage, which gives every
+      // command's arguments (`palpate help solve` too: the usage is one
+      // page for all commands).
       const bool asks_help = std::any_of(args.begin(),
                                          args.end(),
                                          [](const std::string &a) {
@@ -931,11 +931,10 @@ namespace palpate
         return run_precompute_command(args, settings, out);
       if (args[0] == "study")
         return run_study_command(args, settings, out);
-      // "palpate slove scene.prm" blamed the scene as an unexpected
-      // argument (the thirteenth re-run): a first word that is no file,
-      // followed by more, is a command mistyped.
-      // Alone, a word two edits from a command is one too ("palpate
-      // slove" said the file 'slove' does not exist).
+      // A first word that is no file, followed by more, is a command
+      // mistyped ("palpate slove scene.prm"), not a scene with an
+      // unexpected argument. Alone, a word two edits from a command is one
+      // too ("palpate slove" is not a file 'slove' that does not exist).
       if ((args.size() > 1 || !nearest_command(args[0]).empty()) &&
           args[0].find('/') == std::string::npos &&
           std::filesystem::path(args[0]).extension() != ".prm" &&

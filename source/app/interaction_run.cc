@@ -39,8 +39,9 @@ namespace palpate
   check_output_directory(const Scene &scene)
   {
     const std::string &directory = scene.parameters.output.directory;
-    // A link to nowhere said "cannot be created: File exists" (the
-    // sixteenth re-run): say what it is, as every other path does.
+    // A link to nowhere: say what it is, as every other path does
+    // (create_directories() would only say "cannot be created: File
+    // exists").
     std::string problem = dangling_link(directory);
     if (problem.empty())
       try
@@ -85,8 +86,8 @@ namespace palpate
 
     /**
      * Two interactions of one scene into one Output / Directory would write
-     * the same files: two runs started 0.3 s apart both said "wrote", and
-     * the second's force log, summary and index were the first's. The run
+     * the same files: two runs started 0.3 s apart would both say "wrote",
+     * and one's force log, summary and index would be the other's. The run
      * that writes them holds an flock on DIRECTORY/STEM.lock (the kernel's
      * lock goes with the process, however it ends); a second one is refused
      * before it computes anything, naming the first.
@@ -341,9 +342,8 @@ namespace palpate
     {
       // A motion farther from rest than the body is across is a unit
       // mistake (a recording in millimetres read as metres), as solve's
-      // --to says of such a push: a replay moving 0.9 m over a 0.36 m
-      // liver ran with only the state space's warning (the thirteenth
-      // re-run).
+      // --to says of such a push; the state space's warning alone would
+      // let a replay moving 0.9 m over a 0.36 m liver run.
       const std::string farther =
         interaction->mesh().farther_than_across(device->planned_farthest());
       if (farther.empty())

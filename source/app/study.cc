@@ -104,9 +104,9 @@ namespace palpate
             return 127;
           if (stop.signal_number() != 0)
             {
-              // SIGTERM, and after 2 s SIGKILL to the whole group (a plot
-              // that ignored SIGTERM hung the study for good: the
-              // thirteenth re-run).
+              // SIGTERM, and after 2 s SIGKILL to the whole group: a plot
+              // that ignores SIGTERM would otherwise hang the study for
+              // good.
               ::kill(-child, SIGTERM);
               for (unsigned int k = 0;
                    k < 100 && waitpid(child, &status, WNOHANG) == 0;
@@ -930,16 +930,16 @@ namespace palpate
               throw InputError(
                 "command line", 0, "--csv " + result.csv_file, problem, fix);
             };
-            // Names that do not say a file: the default name was used for
-            // an empty one, a file named "-" made for standard output,
-            // and "x.csv/" refused as a missing directory (the thirteenth
-            // re-run).
+            // Names that do not say a file are refused with what to give:
+            // otherwise an empty one would silently take the default name,
+            // "-" would make a file of that name rather than mean standard
+            // output, and "x.csv/" would be blamed as a missing directory.
             if (result.csv_file.empty())
               refuse("the file name is empty",
                      "name the table, e.g. --csv study.csv, or leave --csv "
                      "out to write it to Output / Directory.");
             // A name like an option or of blanks only is a slip, not a file
-            // to make in the working directory (the fourteenth re-run).
+            // to make in the working directory.
             if (result.csv_file.front() == '-' && result.csv_file != "-")
               refuse("the name begins with '-', like an option",
                      "name the table, e.g. --csv study.csv (a file whose "
@@ -1686,9 +1686,9 @@ namespace palpate
           "accuracy_pareto.py";
         std::filesystem::path png(result.csv_file);
         png.replace_extension(".png");
-        // Quoted for a shell, as the user will paste it: a name with an
-        // apostrophe broke the command, and a scene's Output / Directory
-        // of ';touch PWNED;' ran one when pasted (the thirteenth re-run).
+        // Quoted for a shell, as the user will paste it: unquoted, a name
+        // with an apostrophe breaks the command, and a scene's Output /
+        // Directory of ';touch PWNED;' runs one when pasted.
         const auto quoted = [](const std::string &word) {
           std::string q = "'";
           for (const char c : word)

@@ -106,10 +106,10 @@ namespace palpate
     if (!initialized)
       {
         // A stop signal during MPI's start-up (a singleton starts Open
-        // MPI's orted and talks to it) killed palpate in the middle of
-        // that talk, and orted printed "ORTE_ERROR_LOG: Broken pipe" (the
-        // sixth re-run). Held until the start-up is done, the signal then
-        // ends palpate as before, with orted no longer waiting for it.
+        // MPI's orted and talks to it) would kill palpate in the middle of
+        // that talk, and orted would print "ORTE_ERROR_LOG: Broken pipe".
+        // Held until the start-up is done, the signal then ends palpate,
+        // with orted no longer waiting for it.
         sigset_t stops, before;
         sigemptyset(&stops);
         sigaddset(&stops, SIGINT);

@@ -347,9 +347,10 @@ namespace palpate
     // A point around rest that failed from its neighbour is solved again
     // from rest: the path on which a sphere's offered radius was tried
     // (select_nodes() solves the 26 points around rest from rest). The path
-    // matters on a nonlinear model: the twentieth re-run's liver-stvk Node
-    // id 47 with a 0.0249 m sphere converged at all 26 from rest, one
-    // failed from its neighbour, and the force was lost at rest.
+    // matters on a nonlinear model: on liver-stvk.prm at Node id 47 a
+    // 0.0249 m sphere converges at all 26 from rest, yet one fails from
+    // its neighbour, and without this the force would be lost at rest
+    // (the test engine/rest_retry).
     const unsigned int origin = grid.linear({{0, 0, 0}});
     if (!result.converged && result.status != SolveStatus::stopped &&
         task.source != origin && grid.beside_origin(task.target))

@@ -31,17 +31,17 @@
 // which set SIGTERM and SIGABRT to a handler that longjmps back into
 // METIS, and then put the previous handler back with signal(): with
 // glibc's System V semantics (SA_RESETHAND), so palpate's stop handler
-// came back as a one-shot. A second SIGTERM within the 0.5 s that make
-// two deliveries one stop (`timeout` signals a process and its group)
-// then killed `palpate precompute` at once: no stop summary, the store's
-// lock left (the tenth re-run, L1). And a stop signal during METIS would
-// have run GKlib's longjmp in whatever thread took it. palpate defines
+// would come back as a one-shot. A second SIGTERM within the 0.5 s that
+// make two deliveries one stop (`timeout` signals a process and its
+// group) would then kill `palpate precompute` at once: no stop summary,
+// the store's lock left. And a stop signal during METIS would run
+// GKlib's longjmp in whatever thread took it. palpate defines
 // the two functions itself (the dynamic linker binds libmetis's calls to
 // the first definition, and libpalpate is searched before libmetis):
 // they keep GKlib's jump-buffer count, which its setjmp indexes, and
 // leave the signal dispositions alone. What GKlib loses is turning its
 // own fatal errors (out of memory) into a METIS_ERROR return; these
-// now end the process as they would outside a METIS call.
+// end the process as they would outside a METIS call.
 extern "C"
 {
   // GKlib: the calling thread's innermost jump buffer, -1 if none.

@@ -75,9 +75,8 @@ namespace palpate
         "use -1 < nu < 0.5; soft tissue has nu close to 0.5.");
     // Linear and quadratic displacement elements lock as nu nears 0.5:
     // on liver-stvk.prm's 3 cm push (solve) 0.49 renders 3.43 N, 0.4999
-    // 26.3 N; 0.4999999 rendered 3,817 N with exit 0 in an interaction
-    // (the ninth re-run): the force is then the locking's, not the
-    // tissue's.
+    // 26.3 N, and 0.4999999 thousands of newtons with exit 0: the force is
+    // then the locking's, not the tissue's.
     if (nu > max_compressible_nu)
       throw Plugins::EntryError(
         entry,
@@ -89,8 +88,8 @@ namespace palpate
         "use nu <= 0.4999 (0.49 is the paper's value), or Mooney-Rivlin, "
         "whose mixed formulation keeps the volume without locking.");
     // Near -1 the shear modulus E/(2(1+nu)) dwarfs the bulk modulus by
-    // many orders: with -0.9999999 every state of an interaction failed
-    // and the run rendered 0 N with exit 0 (the ninth re-run).
+    // many orders: with -0.9999999 every state of an interaction fails
+    // and the run would render 0 N with exit 0.
     if (nu < min_compressible_nu)
       throw Plugins::EntryError(
         entry,
@@ -442,8 +441,8 @@ namespace palpate
     // is negative, and the last term, quadratic in ln J, outgrows the
     // others as an element is crushed (J -> 0): the energy falls without
     // bound and a deep enough push has no equilibrium. On liver-stvk.prm's
-    // 3 cm push nu = -0.6 still converged, -0.7 to -0.9 were failure
-    // points (the tenth re-run; St.Venant-Kirchhoff solves at -0.9).
+    // 3 cm push nu = -0.6 still converges, -0.7 to -0.9 are failure
+    // points (St.Venant-Kirchhoff solves at -0.9).
     if (nu < 0)
       throw Plugins::EntryError(
         "Poisson's ratio",

@@ -24,8 +24,8 @@ namespace palpate
         // one before: how far a failure point got. Its last increment may
         // converge and the end still be refused (the sphere through the
         // surface, a non-finite force): then it got as far as the one
-        // before (the eighteenth re-run's F1 said "converged" so and
-        // offered a failure point).
+        // before, and counting the last would call a failure point
+        // converged and offer its radius.
         double reached = 0, before = 0;
         solver.set_increment_observer(
           [&reached, &before](const State &, const double t) {

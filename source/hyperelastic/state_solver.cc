@@ -711,8 +711,8 @@ namespace palpate
         // All the Newton iterations one solve may take, its increments,
         // cutbacks and retries together: each limit alone is bounded, but
         // 1000 increments, 1000 iterations each and 30 cutbacks together
-        // ran for minutes (the sixth re-run). A state takes 4-8 per
-        // increment; this is far beyond any that converges.
+        // run for minutes. A state takes 4-8 per increment; this is far
+        // beyond any that converges.
         if (state.newton_iterations >= work_limit)
           {
             x       = saved; // the last equilibrium, not the predictor's guess

@@ -111,9 +111,9 @@ namespace palpate
     /**
      * Give up the states being computed at their next Newton iteration,
      * so that the stop() after it returns within an iteration: on a stop
-     * signal the user wants the run to end, not the states in flight (a
-     * SIGTERM in the graded liver's initial cloud waited 6 s for them: the
-     * thirteenth re-run). Nothing of them is kept. By default they finish.
+     * signal the user wants the run to end, not the states in flight (in
+     * the graded liver's initial cloud, waiting for them takes seconds).
+     * Nothing of them is kept. By default they finish.
      */
     virtual void
     abandon_running()

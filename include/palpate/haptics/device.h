@@ -83,7 +83,7 @@ namespace palpate
     /** The planned displacement from rest that goes farthest against
      * @p outward (a unit normal: the deepest into the body), where the
      * motion is known in advance; zero if not. A circle's deepest point
-     * need not be its farthest (the thirteenth re-run). */
+     * need not be its farthest, so the sphere's checks ask both. */
     virtual Utilities::Point3
     planned_deepest(const Utilities::Point3 &outward) const
     {
