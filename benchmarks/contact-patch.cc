@@ -6,24 +6,28 @@
 //
 // The force between the states with the sphere (issue 45): on the shipped
 // indenter liver (parameters/liver-indenter.prm, 2,012 nodes) and on the
-// blob generator's organ (3 refinements, 2,197 nodes) touched by a 15 mm
-// sphere (the smallest palpate accepts on its 18 mm surface triangles), HIP
-// positions on sweeps that cross contact onset (5 mm above the surface to 8 mm
-// deep, on the normal and beside it), slide along the surface at 2, 4 and 6 mm
-// depth, and press deep along the scene's stroke. At each, the force a
-// haptic loop renders from grid states (trilinear, tricubic Hermite,
-// contact patch) against a direct solve there:
+// blob generator's organ meshed as the liver is (its surface from
+// blob_shape(), 4 mm elements under the probe: 1,889 nodes), both touched
+// by the liver scene's 1 cm sphere, HIP positions on sweeps that cross contact
+// onset (5 mm above the surface to 8 mm deep, on the normal and beside it),
+// slide along the surface at 2, 4 and 6 mm depth, and press deep along the
+// scene's stroke. At each, the force a haptic loop renders from grid states
+// (trilinear, tricubic Hermite, contact patch) against a direct solve there:
 //   err = |f_rendered - f_direct| / max(|f_direct|, 0.05 N).
 // Grid states are computed as the engine computes them (each from a
 // computed neighbour, the scene's solver with Contact solver = condensed,
 // stiffness and patch on), for every corner of a cell a sweep visits and
 // those corners' neighbours (the cross derivatives of Hermite need them).
 // A sample whose cell has a failure point for a corner is left out and
-// counted (`uncovered`).
+// counted (`uncovered`). patch_plain: the corners' patch forces blended by
+// the trilinear weights alone, without PatchContact::blend()'s confidence,
+// in the same run.
 //
 // tick_us_p999: the contact patch's time per tick, replaying the sweeps at
 // 20 ticks between neighbouring samples (the sphere moving about 0.05 mm a
-// tick) in one thread, as the haptic loop calls it.
+// tick) in one thread, as the haptic loop calls it; held_tick_us_p999: as
+// many ticks with the HIP held still (the same work each tick), this VM's
+// jitter for a tick of that size in the same run.
 //
 // Targets: contact patch at 10 mm: err_p95_pct <= 3.5, err_max_pct <= 7,
 // tick_us_p999 <= 100, and below Hermite's error at the same spacing.
@@ -447,7 +451,9 @@ namespace
         row.interpolation = "contact_patch";
         row.spacing_mm    = 1e3 * h;
         row.states_per_cm = path_corners.size() / path_cm;
-        std::vector<double> err, tick_us;
+        std::vector<double> err, tick_us, err_plain;
+        PatchContact        plain_contact(contact.size(), 256);
+        Point3              f_plain;
         unsigned int        unsettled = 0;
         std::size_t         sample    = 0;
         auto                tick      = [&](const Point3 &x, Point3 &f) {
@@ -465,10 +471,22 @@ namespace
               patches[c] = s->contact_patch.get();
             }
           std::array<double, 9> K;
+          const auto            w = trilinear_weights(local);
           const auto            start = std::chrono::steady_clock::now();
-          if (!patch_contact.blend(patches, trilinear_weights(local), x, f, &K))
+          if (!patch_contact.blend(patches, w, x, f, &K))
             ++unsettled;
           tick_us.push_back(1e6 * Utilities::seconds_since(start));
+          // The corners' forces blended by the trilinear weights alone,
+          // without the confidence (a solver of its own: the same warm
+          // starts), for comparison.
+          f_plain = {{0, 0, 0}};
+          for (unsigned int c = 0; c < 8; ++c)
+            if (w[c] != 0)
+              {
+                Point3 fc;
+                plain_contact.force(*patches[c], x, fc);
+                f_plain = add(f_plain, fc, w[c]);
+              }
           return true;
         };
         for (const auto &line : direct_lines)
@@ -492,6 +510,7 @@ namespace
                   continue;
                 }
               err.push_back(error_pct(f, f_direct[sample]));
+              err_plain.push_back(error_pct(f_plain, f_direct[sample]));
               if (o.verbose)
                 print_sample(row.interpolation,
                              samples[sample],
@@ -521,8 +540,15 @@ namespace
         row.held_p50  = percentile(held_us, 0.5);
         row.held_p999 = percentile(held_us, 0.999);
         rows.push_back(row);
+        Row plain           = row;
+        plain.interpolation = "patch_plain";
+        plain.p95           = percentile(err_plain, 0.95);
+        plain.max           = percentile(err_plain, 1.0);
+        plain.tick_p999 = plain.held_p999 = 0;
+        rows.push_back(plain);
         std::cout << "  contact_patch: p95 " << row.p95 << " %, max " << row.max
-                  << " %" << std::endl;
+                  << " %; the corners' forces blended trilinearly alone: p95 "
+                  << plain.p95 << " %, max " << plain.max << " %" << std::endl;
         std::cout << "  contact patch: " << tick_us.size() << " ticks ("
                   << unsettled << " not settled), p50 "
                   << percentile(tick_us, 0.5) << " us, p99 "

@@ -357,6 +357,7 @@ namespace palpate
     if (stiffness)
       stiffness->fill(0.0);
     bool                  settled = true;
+    double                total   = 0;
     Utilities::Point3     f;
     std::array<double, 9> k;
     for (unsigned int c = 0; c < 8; ++c)
@@ -365,11 +366,27 @@ namespace palpate
           continue;
         settled =
           this->force(*corners[c], x, f, stiffness ? &k : nullptr) && settled;
+        // A corner pressing harder than the contact at x does is trusted
+        // less (see blend() in the header).
+        const double own = Utilities::norm(corners[c]->force);
+        const double d =
+          std::max(0.0, own - Utilities::norm(f)) / (own + force_floor);
+        const double ratio = d / confidence_scale;
+        const double w     = weights[c] / (1 + ratio * ratio);
+        total += w;
         for (unsigned int a = 0; a < 3; ++a)
-          force[a] += weights[c] * f[a];
+          force[a] += w * f[a];
         if (stiffness)
           for (unsigned int e = 0; e < 9; ++e)
-            (*stiffness)[e] += weights[c] * k[e];
+            (*stiffness)[e] += w * k[e];
+      }
+    if (total > 0)
+      {
+        for (unsigned int a = 0; a < 3; ++a)
+          force[a] /= total;
+        if (stiffness)
+          for (unsigned int e = 0; e < 9; ++e)
+            (*stiffness)[e] /= total;
       }
     return settled;
   }

@@ -103,6 +103,8 @@ namespace palpate
         for (unsigned int a = 0; a < 3; ++a)
           patch->position[3 * i + a] = patch->center[a] + r.rho * r.n[a];
         patch->lambda[i] = std::max(0.0, r.lambda_hat);
+        for (unsigned int a = 0; a < 3; ++a)
+          patch->force[a] -= patch->lambda[i] * r.n[a];
         patch->offset[i] =
           patch->lambda[i] > 0 ? -r.gap : std::max(0.0, -r.gap);
       }

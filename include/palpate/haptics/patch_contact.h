@@ -25,7 +25,7 @@ namespace palpate
    * resultant -sum lambda_i nu_i. F_k is exactly zero while the sphere is
    * off the corner's free surface, grows as the sphere's geometry and the
    * tissue's compliance say from the moment it touches, and is the state's
-   * own force at the corner. The rendered force is their trilinear blend:
+   * own force at the corner. The rendered force is their blend (blend()):
    * the state's force at every grid point, continuous everywhere, zero
    * where no corner's surface is touched.
    *
@@ -65,9 +65,27 @@ namespace palpate
           std::array<double, 9>   *stiffness = nullptr) noexcept;
 
     /**
-     * The rendered force at @p x: the blend by @p weights of the forces of
-     * the @p corners' patches (weight 0: not solved); @p stiffness as
-     * force(). Returns whether every problem settled.
+     * The rendered force at @p x from the forces F_k(x) of the @p corners'
+     * patches (weight 0: not solved), @p stiffness likewise from theirs (as
+     * force()). Returns whether every problem settled.
+     *
+     * Each corner's model is a linearisation about its state, and one
+     * direction of it is poor: from a state pressed deeper than the
+     * contact at x. Its free surface x - H f_s, the state's forces taken
+     * off with the tangent compliance, is not the tissue's rest surface
+     * (on the liver, 1-3 mm nearer the sphere for states pressed 10 mm
+     * deep), so its model touches early at a shallow HIP; a corner pressed
+     * less, or not at all, has a free surface near the rest surface and
+     * the contact's geometry exact. The blend therefore weights each corner
+     * by @p weights w_k (trilinear) times a confidence
+     * c_k = 1 / (1 + (d_k / tau)^2), d_k = max(0, |F_k| - |F_k(x)|) /
+     * (|F_k| + force_floor), with F_k the state's force, and normalises:
+     *
+     *   F(x) = sum_k w_k c_k F_k(x) / sum_k w_k c_k.
+     *
+     * At a grid point w is 1 for its corner (the state's force); the c_k are
+     * continuous and positive, so F is continuous; it is zero where every
+     * F_k is.
      */
     bool
     blend(const std::array<const ContactPatch *, 8> &corners,
@@ -78,6 +96,17 @@ namespace palpate
 
     /** The most active-set iterations one call may take. */
     static constexpr unsigned int max_iterations = 12;
+
+    /** tau of the blend's confidence: a corner whose force at the HIP is
+     * 60 % of its state's keeps half its weight, at 20 % a fifth
+     * (doc/benchmarks/contact-patch.md: 0.2-0.4 alike on the liver, 0.4
+     * best on the beam). */
+    static constexpr double confidence_scale = 0.4;
+
+    /** Forces below this (N) are compared by their difference, not their
+     * ratio: the force a hand tells apart from none, the floor of the
+     * benchmark's error measure. */
+    static constexpr double force_floor = 0.05;
 
   private:
     /** A patch's warm start: its last forces and active set, and the LU
@@ -115,12 +144,14 @@ namespace palpate
     bool
     factorize_active(const ContactPatch &patch, Slot &s) noexcept;
 
-    unsigned int                       max_nodes, max_active;
-    std::vector<Slot>                  slots;
-    std::uint64_t                      clock = 0;
-    std::vector<double>                q, w, rhs, rho;
-    std::vector<std::array<double, 3>> u;
-    std::vector<unsigned int>          loaded;
+    unsigned int                         max_nodes, max_active;
+    std::vector<Slot>                    slots;
+    std::uint64_t                        clock = 0;
+    std::vector<double>                  q, w, rhs, rho;
+    std::vector<std::array<double, 3>>   u;
+    std::vector<unsigned int>            loaded;
+    std::array<Utilities::Point3, 8>     corner_force;
+    std::array<std::array<double, 9>, 8> corner_stiffness;
   };
 } // namespace palpate
 

@@ -66,6 +66,9 @@ namespace palpate
     std::vector<double> position, normal, free_position;
     /** The state's contact forces on them (N). */
     std::vector<double> lambda;
+    /** Their resultant on the sphere, -sum lambda_i n_i (N): the state's
+     * force, which the patch gives at its own centre. */
+    Utilities::Point3 force = {{0, 0, 0}};
     /** o_i of the gaps (m). */
     std::vector<double> offset;
     /** H (3n x 3n, row-major, symmetric; m/N), in single precision: the
