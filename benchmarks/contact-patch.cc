@@ -45,6 +45,7 @@
 #include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
+#include <palpate/mesh/surface.h>
 #include <palpate/scene/scene.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
@@ -53,7 +54,6 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -100,62 +100,39 @@ namespace
   std::string
   write_blob_surface(const Point3 &semi_axes, const unsigned int levels)
   {
-    const double                             g = (1 + std::sqrt(5.0)) / 2;
-    std::vector<Point3>                      v = {{{-1, g, 0}},
-                                                  {{1, g, 0}},
-                                                  {{-1, -g, 0}},
-                                                  {{1, -g, 0}},
-                                                  {{0, -1, g}},
-                                                  {{0, 1, g}},
-                                                  {{0, -1, -g}},
-                                                  {{0, 1, -g}},
-                                                  {{g, 0, -1}},
-                                                  {{g, 0, 1}},
-                                                  {{-g, 0, -1}},
-                                                  {{-g, 0, 1}}};
-    std::vector<std::array<unsigned int, 3>> f = {
-      {{0, 11, 5}}, {{0, 5, 1}},  {{0, 1, 7}},   {{0, 7, 10}}, {{0, 10, 11}},
-      {{1, 5, 9}},  {{5, 11, 4}}, {{11, 10, 2}}, {{10, 7, 6}}, {{7, 1, 8}},
-      {{3, 9, 4}},  {{3, 4, 2}},  {{3, 2, 6}},   {{3, 6, 8}},  {{3, 8, 9}},
-      {{4, 9, 5}},  {{2, 4, 11}}, {{6, 2, 10}},  {{8, 6, 7}},  {{9, 8, 1}}};
-    for (Point3 &x : v)
-      x = unit(x);
-    for (unsigned int l = 0; l < levels; ++l)
+    const double g = (1 + std::sqrt(5.0)) / 2;
+    Surface      ball;
+    ball.vertices  = {{{-1, g, 0}},
+                      {{1, g, 0}},
+                      {{-1, -g, 0}},
+                      {{1, -g, 0}},
+                      {{0, -1, g}},
+                      {{0, 1, g}},
+                      {{0, -1, -g}},
+                      {{0, 1, -g}},
+                      {{g, 0, -1}},
+                      {{g, 0, 1}},
+                      {{-g, 0, -1}},
+                      {{-g, 0, 1}}};
+    ball.triangles = {{{0, 11, 5}},  {{0, 5, 1}},  {{0, 1, 7}},  {{0, 7, 10}},
+                      {{0, 10, 11}}, {{1, 5, 9}},  {{5, 11, 4}}, {{11, 10, 2}},
+                      {{10, 7, 6}},  {{7, 1, 8}},  {{3, 9, 4}},  {{3, 4, 2}},
+                      {{3, 2, 6}},   {{3, 6, 8}},  {{3, 8, 9}},  {{4, 9, 5}},
+                      {{2, 4, 11}},  {{6, 2, 10}}, {{8, 6, 7}},  {{9, 8, 1}}};
+    for (unsigned int l = 0; l <= levels; ++l)
       {
-        std::map<std::pair<unsigned int, unsigned int>, unsigned int> middle;
-        auto mid = [&](unsigned int a, unsigned int b) {
-          const auto key = std::minmax(a, b);
-          if (const auto m = middle.find(key); m != middle.end())
-            return m->second;
-          v.push_back(unit(add(v[a], v[b])));
-          return middle[key] = v.size() - 1;
-        };
-        std::vector<std::array<unsigned int, 3>> finer;
-        for (const auto &t : f)
-          {
-            const unsigned int a = mid(t[0], t[1]), b = mid(t[1], t[2]),
-                               c = mid(t[2], t[0]);
-            finer.push_back({{t[0], a, c}});
-            finer.push_back({{t[1], b, a}});
-            finer.push_back({{t[2], c, b}});
-            finer.push_back({{a, b, c}});
-          }
-        f = std::move(finer);
+        // Onto the unit sphere, then finer (the last level only projected).
+        for (Point3 &x : ball.vertices)
+          x = unit(x);
+        if (l < levels)
+          subdivide(ball);
       }
+    for (Point3 &x : ball.vertices)
+      x = blob_shape(x, semi_axes);
     const std::string file =
       (std::filesystem::temp_directory_path() / "palpate-blob-surface.obj")
         .string();
-    std::ofstream out(file);
-    out << std::setprecision(12);
-    for (const Point3 &x : v)
-      {
-        const Point3 y = blob_shape(x, semi_axes);
-        out << "v " << y[0] << ' ' << y[1] << ' ' << y[2] << '\n';
-      }
-    for (const auto &t : f)
-      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-    if (!out)
-      throw std::runtime_error("could not write " + file);
+    write_surface(ball, file, false, 1);
     return file;
   }
 
@@ -168,7 +145,7 @@ namespace
       "Nonlinear solver/Contact solver=condensed",
       "Nonlinear solver/Assembly threads=1"};
     if (body == "blob")
-      for (const std::string s : std::vector<std::string>{
+      for (const std::string &s : std::vector<std::string>{
              "Mesh/File name=" + write_blob_surface({{0.125, 0.09, 0.07}}, 5),
              "Mesh/Scale factor=1",
              "Boundary conditions/Fixed nodes/Half-space point=0, 0, -0.04",
