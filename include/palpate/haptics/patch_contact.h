@@ -73,8 +73,8 @@ namespace palpate
      * direction of it is poor: from a state pressed deeper than the
      * contact at x. Its free surface x - H f_s, the state's forces taken
      * off with the tangent compliance, is not the tissue's rest surface
-     * (on the liver, 1-3 mm nearer the sphere for states pressed 10 mm
-     * deep), so its model touches early at a shallow HIP; a corner pressed
+     * but nearer the sphere (doc/benchmarks/contact-patch.md measures it),
+     * so its model touches early at a shallow HIP; a corner pressed
      * less, or not at all, has a free surface near the rest surface and
      * the contact's geometry exact. The blend therefore weights each corner
      * by @p weights w_k (trilinear) times a confidence
@@ -144,14 +144,12 @@ namespace palpate
     bool
     factorize_active(const ContactPatch &patch, Slot &s) noexcept;
 
-    unsigned int                         max_nodes, max_active;
-    std::vector<Slot>                    slots;
-    std::uint64_t                        clock = 0;
-    std::vector<double>                  q, w, rhs, rho;
-    std::vector<std::array<double, 3>>   u;
-    std::vector<unsigned int>            loaded;
-    std::array<Utilities::Point3, 8>     corner_force;
-    std::array<std::array<double, 9>, 8> corner_stiffness;
+    unsigned int                       max_nodes, max_active;
+    std::vector<Slot>                  slots;
+    std::uint64_t                      clock = 0;
+    std::vector<double>                q, w, rhs, rho;
+    std::vector<std::array<double, 3>> u;
+    std::vector<unsigned int>          loaded;
   };
 } // namespace palpate
 
