@@ -32,6 +32,7 @@
 #include <palpate/engine/mpi_engine.h>
 #include <palpate/haptics/run_summary.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/mumps_library.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -347,6 +348,44 @@ namespace
     t.states          = s.states_computed;
     t.failures        = s.states_failed;
     t.passed = t.missing == 0 && s.initial_cloud_complete && !s.loop_truncated;
+    return t;
+  }
+
+  struct Throughput
+  {
+    unsigned int states  = 0;
+    double       seconds = 0;
+    std::string  mumps;
+  };
+
+  /**
+   * The thread engine's states per second with @p workers: the stroke
+   * scene's initial cloud (every grid point within @p radius of rest),
+   * timed until the motion may start. With @p private_copies false every
+   * solver calls the one MUMPS linked into palpate under its lock (the
+   * path before MumpsLibrary), as the reference in the same run.
+   */
+  Throughput
+  thread_throughput(const double       fine_size,
+                    const std::string &material,
+                    const unsigned int workers,
+                    const double       radius,
+                    const bool         private_copies)
+  {
+    const unsigned int limit = MumpsLibrary::max_private_copies();
+    MumpsLibrary::set_max_private_copies(private_copies ? limit : 0);
+    Scene scene = stroke_scene(fine_size, material, "threads");
+    scene.parameters.engine.workers              = workers;
+    scene.parameters.scheduler.cloud_radius      = radius;
+    scene.parameters.haptics.trajectory.speed    = 0.01;
+    scene.parameters.haptics.trajectory.duration = 0.02;
+    std::ostringstream quiet;
+    const RunSummary   s = run_interaction(quiet, scene);
+    Throughput         t;
+    t.states  = s.states_computed;
+    t.seconds = s.motion_start;
+    t.mumps   = MumpsLibrary::description();
+    MumpsLibrary::set_max_private_copies(limit);
     return t;
   }
 
@@ -673,6 +712,47 @@ run_benchmark(int argc, char **argv)
           }
         if (!o.stroke)
           continue;
+
+        // Part 3: states per second of the thread engine, one worker and
+        // two, each solver with a MUMPS of its own and (the reference)
+        // all sharing the linked one. Three grid steps around rest: about
+        // half the states press into the liver, up to 15 mm deep.
+        std::cout << "  thread engine, the initial cloud within "
+                  << 2e3 *
+                       (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
+                  << " mm of rest:\n";
+        for (const bool private_copies : {false, true})
+          {
+            double one = 0;
+            for (const unsigned int workers : {1u, 2u})
+              {
+                const double h =
+                  stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005;
+                const Throughput t = thread_throughput(
+                  size, material, workers, 3 * h, private_copies);
+                const double rate = t.seconds > 0 ? t.states / t.seconds : 0;
+                if (workers == 1)
+                  one = rate;
+                std::cout << "    " << workers << " worker(s), MUMPS "
+                          << (private_copies ? "per solver" : "shared") << ": "
+                          << t.states << " states in " << std::fixed
+                          << std::setprecision(1) << t.seconds << " s, "
+                          << std::setprecision(2) << rate << " states/s"
+                          << (workers == 2 && one > 0 ?
+                                " (" + Utilities::to_string(rate / one, 3) +
+                                  "x one worker)" :
+                                std::string())
+                          << std::defaultfloat << "\n      (" << t.mumps << ")"
+                          << std::endl;
+                results << "RESULT organ-speed mesh=" << name
+                        << " nodes=" << mesh.n_vertices()
+                        << " material=" << material
+                        << " engine=threads workers=" << workers << " mumps="
+                        << (private_copies ? "per_solver" : "shared")
+                        << " states=" << t.states << " states_per_s=" << rate
+                        << "\n";
+              }
+          }
 
         // Part 2: the stroke, with the last (all levers) configuration.
         const double state_ms = median(all.back().ms);

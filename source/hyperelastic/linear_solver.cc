@@ -4,6 +4,7 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/base/plugins.templates.h>
 #include <palpate/hyperelastic/linear_solver.h>
+#include <palpate/hyperelastic/mumps_library.h>
 #include <palpate/scene/parameters.h>
 
 #include <Amesos.h>
@@ -153,20 +154,6 @@ namespace palpate
       return position;
     }
 
-    /**
-     * Debian's MUMPS keeps the state of its load-balancing module in
-     * global (Fortran module) variables, so two instances that factorise at
-     * the same time corrupt each other ("PB allocation in DMUMPS_LOAD_INIT",
-     * then a crash). Every MUMPS call in the process therefore holds this
-     * lock; solver workers still assemble and line-search in parallel.
-     */
-    std::mutex &
-    mumps_lock()
-    {
-      static std::mutex m;
-      return m;
-    }
-
     // ------------------------------------------------------------------
     // MUMPS through its C interface.
     //
@@ -181,13 +168,8 @@ namespace palpate
     /** MUMPS in double precision (DMUMPS), the default. */
     struct Double
     {
-      using Struct = DMUMPS_STRUC_C;
-      using Real   = double;
-      static void
-      call(Struct *id)
-      {
-        dmumps_c(id);
-      }
+      using Struct                = DMUMPS_STRUC_C;
+      using Real                  = double;
       static constexpr bool exact = true;
     };
 
@@ -201,13 +183,8 @@ namespace palpate
      */
     struct Single
     {
-      using Struct = SMUMPS_STRUC_C;
-      using Real   = float;
-      static void
-      call(Struct *id)
-      {
-        smumps_c(id);
-      }
+      using Struct                = SMUMPS_STRUC_C;
+      using Real                  = float;
       static constexpr bool exact = false;
     };
 
@@ -218,7 +195,8 @@ namespace palpate
       using Real = typename Precision::Real;
 
       explicit Mumps(const std::string &ordering)
-        : ordering_name(ordering)
+        : library(MumpsLibrary::acquire())
+        , ordering_name(ordering)
       {
         // METIS is not compiled into Debian's MUMPS (it would silently
         // fall back to AMF), so palpate computes the METIS nested
@@ -240,9 +218,9 @@ namespace palpate
       {
         if (initialized)
           {
-            std::lock_guard<std::mutex> lock(mumps_lock());
-            id.job = -2;
-            Precision::call(&id);
+            const auto lock = library.lock();
+            id.job          = -2;
+            library.call(&id);
           }
       }
 
@@ -269,7 +247,7 @@ namespace palpate
               }
         values.resize(upper.size());
 
-        std::lock_guard<std::mutex> lock(mumps_lock());
+        const auto lock = library.lock();
         // A new analysis starts from a new MUMPS instance: the old one is
         // terminated first (JOB = -2 frees its analysis and factors).
         // Calling JOB = -1 over a live instance would lose it and all it
@@ -281,7 +259,7 @@ namespace palpate
         if (initialized)
           {
             id.job = -2;
-            Precision::call(&id);
+            library.call(&id);
             initialized = false;
             id          = {};
           }
@@ -306,7 +284,7 @@ namespace palpate
             id.perm_in  = permutation.data();
           }
         id.job = 1; // analysis
-        Precision::call(&id);
+        library.call(&id);
         if (id.infog[0] < 0)
           throw std::runtime_error("MUMPS analysis failed, INFOG(1) = " +
                                    std::to_string(id.infog[0]));
@@ -334,15 +312,15 @@ namespace palpate
                          "precision) too large entries";
             return false;
           }
-        id.a = values.data();
-        std::lock_guard<std::mutex> lock(mumps_lock());
+        id.a            = values.data();
+        const auto lock = library.lock();
         // -8, -9, -17, -20: a workspace was too small (e.g. many delayed
         // pivots); enlarge it for this factorisation and retry.
         const MUMPS_INT margin = id.icntl[13];
         for (unsigned int attempt = 0; attempt < 5; ++attempt)
           {
             id.job = 2;
-            Precision::call(&id);
+            library.call(&id);
             const int e = id.infog[0];
             if (e != -8 && e != -9 && e != -17 && e != -20)
               break;
@@ -392,7 +370,7 @@ namespace palpate
         {
           if constexpr (!Precision::exact)
             work.assign(rhs.begin(), rhs.end());
-          std::lock_guard<std::mutex> lock(mumps_lock());
+          const auto lock = library.lock();
           if constexpr (Precision::exact)
             id.rhs = rhs.data();
           else
@@ -408,7 +386,7 @@ namespace palpate
               id.rhs_sparse  = sparse_value.data();
             }
           id.job = 3;
-          Precision::call(&id);
+          library.call(&id);
           id.nrhs      = 1;
           id.icntl[19] = 0;
         }
@@ -470,8 +448,8 @@ namespace palpate
         id.job          = -1; // initialise an instance
         id.par          = 1;  // this process works
         id.sym          = 2;  // general symmetric: LDL^T with 2x2 pivots
-        id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(MPI_COMM_SELF));
-        Precision::call(&id);
+        id.comm_fortran = library.fortran_communicator();
+        library.call(&id);
         const MUMPS_INT error = std::min(id.infog[0], id.info[0]);
         if (error < 0)
           {
@@ -487,6 +465,9 @@ namespace palpate
         initialized = true;
       }
 
+      /** The copy of MUMPS this solver calls: its own where one could be
+       * loaded, so that solver workers factorise at the same time. */
+      MumpsLibrary::Lease        library;
       typename Precision::Struct id          = {};
       bool                       initialized = false;
       int                        ordering_code;
@@ -719,7 +700,7 @@ namespace palpate
       mumps_guard() const
       {
         return type == "Amesos_Mumps" ?
-                 std::unique_lock<std::mutex>(mumps_lock()) :
+                 std::unique_lock<std::mutex>(MumpsLibrary::shared_lock()) :
                  std::unique_lock<std::mutex>();
       }
 
@@ -741,9 +722,9 @@ namespace palpate
         problem = std::make_unique<Epetra_LinearProblem>(matrix.get(),
                                                          x.get(),
                                                          b.get());
-        // Amesos_Mumps is MUMPS too, with the same global state: it takes
-        // the same lock as our own MUMPS (found by the concurrent-workers
-        // test, which crashed in MUMPS's load module without it).
+        // Amesos_Mumps calls the MUMPS linked into palpate, whose global
+        // state the solvers without a private copy share: it takes their
+        // lock (MumpsLibrary).
         const auto lock = mumps_guard();
         Amesos     factory;
         solver.reset(factory.Create(type, *problem));
