@@ -85,6 +85,10 @@ namespace
     /** Cores for one state (part 1): assembly threads and BLAS threads in
      * the factorisation (the second level of parallelism). */
     unsigned int cores = 1;
+    /** Part 1 with the scene's interpolation (Hermite: every state also
+     * makes the probe's stiffness, from factors of its own) or, with
+     * --interpolation trilinear, without derivatives. */
+    std::string interpolation;
   };
 
   /** A solver configuration: the scene's settings with some levers. */
@@ -208,9 +212,9 @@ namespace
                     << "  step " << r.step_length << "  "
                     << (r.factorized ? "factorised" : "GMRES ")
                     << (r.factorized ? "" : std::to_string(r.krylov_iterations))
-                    << "  asm " << 1e3 * r.assembly_time << " solve "
-                    << 1e3 * r.solve_time << " ls " << 1e3 * r.line_search_time
-                    << " ms\n";
+                    << (r.accelerated ? " accelerated" : "") << "  asm "
+                    << 1e3 * r.assembly_time << " solve " << 1e3 * r.solve_time
+                    << " ls " << 1e3 * r.line_search_time << " ms\n";
               }
             for (const auto &r : s.history)
               {
@@ -246,14 +250,33 @@ namespace
     return m;
   }
 
-  /** The stroke's grid (--spacing, --hermite): 0 keeps the scene's 5 mm,
-   * false is trilinear interpolation (the rounds' stroke). What accuracy costs
-   * in time: a coarser Hermite grid needs fewer states per millimetre of
-   * stroke. */
+  /** The stroke's grid (--spacing, --hermite, --patch): 0 keeps the
+   * scene's 5 mm; trilinear interpolation unless named (the rounds'
+   * stroke). What accuracy costs in time: a coarser grid needs fewer
+   * states per millimetre of stroke; the contact patch is accurate at
+   * 10 mm (doc/benchmarks/contact-patch.md). */
   struct StrokeGrid
   {
     double spacing = 0; // m
-    bool   hermite = false;
+    /** 0 trilinear, 1 tricubic Hermite, 2 contact patch. */
+    unsigned int interpolation = 0;
+
+    std::string
+    interpolation_name() const
+    {
+      return interpolation == 1 ? "tricubic Hermite" :
+             interpolation == 2 ? "contact patch" :
+                                  "trilinear";
+    }
+
+    /** As the RESULT line names it. */
+    std::string
+    interpolation_key() const
+    {
+      return interpolation == 1 ? "hermite" :
+             interpolation == 2 ? "contact_patch" :
+                                  "trilinear";
+    }
     /** Contact solver = condensed (--stroke-contact condensed, the
      * default) or in matrix (--stroke-contact matrix). */
     bool condensed = true;
@@ -271,8 +294,7 @@ namespace
       p.state_space.grid_spacing = stroke_grid.spacing;
     // Named in the RESULT line, so set either way (the scene's own is
     // Hermite since 2026-11-27).
-    p.state_space.interpolation =
-      stroke_grid.hermite ? "tricubic Hermite" : "trilinear";
+    p.state_space.interpolation             = stroke_grid.interpolation_name();
     p.nonlinear_solver.max_increment_length = p.state_space.grid_spacing;
     p.nonlinear_solver.condensed_contact    = stroke_grid.condensed;
     // The accuracy study's residual tolerance (part 1's last lever).
@@ -317,7 +339,7 @@ namespace
         std::ostringstream a;
         a << std::setprecision(17) << "--child " << fine_size << " " << material
           << " " << speed << " " << stroke_grid.spacing << " "
-          << stroke_grid.hermite << " " << stroke_grid.condensed;
+          << stroke_grid.interpolation << " " << stroke_grid.condensed;
         const auto v = mpi_child::run(mpi_child::command(3, a.str()));
         Trial      t;
         t.speed           = speed;
@@ -437,10 +459,10 @@ namespace
   int
   child(const std::vector<std::string> &a)
   {
-    const double fine_size = std::stod(a[0]);
-    stroke_grid.spacing    = std::stod(a[3]);
-    stroke_grid.hermite    = a[4] == "1";
-    stroke_grid.condensed  = a.size() > 5 && a[5] == "1";
+    const double fine_size    = std::stod(a[0]);
+    stroke_grid.spacing       = std::stod(a[3]);
+    stroke_grid.interpolation = std::stoul(a[4]);
+    stroke_grid.condensed     = a.size() > 5 && a[5] == "1";
     if (mpi_rank() > 0)
       {
         const Scene         scene = stroke_scene(fine_size, a[1], "mpi");
@@ -507,10 +529,14 @@ run_benchmark(int argc, char **argv)
         }
       else if (a == "--csv" && i + 1 < argc)
         o.csv = argv[++i];
+      else if (a == "--interpolation" && i + 1 < argc)
+        o.interpolation = argv[++i];
       else if (a == "--spacing" && i + 1 < argc)
         stroke_grid.spacing = 1e-3 * std::stod(argv[++i]);
       else if (a == "--hermite")
-        stroke_grid.hermite = true;
+        stroke_grid.interpolation = 1;
+      else if (a == "--patch")
+        stroke_grid.interpolation = 2;
       else if (a == "--stroke-contact" && i + 1 < argc)
         stroke_grid.condensed = std::string(argv[++i]) != "matrix";
       else if (a == "--cores" && i + 1 < argc)
@@ -524,7 +550,7 @@ run_benchmark(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K] [--spacing MM] [--hermite] "
+               "[--cores K] [--interpolation NAME] [--spacing MM] [--hermite|--patch] "
                "[--stroke-contact condensed|matrix]\n";
           return 2;
         }
@@ -576,6 +602,14 @@ run_benchmark(int argc, char **argv)
      "candidates' compliance (Contact solver = condensed)",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.condensed_contact = true;
+       p.nonlinear_solver.anderson_depth    = 0;
+     },
+     false},
+    {"+Anderson",
+     "Anderson acceleration of the quasi-Newton steps on kept factors "
+     "(Anderson depth = 4)",
+     [](Parameters::AllParameters &p) {
+       p.nonlinear_solver.anderson_depth = 4;
      },
      false},
     {"+study tolerance",
@@ -629,6 +663,8 @@ run_benchmark(int argc, char **argv)
     for (const std::string &material : o.materials)
       {
         Scene scene = organ_scene(size, material);
+        if (!o.interpolation.empty())
+          scene.parameters.state_space.interpolation = o.interpolation;
         if (o.krylov > 0)
           scene.parameters.nonlinear_solver.max_krylov_iterations = o.krylov;
         scene.parameters.nonlinear_solver.assembly_threads = o.cores;
@@ -718,7 +754,7 @@ run_benchmark(int argc, char **argv)
         // all sharing the linked one. Three grid steps around rest: about
         // half the states press into the liver, up to 15 mm deep.
         std::cout << "  thread engine, the initial cloud within "
-                  << 2e3 *
+                  << 3e3 *
                        (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
                   << " mm of rest:\n";
         for (const bool private_copies : {false, true})
@@ -783,8 +819,7 @@ run_benchmark(int argc, char **argv)
                     << " nodes=" << mesh.n_vertices()
                     << " material=" << material << " engine=" << engine
                     << " workers=2"
-                    << " grid="
-                    << (stroke_grid.hermite ? "hermite" : "trilinear") << "_"
+                    << " grid=" << stroke_grid.interpolation_key() << "_"
                     << 1e3 *
                          (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
                     << "mm"

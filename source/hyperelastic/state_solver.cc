@@ -13,6 +13,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <tuple>
 
 namespace palpate
 {
@@ -427,15 +428,17 @@ namespace palpate
         outcome.message = "the starting state is not admissible";
         return outcome;
       }
-    double       assembly_time   = seconds_since(start);
-    double       last_correction = -1;
-    unsigned int short_steps     = 0;
-    double       previous_rate   = 0;
-    bool         refactorize     = condensed_path && !contact_free_factors;
+    double       assembly_time    = seconds_since(start);
+    double       last_correction  = -1;
+    unsigned int short_steps      = 0;
+    double       previous_rate    = 0;
+    unsigned int steps_on_factors = 0;
+    bool         refactorize      = condensed_path && !contact_free_factors;
     // Factors count as the state's only if made in its last increment
     // (this Newton solve): those of an increment before are of another
     // target.
     factors_of_state = false;
+    anderson.reset();
 
     for (unsigned int iteration = 0;; ++iteration)
       {
@@ -463,13 +466,25 @@ namespace palpate
                                    linear_solver->message();
             return outcome;
           }
+        if (condensed_path)
+          record.accelerated = accelerate(x, record.factorized);
         record.solve_time = seconds_since(start);
 
         // (The condensed step is never the predictor that only moves the
         // probe: its first step is already the contact's Newton step.)
         start = Clock::now();
-        const auto [best_alpha, best_scale] =
+        auto [best_alpha, best_scale] =
           line_search(x, target, condensed_path ? 1 : iteration);
+        if (record.accelerated && best_alpha != 1)
+          {
+            // The combined step did not reduce the residual at full
+            // length: its linear model does not hold here. The plain
+            // step, and a new history from it.
+            step.swap(plain_step);
+            anderson.reset();
+            record.accelerated               = false;
+            std::tie(best_alpha, best_scale) = line_search(x, target, 1);
+          }
         record.line_search_time = seconds_since(start);
         if (condensed_path)
           {
@@ -535,7 +550,9 @@ namespace palpate
           }
         if (condensed_path)
           {
-            refactorize   = worth_refactorizing(record, previous_rate);
+            steps_on_factors = record.factorized ? 0 : steps_on_factors + 1;
+            refactorize =
+              worth_refactorizing(record, previous_rate, steps_on_factors);
             previous_rate = record.factorized ?
                               0 :
                               record.residual_after / record.residual_before;

@@ -944,6 +944,19 @@ namespace palpate
           "the kept factorisation serves while the contact set moves. Both "
           "converge to the same states (Residual tolerance). Ignored without "
           "a sphere (doc/benchmarks/organ-speed.md).");
+        prm.declare_entry(
+          "Anderson depth",
+          "4",
+          Patterns::Integer(0, 20),
+          "With Contact solver = condensed: how many earlier Newton steps "
+          "on kept factors are combined into each new one (Anderson "
+          "acceleration; 0: none). Steps on factors of an older tangent cut "
+          "the residual by a fixed ratio; the combination removes the few "
+          "modes that make the ratio slow. Restarted when the factors or "
+          "the set of nodes touching the sphere change; a combined step "
+          "that does not reduce the residual is replaced by the plain one. "
+          "The states are the same (Residual tolerance); on the shipped liver a "
+          "state costs 0.7x (doc/benchmarks/organ-speed.md).");
       }
       prm.leave_subsection();
     }
@@ -969,6 +982,7 @@ namespace palpate
         reuse_factorization     = reuse != "false";
         max_krylov_iterations   = prm.get_integer("Maximum Krylov iterations");
         condensed_contact       = prm.get("Contact solver") == "condensed";
+        anderson_depth          = prm.get_integer("Anderson depth");
       }
       prm.leave_subsection();
     }

@@ -9,9 +9,10 @@
 // computes them. Force, displacement field and the set of nodes in
 // contact agree to 1e-8 (both solved to a residual of 1e-10), and so does
 // the probe's stiffness (to 1e-4), which also agrees with central
-// differences of the force. A step of the sphere that changes the contact
-// set converges on the kept factors without a refactorisation until the
-// stiffness needs one.
+// differences of the force; so do the condensed states with the
+// quasi-Newton steps Anderson-accelerated (Anderson depth = 4). A step of
+// the sphere that changes the contact set converges on the kept factors
+// without a refactorisation until the stiffness needs one.
 
 #include <palpate/hyperelastic/hyperelastic_system.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -39,13 +40,15 @@ namespace
   void
   compare(const std::string         &name,
           palpate::Scene             scene,
-          const std::vector<Point3> &path)
+          const std::vector<Point3> &path,
+          const unsigned int         anderson_depth = 0)
   {
     scene.parameters.nonlinear_solver.residual_tolerance = 1e-10;
     scene.parameters.nonlinear_solver.compute_stiffness  = true;
     const Body           body(scene);
     palpate::StateSolver reference(body.mesh, body.nodes, scene.parameters);
     scene.parameters.nonlinear_solver.condensed_contact = true;
+    scene.parameters.nonlinear_solver.anderson_depth    = anderson_depth;
     palpate::StateSolver condensed(body.mesh, body.nodes, scene.parameters);
 
     palpate::State from_reference = reference.rest_state(),
@@ -135,28 +138,29 @@ main(int argc, char **argv)
   // press 3 mm, slide 4 mm each way, press deeper, lift off.
   palpate::Scene beam = shipped_scene("beam.prm");
   touch_beam_with_sphere(beam, 0.01);
-  compare("beam",
-          beam,
-          {{{0, 0, -0.0015}},
-           {{0, 0, -0.003}},
-           {{0.002, 0, -0.003}},
-           {{0.004, 0, -0.003}},
-           {{0.004, 0.002, -0.003}},
-           {{0, 0.002, -0.004}},
-           {{0, 0, -0.005}},
-           {{0, 0, -0.003}},
-           {{0, 0, -0.001}},
-           {{0, 0, 0.001}}});
+  const std::vector<Point3> beam_path = {{{0, 0, -0.0015}},
+                                         {{0, 0, -0.003}},
+                                         {{0.002, 0, -0.003}},
+                                         {{0.004, 0, -0.003}},
+                                         {{0.004, 0.002, -0.003}},
+                                         {{0, 0.002, -0.004}},
+                                         {{0, 0, -0.005}},
+                                         {{0, 0, -0.003}},
+                                         {{0, 0, -0.001}},
+                                         {{0, 0, 0.001}}};
+  compare("beam", beam, beam_path);
+  // The same with the quasi-Newton steps Anderson-accelerated.
+  compare("beam, Anderson depth 4", beam, beam_path, 4);
 
   // The shipped indenter liver: the engine's 5 mm steps from a pressed
   // state, sideways both ways.
-  const palpate::Scene liver = shipped_scene("liver-indenter.prm");
-  compare("liver",
-          liver,
-          {{{0, 0, -0.005}},
-           {{0.005, 0, -0.005}},
-           {{0.005, 0.005, -0.005}},
-           {{0, 0.005, -0.005}}});
+  const palpate::Scene      liver      = shipped_scene("liver-indenter.prm");
+  const std::vector<Point3> liver_path = {{{0, 0, -0.005}},
+                                          {{0.005, 0, -0.005}},
+                                          {{0.005, 0.005, -0.005}},
+                                          {{0, 0.005, -0.005}}};
+  compare("liver", liver, liver_path);
+  compare("liver, Anderson depth 4", liver, liver_path, 4);
 
   // A 2 mm slide of the pressed sphere on the liver moves the contact set;
   // the kept factors of the state before solve it (those the pressed

@@ -62,6 +62,8 @@ namespace palpate
      * a kept factorisation solved it), and GMRES iterations (0 if none). */
     bool         factorized        = true;
     unsigned int krylov_iterations = 0;
+    /** Whether the step taken was Anderson-accelerated (Anderson depth). */
+    bool accelerated = false;
     /** Wall-clock seconds: residual+tangent assembly, factorisation and
      * solve, line search (residual evaluations at trial points). */
     double assembly_time, solve_time, line_search_time;

@@ -9,6 +9,7 @@
 // state_solver_staging.cc: the staging's checks and predictors;
 // state_solver_condensed.cc: the condensed contact's Newton steps).
 
+#include <palpate/hyperelastic/anderson_acceleration.h>
 #include <palpate/hyperelastic/condensed_contact.h>
 #include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
@@ -59,6 +60,7 @@ namespace palpate
          const NodeSelection             &nodes,
          const Parameters::AllParameters &p)
       : settings(p.nonlinear_solver)
+      , anderson(p.nonlinear_solver.anderson_depth)
     {
       settings.compute_stiffness =
         settings.compute_stiffness ||
@@ -138,11 +140,21 @@ namespace palpate
     /**
      * Whether the next condensed Newton iteration should factorise the
      * tangent anew, after the iteration @p record (its relative residual
-     * before and after) and the rate of the one before it.
+     * before and after), the rate of the one before it and the
+     * @p steps_on_factors taken in this Newton solve since factors were
+     * last made (all of them if none were).
      */
     bool
     worth_refactorizing(const NewtonIteration &record,
-                        const double           previous_rate) const;
+                        const double           previous_rate,
+                        const unsigned int     steps_on_factors) const;
+
+    /** With Anderson depth > 0: record the condensed step just made and
+     * turn it into the accelerated one (the plain one kept in plain_step);
+     * the history restarts on new factors (@p factorized_now) or a new set
+     * of nodes in contact. Whether the step was changed. */
+    bool
+    accelerate(const std::vector<double> &x, bool factorized_now);
 
     /** Assemble the contact-free tangent at @p x and factorise it; the
      * compliance columns of the old factors are dropped. */
@@ -340,6 +352,12 @@ namespace palpate
     double                                     setup_time = 0;
     std::function<void(const State &, double)> observer;
     std::function<bool()>                      stop_check;
+    // The condensed path's acceleration, the plain step it started from,
+    // and which candidates' rows were in contact after the last step (a
+    // change restarts it).
+    AndersonAcceleration anderson;
+    std::vector<double>  plain_step;
+    std::vector<char>    in_contact, was_in_contact;
     // With Interpolation = contact patch: how far from the sphere a
     // patch's nodes may be (m); 0: no patches.
     double patch_reach = 0;

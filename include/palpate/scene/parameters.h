@@ -262,6 +262,10 @@ namespace palpate
        * the candidates' compliance (a small dense problem); false: the
        * contact rows are in the factorised tangent (the reference). */
       bool condensed_contact = false;
+      /** Anderson depth: with Contact solver = condensed, how many earlier
+       * quasi-Newton steps are combined into each new one
+       * (AndersonAcceleration; 0: none). */
+      unsigned int anderson_depth = 4;
 
       /** Fix reuse_factorization to @p on (no choice by size). */
       void
