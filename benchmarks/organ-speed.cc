@@ -204,7 +204,9 @@ namespace
                 std::cout << "    state " << m.ms.size() << " at ("
                           << 1e3 * target[0] << ", " << 1e3 * target[1] << ", "
                           << 1e3 * target[2] << ") mm: " << m.ms.back()
-                          << " ms, |f| " << Utilities::norm(s.force) << " N\n";
+                          << " ms (stiffness " << 1e3 * s.stiffness_time
+                          << ", patch " << 1e3 * s.contact_patch_time
+                          << "), |f| " << Utilities::norm(s.force) << " N\n";
                 for (const auto &r : s.history)
                   std::cout
                     << "      inc " << r.increment << "  res "

@@ -2,7 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/hyperelastic/contact_patch.h>
-#include <palpate/hyperelastic/linear_solver.h>
+#include <palpate/hyperelastic/inverse_block.h>
 
 #include <algorithm>
 #include <atomic>
@@ -32,7 +32,8 @@ namespace palpate
 
   std::shared_ptr<const ContactPatch>
   make_contact_patch(const HyperelasticSystem                    &system,
-                     LinearSolver                                &solver,
+                     InverseBlock                                &compliance,
+                     const std::vector<double>                   &tangent,
                      const std::vector<double>                   &x,
                      const Utilities::Point3                     &target,
                      const double                                 reach,
@@ -54,28 +55,29 @@ namespace palpate
     if (m == 0)
       return patch;
 
-    // Three right-hand sides per node, unit forces along x, y and z.
-    const unsigned int  N = system.n_equations();
-    std::vector<double> block(std::size_t(N) * 3 * m, 0.0);
+    // H = P K^-1 P^T on the nodes' free DoFs, the block of the inverse of
+    // the contact-free tangent there (zero rows and columns for DoFs a
+    // boundary condition fixes).
+    std::vector<unsigned int> unknowns;
+    std::vector<int>          slot(3 * m, -1);
     for (unsigned int j = 0; j < m; ++j)
       for (unsigned int a = 0; a < 3; ++a)
         if (const int e = rows[patch->nodes[j]].eq[a]; e >= 0)
-          block[std::size_t(3 * j + a) * N + e] = 1;
-    if (!solver.solve_many(block, 3 * m))
+          {
+            slot[3 * j + a] = unknowns.size();
+            unknowns.push_back(e);
+          }
+    std::vector<double> block;
+    if (!compliance.compute(tangent, unknowns, block))
       return nullptr;
-    const unsigned int  M = 3 * m;
+    const unsigned int  M = 3 * m, k = unknowns.size();
     std::vector<double> H(std::size_t(M) * M, 0.0);
-    for (unsigned int i = 0; i < m; ++i)
-      for (unsigned int a = 0; a < 3; ++a)
-        if (const int e = rows[patch->nodes[i]].eq[a]; e >= 0)
-          for (unsigned int c = 0; c < M; ++c)
-            H[std::size_t(3 * i + a) * M + c] = block[std::size_t(c) * N + e];
-    // Symmetric as the tangent is, up to the factors' round-off: made
-    // exactly so, so that the contact problem is that of an energy.
     for (unsigned int r = 0; r < M; ++r)
-      for (unsigned int c = 0; c < r; ++c)
-        H[std::size_t(r) * M + c] = H[std::size_t(c) * M + r] =
-          0.5 * (H[std::size_t(r) * M + c] + H[std::size_t(c) * M + r]);
+      if (slot[r] >= 0)
+        for (unsigned int c = 0; c < M; ++c)
+          if (slot[c] >= 0)
+            H[std::size_t(r) * M + c] =
+              block[std::size_t(slot[r]) * k + slot[c]];
     patch->H.assign(H.begin(), H.end());
     patch->normal.resize(M);
     for (unsigned int i = 0; i < m; ++i)

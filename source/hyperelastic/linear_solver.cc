@@ -83,6 +83,45 @@ namespace palpate
 
 
 
+  /**
+   * METIS nested dissection of the matrix graph, as MUMPS's PERM_IN: the
+   * 1-based position of each unknown in the pivot order. METIS compresses
+   * the three DoFs of a node (identical adjacency) by itself.
+   */
+  std::vector<int>
+  nested_dissection_positions(const SparsityCSR &pattern)
+  {
+    std::vector<idx_t> xadj(1, 0), adjncy;
+    for (unsigned int i = 0; i < pattern.n_rows; ++i)
+      {
+        for (unsigned int k = pattern.row_start[i];
+             k < pattern.row_start[i + 1];
+             ++k)
+          if (pattern.column[k] != i)
+            adjncy.push_back(pattern.column[k]);
+        xadj.push_back(adjncy.size());
+      }
+    idx_t              n = pattern.n_rows;
+    std::vector<idx_t> perm(n), iperm(n);
+    idx_t              options[METIS_NOPTIONS];
+    METIS_SetDefaultOptions(options);
+    options[METIS_OPTION_NUMBERING] = 0;
+    if (METIS_NodeND(&n,
+                     xadj.data(),
+                     adjncy.data(),
+                     nullptr,
+                     options,
+                     perm.data(),
+                     iperm.data()) != METIS_OK)
+      throw std::runtime_error("METIS nested dissection failed");
+    std::vector<int> position(n);
+    for (idx_t i = 0; i < n; ++i)
+      position[i] = iperm[i] + 1;
+    return position;
+  }
+
+
+
   std::unique_ptr<Epetra_CrsMatrix>
   epetra_matrix(const SparsityCSR &pattern, const Epetra_Map &map)
   {
@@ -117,42 +156,6 @@ namespace palpate
       return true;
     }
 
-    /**
-     * METIS nested dissection of the matrix graph, as MUMPS's PERM_IN: the
-     * 1-based position of each unknown in the pivot order. METIS compresses
-     * the three DoFs of a node (identical adjacency) by itself.
-     */
-    std::vector<MUMPS_INT>
-    metis_nested_dissection(const SparsityCSR &pattern)
-    {
-      std::vector<idx_t> xadj(1, 0), adjncy;
-      for (unsigned int i = 0; i < pattern.n_rows; ++i)
-        {
-          for (unsigned int k = pattern.row_start[i];
-               k < pattern.row_start[i + 1];
-               ++k)
-            if (pattern.column[k] != i)
-              adjncy.push_back(pattern.column[k]);
-          xadj.push_back(adjncy.size());
-        }
-      idx_t              n = pattern.n_rows;
-      std::vector<idx_t> perm(n), iperm(n);
-      idx_t              options[METIS_NOPTIONS];
-      METIS_SetDefaultOptions(options);
-      options[METIS_OPTION_NUMBERING] = 0;
-      if (METIS_NodeND(&n,
-                       xadj.data(),
-                       adjncy.data(),
-                       nullptr,
-                       options,
-                       perm.data(),
-                       iperm.data()) != METIS_OK)
-        throw std::runtime_error("METIS nested dissection failed");
-      std::vector<MUMPS_INT> position(n);
-      for (idx_t i = 0; i < n; ++i)
-        position[i] = iperm[i] + 1;
-      return position;
-    }
 
     // ------------------------------------------------------------------
     // MUMPS through its C interface.
@@ -280,7 +283,7 @@ namespace palpate
         id.rhs = nullptr;
         if (ordering_code == 1)
           {
-            permutation = metis_nested_dissection(pattern);
+            permutation = nested_dissection_positions(pattern);
             id.perm_in  = permutation.data();
           }
         id.job = 1; // analysis

@@ -178,19 +178,26 @@ namespace palpate
   StateSolver::Impl::contact_patch(State &state, const std::vector<double> &x)
   {
     // The patch's compliance is that of the state's own contact-free
-    // tangent: factors made within one Newton step of it (the condensed
-    // stiffness's) serve, any others are made anew.
-    if (!(contact_free_factors && factors_of_state &&
-          factored_residual <= 1e-4))
-      {
-        ++state.stiffness_factorizations;
-        if (!factorize_contact_free(x, state.active_displacement))
-          return false;
-        factors_of_state  = true;
-        factored_residual = 0;
-      }
-    state.contact_patch = make_contact_patch(
-      *system, *linear_solver, x, state.active_displacement, patch_reach, rows);
+    // tangent, from a partial factorisation of its own (InverseBlock):
+    // the Newton steps' factors, which the next state starts from, are
+    // left as they are.
+    if (!inverse_block)
+      inverse_block = std::make_unique<InverseBlock>(system->sparsity());
+    ++state.stiffness_factorizations;
+    if (!system->assemble(x,
+                          state.active_displacement,
+                          trial_residual,
+                          &patch_tangent,
+                          nullptr,
+                          false))
+      return false;
+    state.contact_patch = make_contact_patch(*system,
+                                             *inverse_block,
+                                             patch_tangent,
+                                             x,
+                                             state.active_displacement,
+                                             patch_reach,
+                                             rows);
     return state.contact_patch != nullptr;
   }
 

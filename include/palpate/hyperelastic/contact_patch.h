@@ -14,7 +14,7 @@
 
 namespace palpate
 {
-  class LinearSolver;
+  class InverseBlock;
 
   /**
    * A state's contact patch (State space / Interpolation = contact patch):
@@ -101,13 +101,15 @@ namespace palpate
   /**
    * The contact patch of the converged state at unknowns @p x with the
    * HIP at @p target: the surface nodes whose gap is at most @p reach (m),
-   * and their compliance by one block solve with @p solver, which must
-   * hold factors of the contact-free tangent at (or near) @p x; @p rows is
-   * work space. Null if the solver fails.
+   * and their compliance, the block of the inverse of the contact-free
+   * @p tangent at @p x (its entries in the system's sparsity pattern) on
+   * their DoFs, by @p compliance; @p rows is work space. Null if that
+   * fails.
    */
   std::shared_ptr<const ContactPatch>
   make_contact_patch(const HyperelasticSystem                    &system,
-                     LinearSolver                                &solver,
+                     InverseBlock                                &compliance,
+                     const std::vector<double>                   &tangent,
                      const std::vector<double>                   &x,
                      const Utilities::Point3                     &target,
                      const double                                 reach,

@@ -44,6 +44,14 @@ namespace palpate
   };
 
   /**
+   * METIS nested dissection of the graph of @p pattern, as MUMPS's
+   * PERM_IN: the 1-based position of each unknown in the pivot order.
+   * (Debian's MUMPS is built without METIS and would fall back to AMF.)
+   */
+  std::vector<int>
+  nested_dissection_positions(const SparsityCSR &pattern);
+
+  /**
    * A sparse direct solver for the symmetric (indefinite) linearised
    * systems of the Newton method. analyze() runs the symbolic analysis
    * (ordering, elimination tree) of a sparsity pattern; factorize() then

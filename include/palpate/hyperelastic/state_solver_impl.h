@@ -13,6 +13,7 @@
 #include <palpate/hyperelastic/condensed_contact.h>
 #include <palpate/hyperelastic/effect.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/inverse_block.h>
 #include <palpate/hyperelastic/linear_solver.h>
 #include <palpate/hyperelastic/state_solver.h>
 
@@ -168,9 +169,9 @@ namespace palpate
     void
     derivatives(State &state, const std::vector<double> &x);
 
-    /** The contact patch of the converged @p state at @p x, from
-     * contact-free factors of this state (made if the kept ones are not).
-     * False if the linear solver fails. */
+    /** The contact patch of the converged @p state at @p x, its
+     * compliance from the contact-free tangent there (inverse_block).
+     * False if that fails. */
     bool
     contact_patch(State &state, const std::vector<double> &x);
 
@@ -358,6 +359,9 @@ namespace palpate
     AndersonAcceleration anderson;
     std::vector<double>  plain_step;
     std::vector<char>    in_contact, was_in_contact;
+    // The contact patches' compliance (made when the first is wanted).
+    std::unique_ptr<InverseBlock> inverse_block;
+    std::vector<double>           patch_tangent;
     // With Interpolation = contact patch: how far from the sphere a
     // patch's nodes may be (m); 0: no patches.
     double patch_reach = 0;
