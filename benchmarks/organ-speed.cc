@@ -89,6 +89,9 @@ namespace
      * makes the probe's stiffness, from factors of its own) or, with
      * --interpolation trilinear, without derivatives. */
     std::string interpolation;
+    /** The stroke's engine alone (--engine threads|mpi); empty: both
+     * (--quick: threads). */
+    std::string engine;
   };
 
   /** A solver configuration: the scene's settings with some levers. */
@@ -531,6 +534,8 @@ run_benchmark(int argc, char **argv)
         }
       else if (a == "--csv" && i + 1 < argc)
         o.csv = argv[++i];
+      else if (a == "--engine" && i + 1 < argc)
+        o.engine = argv[++i];
       else if (a == "--interpolation" && i + 1 < argc)
         o.interpolation = argv[++i];
       else if (a == "--spacing" && i + 1 < argc)
@@ -552,7 +557,7 @@ run_benchmark(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K] [--interpolation NAME] [--spacing MM] [--hermite|--patch] "
+               "[--cores K] [--interpolation NAME] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
                "[--stroke-contact condensed|matrix]\n";
           return 2;
         }
@@ -755,12 +760,15 @@ run_benchmark(int argc, char **argv)
         // two, each solver with a MUMPS of its own and (the reference)
         // all sharing the linked one. Three grid steps around rest: about
         // half the states press into the liver, up to 15 mm deep.
-        std::cout << "  thread engine, the initial cloud within "
-                  << 3e3 *
-                       (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
-                  << " mm of rest:\n";
+        if (o.engine != "mpi")
+          std::cout << "  thread engine, the initial cloud within "
+                    << 3e3 *
+                         (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
+                    << " mm of rest:\n";
         for (const bool private_copies : {false, true})
           {
+            if (o.engine == "mpi")
+              break; // the thread engine's measure
             double one = 0;
             for (const unsigned int workers : {1u, 2u})
               {
@@ -797,8 +805,9 @@ run_benchmark(int argc, char **argv)
         std::cout << "  stroke: " << 1e3 * stroke_length
                   << " mm along (-0.8, 0, -0.6), 2 workers\n";
         for (const std::string &engine :
-             o.quick ? std::vector<std::string>{"threads"} :
-                       std::vector<std::string>{"threads", "mpi"})
+             !o.engine.empty() ? std::vector<std::string>{o.engine} :
+             o.quick           ? std::vector<std::string>{"threads"} :
+                                 std::vector<std::string>{"threads", "mpi"})
           {
             // --quick has two trials: it starts where two workers of this
             // state time can plausibly keep up (a grid step's cell ahead

@@ -228,6 +228,8 @@ namespace palpate
     // The rest state's stiffness, from the servers' ready messages.
     std::array<double, 9> rest_stiffness     = {};
     bool                  has_rest_stiffness = false;
+    /** The rest state's contact patch (Interpolation = contact patch). */
+    std::shared_ptr<const ContactPatch> rest_patch;
 
     // Which servers hold the whole state of each point (bit r-1 for rank
     // r), and which server computes it (its rank, or 0).
@@ -301,6 +303,8 @@ namespace palpate
                 std::copy(h.stiffness, h.stiffness + 9, rest_stiffness.begin());
                 has_rest_stiffness = true;
               }
+            if (h.flags & Flags::patch)
+              rest_patch = patch_of(message);
             ++ready;
           }
         else if (Clock::now() > deadline)
@@ -457,11 +461,12 @@ namespace palpate
                 holders[h.point] |= bit(from);
                 std::array<double, 9> stiffness;
                 std::copy(h.stiffness, h.stiffness + 9, stiffness.begin());
-                cache.publish_force(h.point,
-                                    {{h.force[0], h.force[1], h.force[2]}},
-                                    h.generation,
-                                    (h.flags & Flags::stiffness) ? &stiffness :
-                                                                   nullptr);
+                cache.publish_force(
+                  h.point,
+                  {{h.force[0], h.force[1], h.force[2]}},
+                  h.generation,
+                  (h.flags & Flags::stiffness) ? &stiffness : nullptr,
+                  (h.flags & Flags::patch) ? patch_of(message) : nullptr);
                 ++stats.computed;
               }
             else
@@ -930,7 +935,8 @@ namespace palpate
       s.cache.publish_force(s.origin,
                             {{0, 0, 0}},
                             s.cache.generation(),
-                            s.has_rest_stiffness ? &s.rest_stiffness : nullptr);
+                            s.has_rest_stiffness ? &s.rest_stiffness : nullptr,
+                            s.rest_patch);
     std::lock_guard<std::mutex> lock(s.mutex);
     s.nothing_to_plan = false;
     s.replan          = true;

@@ -29,6 +29,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <csignal>
+#include <cstring>
 #include <deque>
 #include <iostream>
 #include <map>
@@ -70,7 +71,8 @@ namespace palpate
     bytes_of(const State &s)
     {
       return sizeof(State) +
-             (s.solution.size() + s.multipliers.size()) * sizeof(double);
+             (s.solution.size() + s.multipliers.size()) * sizeof(double) +
+             (s.contact_patch ? s.contact_patch->memory() : 0);
     }
 
     /**
@@ -297,7 +299,15 @@ namespace palpate
           ready.flags = Flags::error;
           ready.set_text(e.what());
         }
-      messenger.send(client_rank, pack(ready));
+      // The rest state's contact patch rides on it (the client publishes
+      // the rest state itself).
+      if (!(ready.flags & Flags::error) && rest && rest->contact_patch)
+        {
+          ready.flags |= Flags::patch;
+          messenger.send(client_rank, pack(ready, *rest->contact_patch));
+        }
+      else
+        messenger.send(client_rank, pack(ready));
       if (!solver)
         messenger.flush(5);
       return solver != nullptr;
@@ -448,7 +458,16 @@ namespace palpate
           state.history.shrink_to_fit();
           auto kept = std::make_shared<const State>(std::move(state));
           shared.bytes += bytes_of(*kept);
-          shared.store[task.point] = std::move(kept);
+          shared.store[task.point] = kept;
+          // The contact patch goes with the result: the haptic loop
+          // solves against it at every tick.
+          if (kept->contact_patch)
+            {
+              result.flags |= Flags::patch;
+              shared.outbox.emplace_back(result, std::move(kept));
+              keep_within_budget(task.point, target);
+              return;
+            }
         }
       shared.outbox.emplace_back(result, nullptr);
       keep_within_budget(task.point, target);
@@ -660,9 +679,14 @@ namespace palpate
         {
           // The counters ride on every result: the client adds up the
           // traffic of all ranks.
+          std::vector<char> message =
+            (h.flags & Flags::patch) && s && s->contact_patch ?
+              pack(h, *s->contact_patch) :
+              pack(h);
           h.messages_sent = messenger.messages_sent + 1;
-          h.bytes_sent    = messenger.bytes_sent + sizeof(Header);
-          messenger.send(client_rank, pack(h));
+          h.bytes_sent    = messenger.bytes_sent + message.size();
+          std::memcpy(message.data(), &h, sizeof(Header));
+          messenger.send(client_rank, std::move(message));
         }
       return !outbox.empty();
     }

@@ -1179,8 +1179,8 @@ namespace palpate
           Patterns::Double(1.),
           "Memory for the whole states kept in the cache (MiB), "
           "their contact patches included; with Type = mpi, on each "
-          "server (and on the client, for the states its shape output "
-          "fetched). Beyond it, the states farthest from the HIP are "
+          "server and on the client (the states its shape output fetched, "
+          "the contact patches the results carry). Beyond it, the states farthest from the HIP are "
           "dropped with their patches; their forces stay (with "
           "Interpolation = contact patch, a cell with such a corner is "
           "interpolated trilinearly).");

@@ -1790,16 +1790,8 @@ namespace palpate
                       "set Tip = sphere with a Tip radius, or Interpolation "
                       "= tricubic Hermite.",
                       {"Boundary conditions/Active node/Tip"});
-        // The patches live in the states of this process's cache: solver
-        // servers send forces only, and the store keeps no patches yet.
-        if (p.engine.type == "mpi")
-          throw error("State space/Interpolation",
-                      "contact patch needs the states' contact patches in "
-                      "the haptic process, and Engine / Type = mpi sends "
-                      "the haptic loop forces only",
-                      "use Engine / Type = threads with contact patch, or "
-                      "Interpolation = tricubic Hermite with mpi.",
-                      {"Engine/Type"});
+        // The patches travel with the states' forces (MPI results too);
+        // a store keeps none yet.
         if (!p.state_space.store.empty())
           throw error("State space/Interpolation",
                       "contact patch needs each state's contact patch, and "

@@ -164,6 +164,7 @@ namespace palpate
     , is_wanted(grid.size(), 0)
     , reasons(grid.size(), SolveStatus::max_iterations)
     , budget(memory_budget)
+    , remote_patch(grid.size(), 0)
   {}
 
 
@@ -257,6 +258,8 @@ namespace palpate
       }
     bytes = 0;
     held  = 0;
+    std::fill(remote_patch.begin(), remote_patch.end(), 0);
+    remote_bytes = 0;
     for (const unsigned int p : wanted)
       is_wanted[p] = 0;
     wanted.clear();
@@ -266,17 +269,50 @@ namespace palpate
 
 
   void
-  StateCache::publish_force(const unsigned int           point,
-                            const Utilities::Point3     &force,
-                            const std::uint64_t          generation,
-                            const std::array<double, 9> *stiffness)
+  StateCache::publish_force(const unsigned int                  point,
+                            const Utilities::Point3            &force,
+                            const std::uint64_t                 generation,
+                            const std::array<double, 9>        *stiffness,
+                            std::shared_ptr<const ContactPatch> patch)
   {
     std::lock_guard<std::mutex> lock(mutex);
     if (generation != current_generation.load(std::memory_order_acquire))
       return;
+    if (patch)
+      {
+        // The patch first: a real-time read that finds the point
+        // available finds its patch too.
+        retire_patch(point);
+        remote_bytes -= remote_patch[point];
+        remote_patch[point] = patch->memory();
+        remote_bytes += remote_patch[point];
+        entries[point].patch.store(new HeldPatch{std::move(patch), generation});
+      }
+    reclaim_patches();
     make_available(entries[point], force, stiffness, generation);
     if (stiffness != nullptr)
       update_cross_around(point);
+
+    // Over budget: let go of the patches farthest from the focus (cells
+    // with those corners render trilinearly until they come again).
+    if (bytes + remote_bytes > budget)
+      {
+        std::vector<std::pair<double, unsigned int>> by_distance;
+        for (unsigned int p = 0; p < remote_patch.size(); ++p)
+          if (remote_patch[p] > 0 && p != point)
+            by_distance.emplace_back(Utilities::distance(grid.position(p),
+                                                         focus),
+                                     p);
+        std::sort(by_distance.begin(), by_distance.end());
+        while (bytes + remote_bytes > 0.9 * budget && !by_distance.empty())
+          {
+            const unsigned int p = by_distance.back().second;
+            by_distance.pop_back();
+            retire_patch(p);
+            remote_bytes -= remote_patch[p];
+            remote_patch[p] = 0;
+          }
+      }
   }
 
 
@@ -308,6 +344,9 @@ namespace palpate
     if (state->contact_patch)
       {
         retire_patch(point);
+        // Counted with the state held here from now on.
+        remote_bytes -= remote_patch[point];
+        remote_patch[point] = 0;
         e.patch.store(new HeldPatch{state->contact_patch, generation});
       }
     reclaim_patches();

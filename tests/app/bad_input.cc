@@ -198,16 +198,14 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = /dev/zero\n  end\nend\n");
-  // State space / Interpolation = contact patch needs patches in the
-  // haptic process: a sphere, the thread engine, no store.
+  // State space / Interpolation = contact patch needs a sphere, and no
+  // store (a store keeps no patches).
   const std::string patch =
     "good.prm --set 'State space/Interpolation=contact patch'";
   const std::string sphere =
     " --set 'Boundary conditions/Active node/Tip=sphere' --set "
     "'Boundary conditions/Active node/Tip radius=0.02'";
   run("contact patch with a point probe", patch);
-  run("contact patch with the MPI engine",
-      patch + sphere + " --set 'Engine/Type=mpi'");
   run("contact patch with a state store",
       patch + sphere + " --set 'State space/Store=beam.h5'");
   run("a scene file that does not exist", "no-such-scene.prm");

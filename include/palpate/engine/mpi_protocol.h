@@ -8,6 +8,7 @@
 // servers (ranks 1..N-1). Only source/engine/mpi_*.cc include this header:
 // it pulls in <mpi.h>, which the haptic side never needs.
 
+#include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/hyperelastic/state.h>
 
 #include <mpi.h>
@@ -15,6 +16,7 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -81,6 +83,9 @@ namespace palpate
       constexpr std::uint32_t stiffness = 16;
       /** shutdown: a server was lost (finalise without waiting for it). */
       constexpr std::uint32_t peers_lost = 32;
+      /** result, ready (of the rest state): the state's contact patch
+       * follows the header (Interpolation = contact patch). */
+      constexpr std::uint32_t patch = 64;
     } // namespace Flags
 
     /** Every message starts with this header (plain bytes). */
@@ -121,6 +126,16 @@ namespace palpate
     /** A header followed by a whole state (solution, multipliers). */
     std::vector<char>
     pack(const Header &header, const State &state);
+
+    /** A result header followed by the state's contact patch: the haptic
+     * process solves the contact against it at every tick. */
+    std::vector<char>
+    pack(const Header &header, const ContactPatch &patch);
+
+    /** The contact patch carried by a result with Flags::patch (throws
+     * if the message is truncated). */
+    std::shared_ptr<const ContactPatch>
+    patch_of(const std::vector<char> &message);
 
     /** The header of a received message (throws if too short). */
     Header

@@ -77,13 +77,17 @@ namespace palpate
     /**
      * Make @p point available with force @p force (N) only, for
      * @p generation: its whole state is held elsewhere (a solver server of
-     * the MPI engine) and travels here only when state() asks for it.
+     * the MPI engine) and travels here only when state() asks for it. Its
+     * contact @p patch, if given, is held here for the haptic loop and
+     * counts in the memory budget; beyond it, the patches farthest from
+     * the focus are let go of (their forces stay).
      */
     void
-    publish_force(const unsigned int           point,
-                  const Utilities::Point3     &force,
-                  const std::uint64_t          generation,
-                  const std::array<double, 9> *stiffness = nullptr);
+    publish_force(const unsigned int                  point,
+                  const Utilities::Point3            &force,
+                  const std::uint64_t                 generation,
+                  const std::array<double, 9>        *stiffness = nullptr,
+                  std::shared_ptr<const ContactPatch> patch     = nullptr);
 
     /**
      * The available points whose whole state was asked for by state() but
@@ -247,8 +251,12 @@ namespace palpate
     mutable std::vector<std::uint8_t> is_wanted;
     std::vector<SolveStatus>          reasons; // of failure points
     std::size_t                       bytes = 0, budget;
-    unsigned int                      held = 0, evicted = 0;
-    Utilities::Point3                 focus = {{0, 0, 0}};
+    // Patches of points whose state is held elsewhere (publish_force()):
+    // each one's bytes, and their sum.
+    std::vector<std::size_t> remote_patch;
+    std::size_t              remote_bytes = 0;
+    unsigned int             held = 0, evicted = 0;
+    Utilities::Point3        focus = {{0, 0, 0}};
     // Patches let go of, with the read sections ended when they were.
     std::vector<std::pair<const HeldPatch *, std::uint64_t>> retired;
     mutable std::atomic<bool>          reader_active{false};
