@@ -92,6 +92,8 @@ namespace
     /** The stroke's engine alone (--engine threads|mpi); empty: both
      * (--quick: threads). */
     std::string engine;
+    /** Part 1's grid step (--step MM; 0: the scene's 5 mm). */
+    double step = 0;
   };
 
   /** A solver configuration: the scene's settings with some levers. */
@@ -160,8 +162,9 @@ namespace
           const bool                trace = false)
   {
     lever.apply(p);
-    StateSolver  solver(mesh, selection, p);
-    const double h = 0.005;
+    StateSolver solver(mesh, selection, p);
+    // Grid steps of the scene's spacing (5 mm; --step), from 5 mm deep.
+    const double h = p.state_space.grid_spacing;
     const Point3 pressed_at{{0, 0, -0.005}};
     const State  pressed = solver.solve(solver.rest_state(), pressed_at);
     Measured     m;
@@ -534,6 +537,8 @@ run_benchmark(int argc, char **argv)
         }
       else if (a == "--csv" && i + 1 < argc)
         o.csv = argv[++i];
+      else if (a == "--step" && i + 1 < argc)
+        o.step = 1e-3 * std::stod(argv[++i]);
       else if (a == "--engine" && i + 1 < argc)
         o.engine = argv[++i];
       else if (a == "--interpolation" && i + 1 < argc)
@@ -557,7 +562,7 @@ run_benchmark(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K] [--interpolation NAME] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
+               "[--cores K] [--interpolation NAME] [--step MM] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
                "[--stroke-contact condensed|matrix]\n";
           return 2;
         }
@@ -595,7 +600,7 @@ run_benchmark(int argc, char **argv)
     {"+one increment",
      "a grid step (5 mm) in one increment",
      [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.max_increment_length = 0.005;
+       p.nonlinear_solver.max_increment_length = p.state_space.grid_spacing;
      },
      false},
     {"+single precision",
@@ -672,6 +677,8 @@ run_benchmark(int argc, char **argv)
         Scene scene = organ_scene(size, material);
         if (!o.interpolation.empty())
           scene.parameters.state_space.interpolation = o.interpolation;
+        if (o.step > 0)
+          scene.parameters.state_space.grid_spacing = o.step;
         if (o.krylov > 0)
           scene.parameters.nonlinear_solver.max_krylov_iterations = o.krylov;
         scene.parameters.nonlinear_solver.assembly_threads = o.cores;
