@@ -400,6 +400,43 @@ namespace palpate
 
 
 
+  std::pair<double, double>
+  StateSolver::Impl::step_length(const std::vector<double> &x,
+                                 const Utilities::Point3   &target,
+                                 NewtonIteration           &record,
+                                 const bool                 condensed_path,
+                                 const unsigned int         iteration)
+  {
+    // (The condensed step is never the predictor that only moves the
+    // probe: its first step is already the contact's Newton step.)
+    const auto start = Clock::now();
+    auto [best_alpha, best_scale] =
+      line_search(x, target, condensed_path ? 1 : iteration);
+    if (record.accelerated && best_alpha != 1)
+      {
+        // The combined step did not reduce the residual at full length:
+        // its linear model does not hold here. The plain step, and a new
+        // history from it.
+        step.swap(plain_step);
+        anderson.reset();
+        record.accelerated               = false;
+        std::tie(best_alpha, best_scale) = line_search(x, target, 1);
+      }
+    record.line_search_time = seconds_since(start);
+    if (condensed_path)
+      {
+        // What an iteration and a refactorisation cost on this machine and
+        // body, as worth_refactorizing() weighs them.
+        const double spent = record.solve_time + record.line_search_time;
+        double      &cost =
+          record.factorized ? refactorization_cost : iteration_cost;
+        cost = cost > 0 ? 0.7 * cost + 0.3 * spent : spent;
+      }
+    return {best_alpha, best_scale};
+  }
+
+
+
   StateSolver::Impl::Outcome
   StateSolver::Impl::newton(std::vector<double>     &x,
                             const Utilities::Point3 &target,
@@ -470,31 +507,8 @@ namespace palpate
           record.accelerated = accelerate(x, record.factorized);
         record.solve_time = seconds_since(start);
 
-        // (The condensed step is never the predictor that only moves the
-        // probe: its first step is already the contact's Newton step.)
-        start = Clock::now();
-        auto [best_alpha, best_scale] =
-          line_search(x, target, condensed_path ? 1 : iteration);
-        if (record.accelerated && best_alpha != 1)
-          {
-            // The combined step did not reduce the residual at full
-            // length: its linear model does not hold here. The plain
-            // step, and a new history from it.
-            step.swap(plain_step);
-            anderson.reset();
-            record.accelerated               = false;
-            std::tie(best_alpha, best_scale) = line_search(x, target, 1);
-          }
-        record.line_search_time = seconds_since(start);
-        if (condensed_path)
-          {
-            // What an iteration and a refactorisation cost on this machine
-            // and body, as worth_refactorizing() weighs them.
-            const double spent = record.solve_time + record.line_search_time;
-            double      &cost =
-              record.factorized ? refactorization_cost : iteration_cost;
-            cost = cost > 0 ? 0.7 * cost + 0.3 * spent : spent;
-          }
+        const auto [best_alpha, best_scale] =
+          step_length(x, target, record, condensed_path, iteration);
         if (best_alpha < 0)
           {
             record.step_length      = 0;

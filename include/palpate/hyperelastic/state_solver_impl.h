@@ -138,6 +138,18 @@ namespace palpate
                    NewtonIteration           &record,
                    const bool                 refactorize);
 
+    /** The line search along the step just made (the plain step if an
+     * accelerated one does not reduce the residual at full length), its
+     * time in @p record, and the cost model's update: the step length
+     * taken (negative if every step tried inverts an element) and the
+     * force scale there. */
+    std::pair<double, double>
+    step_length(const std::vector<double> &x,
+                const Utilities::Point3   &target,
+                NewtonIteration           &record,
+                bool                       condensed_path,
+                unsigned int               iteration);
+
     /**
      * Whether the next condensed Newton iteration should factorise the
      * tangent anew, after the iteration @p record (its relative residual
