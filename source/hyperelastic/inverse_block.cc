@@ -112,24 +112,14 @@ namespace palpate
 
     terminate(); // the Schur unknowns are fixed at the analysis
     const auto lock = library.lock();
-    id.job          = -1;
-    id.par          = 1;
-    id.sym          = 2;
-    id.comm_fortran = library.fortran_communicator();
-    library.call(&id);
-    if (std::min(id.infog[0], id.info[0]) < 0)
+    if (!library.initialize(id))
       {
         message_ = "MUMPS could not be initialised, INFOG(1) = " +
                    std::to_string(id.infog[0]);
         return false;
       }
-    initialized  = true;
-    id.icntl[0]  = -1;
-    id.icntl[1]  = -1;
-    id.icntl[2]  = -1;
-    id.icntl[3]  = 0;
-    id.icntl[6]  = 1;  // ICNTL(7): the ordering given in PERM_IN
-    id.icntl[13] = 40; // ICNTL(14): workspace margin, %
+    initialized = true;
+    id.icntl[6] = 1; // ICNTL(7): the ordering given in PERM_IN
     // ICNTL(19) = 3: the complete Schur complement, centralised by
     // columns (a 1 x 1 process grid).
     id.icntl[18]     = 3;
@@ -152,21 +142,10 @@ namespace palpate
         return false;
       }
     schur.assign(std::size_t(k) * k, 0.0);
-    id.schur_lld     = k;
-    id.schur         = schur.data();
-    id.a             = entries.data();
-    const int margin = id.icntl[13];
-    for (unsigned int attempt = 0; attempt < 5; ++attempt)
-      {
-        id.job = 2;
-        library.call(&id);
-        const int e = id.infog[0];
-        if (e != -8 && e != -9 && e != -17 && e != -20)
-          break;
-        id.icntl[13] *= 2;
-      }
-    id.icntl[13] = margin;
-    if (id.infog[0] < 0)
+    id.schur_lld = k;
+    id.schur     = schur.data();
+    id.a         = entries.data();
+    if (!library.factorize(id))
       {
         message_ = id.infog[0] == -10 ?
                      "MUMPS: the matrix is numerically singular" :

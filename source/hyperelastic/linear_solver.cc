@@ -267,13 +267,7 @@ namespace palpate
             id          = {};
           }
         initialize();
-
-        id.icntl[0]  = -1;            // no error messages on a stream
-        id.icntl[1]  = -1;            // no diagnostics
-        id.icntl[2]  = -1;            // no global information
-        id.icntl[3]  = 0;             // print nothing
-        id.icntl[6]  = ordering_code; // ICNTL(7): fill-reducing ordering
-        id.icntl[13] = 40;            // ICNTL(14): workspace margin, %
+        id.icntl[6] = ordering_code; // ICNTL(7): fill-reducing ordering
 
         id.n   = pattern.n_rows;
         id.nnz = irn.size();
@@ -317,20 +311,7 @@ namespace palpate
           }
         id.a            = values.data();
         const auto lock = library.lock();
-        // -8, -9, -17, -20: a workspace was too small (e.g. many delayed
-        // pivots); enlarge it for this factorisation and retry.
-        const MUMPS_INT margin = id.icntl[13];
-        for (unsigned int attempt = 0; attempt < 5; ++attempt)
-          {
-            id.job = 2;
-            library.call(&id);
-            const int e = id.infog[0];
-            if (e != -8 && e != -9 && e != -17 && e != -20)
-              break;
-            id.icntl[13] *= 2;
-          }
-        id.icntl[13] = margin;
-        if (id.infog[0] < 0)
+        if (!library.factorize(id))
           {
             message_ = id.infog[0] == -10 ?
                          "MUMPS: the tangent matrix is numerically singular" :
@@ -439,22 +420,14 @@ namespace palpate
 
     private:
       /**
-       * Initialise the MUMPS instance (JOB = -1), with the caller holding
-       * MUMPS's lock. MUMPS reports a failure here (e.g. -13: it could not
-       * allocate its workspace; an MPI communicator it cannot use) only in
-       * INFOG(1) and INFO(1); everything after would work on a broken
-       * instance, so it is an error at once.
+       * Initialise the MUMPS instance (MumpsLibrary::Lease::initialize()),
+       * with the caller holding its lock; a failure is an error at once
+       * (everything after would work on a broken instance).
        */
       void
       initialize()
       {
-        id.job          = -1; // initialise an instance
-        id.par          = 1;  // this process works
-        id.sym          = 2;  // general symmetric: LDL^T with 2x2 pivots
-        id.comm_fortran = library.fortran_communicator();
-        library.call(&id);
-        const MUMPS_INT error = std::min(id.infog[0], id.info[0]);
-        if (error < 0)
+        if (!library.initialize(id))
           {
             std::ostringstream s;
             s << "MUMPS could not be initialised (JOB = -1): INFOG(1) = "

@@ -7,6 +7,7 @@
 #include <dmumps_c.h>
 #include <smumps_c.h>
 
+#include <algorithm>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -69,6 +70,57 @@ namespace palpate
       /** MUMPS's COMM_FORTRAN for an instance made through this lease. */
       int
       fortran_communicator() const;
+
+      /**
+       * A new symmetric (LDL^T, SYM = 2) instance in @p id (JOB = -1), on
+       * this process alone, printing nothing. MUMPS reports a failure
+       * here (-13: no workspace; a communicator it cannot use) only in
+       * INFOG(1) and INFO(1), and everything after would work on a broken
+       * instance: false, and @p id's codes say why. The caller holds
+       * lock().
+       */
+      template <typename Struct>
+      bool
+      initialize(Struct &id) const
+      {
+        id.job          = -1;
+        id.par          = 1;
+        id.sym          = 2;
+        id.comm_fortran = fortran_communicator();
+        call(&id);
+        if (std::min(id.infog[0], id.info[0]) < 0)
+          return false;
+        id.icntl[0]  = -1; // no error messages on a stream
+        id.icntl[1]  = -1; // no diagnostics
+        id.icntl[2]  = -1; // no global information
+        id.icntl[3]  = 0;  // print nothing
+        id.icntl[13] = 40; // ICNTL(14): workspace margin, %
+        return true;
+      }
+
+      /**
+       * The numerical factorisation (JOB = 2) of @p id, retried with the
+       * workspace margin ICNTL(14) doubled, at most five times, where a
+       * workspace was too small (INFOG(1) = -8, -9, -17, -20: many delayed
+       * pivots). Whether INFOG(1) >= 0 after it. The caller holds lock().
+       */
+      template <typename Struct>
+      bool
+      factorize(Struct &id) const
+      {
+        const auto margin = id.icntl[13];
+        for (unsigned int attempt = 0; attempt < 5; ++attempt)
+          {
+            id.job = 2;
+            call(&id);
+            const int e = id.infog[0];
+            if (e != -8 && e != -9 && e != -17 && e != -20)
+              break;
+            id.icntl[13] *= 2;
+          }
+        id.icntl[13] = margin;
+        return id.infog[0] >= 0;
+      }
 
     private:
       friend class MumpsLibrary;
