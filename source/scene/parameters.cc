@@ -921,8 +921,9 @@ namespace palpate
           "path: Mooney-Rivlin P1-P1 on liver501 (1,974 equations) 28 -> 16 "
           "ms, on a 3,976-node liver 4.9 -> 3.6 s; StVK on liver501 (1,473 "
           "equations) 12.6 -> 12.3 ms for one solver but 8 % fewer states "
-          "per second for two, whose triangular solves share MUMPS's lock "
-          "(doc/benchmarks/newton.md, scaling.md, organ-speed.md).");
+          "per second for two, measured while their triangular solves "
+          "shared one MUMPS (doc/benchmarks/newton.md, scaling.md, "
+          "organ-speed.md).");
         prm.declare_entry("Maximum Krylov iterations",
                           "10",
                           Patterns::Integer(1, 100),
