@@ -41,15 +41,20 @@ namespace palpate
     void
     on_stop_signal(const int signal)
     {
-      int expected = 0;
-      if (received.compare_exchange_strong(expected, signal))
-        received_at.store(now_ns());
+      // The first signal is the one whose time is stored first. Two
+      // deliveries may run this handler in two threads at once: had the
+      // first marked `received` before storing its time, the second could
+      // read no time yet and take itself for a second Ctrl-C.
+      const long long now   = now_ns();
+      long long       first = 0;
+      if (received_at.compare_exchange_strong(first, now))
+        received.store(signal);
       // A second stop signal within half a second of the first is the same
       // stop: `timeout`, a terminal or a process manager may deliver one
       // signal to the process and again to its group, and the run would
       // then end at once without its outputs. A person's second Ctrl-C
       // comes later.
-      else if (now_ns() - received_at.load() >= 500000000LL)
+      else if (now - first >= 500000000LL)
         {
           // The second one: the default action, now (sigaction and raise
           // are async-signal-safe).
@@ -87,6 +92,7 @@ namespace palpate
   StopRequest::StopRequest()
   {
     received.store(0);
+    received_at.store(0);
     alive.store(true);
     struct sigaction action
     {};
