@@ -21,16 +21,7 @@ namespace palpate
     : pattern(pattern)
     , library(MumpsLibrary::acquire())
   {
-    // Symmetric storage: the upper triangle, 1-based, as the solvers'.
-    for (unsigned int i = 0; i < pattern.n_rows; ++i)
-      for (unsigned int k = pattern.row_start[i]; k < pattern.row_start[i + 1];
-           ++k)
-        if (pattern.column[k] >= i)
-          {
-            irn.push_back(i + 1);
-            jcn.push_back(pattern.column[k] + 1);
-            upper.push_back(k);
-          }
+    upper_triangle(pattern, irn, jcn, upper);
     entries.resize(upper.size());
     nested_dissection = nested_dissection_positions(pattern);
   }

@@ -122,6 +122,28 @@ namespace palpate
 
 
 
+  void
+  upper_triangle(const SparsityCSR        &pattern,
+                 std::vector<int>         &irn,
+                 std::vector<int>         &jcn,
+                 std::vector<std::size_t> &upper)
+  {
+    irn.clear();
+    jcn.clear();
+    upper.clear();
+    for (unsigned int i = 0; i < pattern.n_rows; ++i)
+      for (unsigned int k = pattern.row_start[i]; k < pattern.row_start[i + 1];
+           ++k)
+        if (pattern.column[k] >= i)
+          {
+            irn.push_back(i + 1);
+            jcn.push_back(pattern.column[k] + 1);
+            upper.push_back(k);
+          }
+  }
+
+
+
   std::unique_ptr<Epetra_CrsMatrix>
   epetra_matrix(const SparsityCSR &pattern, const Epetra_Map &map)
   {
@@ -233,21 +255,8 @@ namespace palpate
         // A new analysis replaces the old one: forget the old pattern's
         // entries (they would otherwise be kept and summed with the new
         // ones).
-        irn.clear();
-        jcn.clear();
-        upper.clear();
         permutation.clear();
-        // Symmetric storage: the upper triangle only, 1-based.
-        for (unsigned int i = 0; i < pattern.n_rows; ++i)
-          for (unsigned int k = pattern.row_start[i];
-               k < pattern.row_start[i + 1];
-               ++k)
-            if (pattern.column[k] >= i)
-              {
-                irn.push_back(i + 1);
-                jcn.push_back(pattern.column[k] + 1);
-                upper.push_back(k);
-              }
+        upper_triangle(pattern, irn, jcn, upper);
         values.resize(upper.size());
 
         const auto lock = library.lock();

@@ -52,6 +52,17 @@ namespace palpate
   nested_dissection_positions(const SparsityCSR &pattern);
 
   /**
+   * The upper triangle of @p pattern as MUMPS's symmetric coordinate
+   * input: 1-based rows @p irn and columns @p jcn, and @p upper, the
+   * position of each in the pattern's value array.
+   */
+  void
+  upper_triangle(const SparsityCSR        &pattern,
+                 std::vector<int>         &irn,
+                 std::vector<int>         &jcn,
+                 std::vector<std::size_t> &upper);
+
+  /**
    * A sparse direct solver for the symmetric (indefinite) linearised
    * systems of the Newton method. analyze() runs the symbolic analysis
    * (ordering, elimination tree) of a sparsity pattern; factorize() then
