@@ -198,13 +198,6 @@ namespace
             m.forces.push_back(s.force);
             m.targets.push_back(target);
             m.converged.push_back(s.converged);
-            if (!s.converged)
-              {
-                ++m.failed;
-                break; // the rest of this line has no neighbour
-              }
-            m.newton += s.newton_iterations;
-            m.factorizations += s.stiffness_factorizations;
             if (trace)
               {
                 std::cout << "    state " << m.ms.size() << " at ("
@@ -212,7 +205,9 @@ namespace
                           << 1e3 * target[2] << ") mm: " << m.ms.back()
                           << " ms (stiffness " << 1e3 * s.stiffness_time
                           << ", patch " << 1e3 * s.contact_patch_time
-                          << "), |f| " << Utilities::norm(s.force) << " N\n";
+                          << "), |f| " << Utilities::norm(s.force) << " N"
+                          << (s.converged ? "" : ", failed: " + s.message)
+                          << "\n";
                 for (const auto &r : s.history)
                   std::cout
                     << "      inc " << r.increment << "  res "
@@ -224,6 +219,13 @@ namespace
                     << 1e3 * r.assembly_time << " solve " << 1e3 * r.solve_time
                     << " ls " << 1e3 * r.line_search_time << " ms\n";
               }
+            if (!s.converged)
+              {
+                ++m.failed;
+                break; // the rest of this line has no neighbour
+              }
+            m.newton += s.newton_iterations;
+            m.factorizations += s.stiffness_factorizations;
             for (const auto &r : s.history)
               {
                 m.krylov += r.krylov_iterations;
@@ -581,8 +583,9 @@ run_benchmark(int argc, char **argv)
      "Newton step, MUMPS in double, AMF ordering, increments of 2.5 mm",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.set_reuse(false);
-       p.linear_solver.solver   = "MUMPS";
-       p.linear_solver.ordering = "AMF";
+       p.nonlinear_solver.free_start = false;
+       p.linear_solver.solver        = "MUMPS";
+       p.linear_solver.ordering      = "AMF";
      },
      false},
     {"+reuse",
@@ -621,7 +624,21 @@ run_benchmark(int argc, char **argv)
      "Anderson acceleration of the quasi-Newton steps on kept factors "
      "(Anderson depth = 4)",
      [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.anderson_depth = 4;
+       p.nonlinear_solver.anderson_depth        = 4;
+       p.nonlinear_solver.patch_factor_residual = 0;
+     },
+     false},
+    {"+free start",
+     "a sphere that clears the body's free equilibrium (known from a state "
+     "without contact force) leaves it there: no Newton steps",
+     [](Parameters::AllParameters &p) { p.nonlinear_solver.free_start = true; },
+     false},
+    {"+patch in Newton",
+     "with a contact patch: the Newton solve's factors made with the "
+     "patch's Schur complement once the residual is below 1e-4 (the "
+     "patch without a factorisation of its own)",
+     [](Parameters::AllParameters &p) {
+       p.nonlinear_solver.patch_factor_residual = 1e-4;
      },
      false},
     {"+study tolerance",

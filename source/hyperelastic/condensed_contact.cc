@@ -24,6 +24,18 @@ namespace palpate
   {
     slot_of.assign(system.n_active_multipliers(), -1);
     columns.clear();
+    block_slot   = nullptr;
+    block_values = nullptr;
+  }
+
+
+
+  void
+  CondensedContact::use_block(const std::vector<int>    &slot,
+                              const std::vector<double> &block)
+  {
+    block_slot   = &slot;
+    block_values = &block;
   }
 
 
@@ -57,6 +69,30 @@ namespace palpate
     LinearSolver                                      &solver,
     const std::vector<HyperelasticSystem::ContactRow> &rows)
   {
+    const unsigned int m = candidates.size(), M = 3 * m;
+    H.resize(std::size_t(M) * M);
+    candidate_eq.resize(M);
+    for (unsigned int r = 0; r < M; ++r)
+      candidate_eq[r] = rows[candidates[r / 3]].eq[r % 3];
+    // From the Schur complement's block, if it holds every candidate.
+    from_block = block_slot != nullptr;
+    for (unsigned int r = 0; from_block && r < M; ++r)
+      from_block = candidate_eq[r] < 0 || (*block_slot)[candidate_eq[r]] >= 0;
+    if (from_block)
+      {
+        const std::size_t k = std::llround(std::sqrt(block_values->size()));
+        for (unsigned int r = 0; r < M; ++r)
+          for (unsigned int c = 0; c < M; ++c)
+            {
+              const int e = candidate_eq[r], f = candidate_eq[c];
+              H[std::size_t(r) * M + c] =
+                e < 0 || f < 0 ?
+                  0.0 :
+                  (*block_values)[(*block_slot)[e] * k + (*block_slot)[f]];
+            }
+        return true;
+      }
+
     // The columns of nodes that just became candidates: one block solve
     // with the kept factors, unit forces along x, y and z at each.
     missing.clear();
@@ -83,8 +119,6 @@ namespace palpate
 
     // H = P Z on the candidates (symmetric up to the factors' round-off:
     // made exactly so) and the contact forces' stiffness G.
-    const unsigned int m = candidates.size(), M = 3 * m;
-    H.resize(std::size_t(M) * M);
     for (unsigned int i = 0; i < m; ++i)
       for (unsigned int a = 0; a < 3; ++a)
         for (unsigned int j = 0; j < m; ++j)
@@ -173,10 +207,22 @@ namespace palpate
 
 
 
-  void
+  bool
   CondensedContact::add_columns(const std::vector<double> &v,
-                                std::vector<double>       &step) const
+                                std::vector<double>       &step)
   {
+    if (from_block)
+      {
+        response.assign(n, 0.0);
+        for (unsigned int r = 0; r < candidate_eq.size(); ++r)
+          if (candidate_eq[r] >= 0)
+            response[candidate_eq[r]] = v[r];
+        if (!solver_now->solve(response))
+          return false;
+        for (unsigned int e = 0; e < n; ++e)
+          step[e] += response[e];
+        return true;
+      }
     for (unsigned int i = 0; i < candidates.size(); ++i)
       for (unsigned int b = 0; b < 3; ++b)
         if (const double c = v[3 * i + b]; c != 0)
@@ -186,6 +232,7 @@ namespace palpate
             for (unsigned int e = 0; e < n; ++e)
               step[e] += c * z[e];
           }
+    return true;
   }
 
 
@@ -222,6 +269,7 @@ namespace palpate
     const unsigned int m = candidates.size(), M = 3 * m;
     if (m == 0)
       return true;
+    solver_now = &solver;
     if (!condense(solver, rows))
       return false;
 
@@ -239,13 +287,16 @@ namespace palpate
     bool with_curvature = false;
     for (const unsigned int k : candidates)
       with_curvature = with_curvature || x[rows[k].multiplier_eq] > 0;
-    if (!(with_curvature && assemble_W(x, rows, true) &&
-          solve_contact(x, rows, step, tolerance, true)))
+    if (with_curvature && assemble_W(x, rows, true))
       {
-        assemble_W(x, rows, false);
-        solve_contact(x, rows, step, tolerance, false);
+        // (Unchanged unless the active-set method settles.)
+        backup = step;
+        if (solve_contact(x, rows, step, tolerance, true))
+          return true;
+        step.swap(backup);
       }
-    return true;
+    assemble_W(x, rows, false);
+    return solve_contact(x, rows, step, tolerance, false);
   }
 
 
@@ -307,8 +358,7 @@ namespace palpate
           for (unsigned int c = 0; c < M; ++c)
             v[c] += d * S[std::size_t(j) * M + c];
       }
-    add_columns(v, step);
-    return true;
+    return add_columns(v, step);
   }
 
 
@@ -336,6 +386,7 @@ namespace palpate
     const unsigned int m = candidates.size(), M = 3 * m;
     if (m == 0)
       return true;
+    solver_now = &solver;
     if (!condense(solver, rows) ||
         !(assemble_W(x, rows, true) || assemble_W(x, rows, false)))
       return false;

@@ -2,7 +2,6 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/hyperelastic/contact_patch.h>
-#include <palpate/hyperelastic/inverse_block.h>
 
 #include <algorithm>
 #include <atomic>
@@ -30,27 +29,42 @@ namespace palpate
 
 
 
+  void
+  contact_patch_nodes(const std::vector<HyperelasticSystem::ContactRow> &rows,
+                      const double                                       reach,
+                      std::vector<unsigned int>                         &nodes,
+                      std::vector<unsigned int> &unknowns)
+  {
+    nodes.clear();
+    unknowns.clear();
+    for (unsigned int k = 0; k < rows.size(); ++k)
+      if (rows[k].gap <= reach && std::any_of(rows[k].eq.begin(),
+                                              rows[k].eq.end(),
+                                              [](int e) { return e >= 0; }))
+        {
+          nodes.push_back(k);
+          for (const int e : rows[k].eq)
+            if (e >= 0)
+              unknowns.push_back(e);
+        }
+  }
+
+
+
   std::shared_ptr<const ContactPatch>
   make_contact_patch(const HyperelasticSystem                    &system,
-                     InverseBlock                                &compliance,
-                     const std::vector<double>                   &tangent,
+                     const std::vector<unsigned int>             &nodes,
+                     const std::vector<double>                   &block,
                      const std::vector<double>                   &x,
                      const Utilities::Point3                     &target,
-                     const double                                 reach,
                      std::vector<HyperelasticSystem::ContactRow> &rows)
   {
     auto patch    = std::make_shared<ContactPatch>();
     patch->target = target;
     patch->center = system.sphere_center(target);
     patch->radius = system.sphere_radius();
+    patch->nodes  = nodes;
     system.contact_rows(x, target, rows);
-    // A node fixed in every direction never moves under the sphere: its
-    // compliance row would be zero and the contact problem singular.
-    for (unsigned int k = 0; k < rows.size(); ++k)
-      if (rows[k].gap <= reach && std::any_of(rows[k].eq.begin(),
-                                              rows[k].eq.end(),
-                                              [](int e) { return e >= 0; }))
-        patch->nodes.push_back(k);
     const unsigned int m = patch->size();
     if (m == 0)
       return patch;
@@ -58,19 +72,15 @@ namespace palpate
     // H = P K^-1 P^T on the nodes' free DoFs, the block of the inverse of
     // the contact-free tangent there (zero rows and columns for DoFs a
     // boundary condition fixes).
-    std::vector<unsigned int> unknowns;
-    std::vector<int>          slot(3 * m, -1);
+    std::vector<int> slot(3 * m, -1);
+    unsigned int     k = 0;
     for (unsigned int j = 0; j < m; ++j)
       for (unsigned int a = 0; a < 3; ++a)
-        if (const int e = rows[patch->nodes[j]].eq[a]; e >= 0)
-          {
-            slot[3 * j + a] = unknowns.size();
-            unknowns.push_back(e);
-          }
-    std::vector<double> block;
-    if (!compliance.compute(tangent, unknowns, block))
+        if (rows[patch->nodes[j]].eq[a] >= 0)
+          slot[3 * j + a] = k++;
+    if (block.size() != std::size_t(k) * k)
       return nullptr;
-    const unsigned int  M = 3 * m, k = unknowns.size();
+    const unsigned int  M = 3 * m;
     std::vector<double> H(std::size_t(M) * M, 0.0);
     for (unsigned int r = 0; r < M; ++r)
       if (slot[r] >= 0)

@@ -13,6 +13,20 @@ extern "C"
   dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info);
   void
   dpotri_(const char *uplo, const int *n, double *a, const int *lda, int *info);
+  void
+  dgemm_(const char   *transa,
+         const char   *transb,
+         const int    *m,
+         const int    *n,
+         const int    *k,
+         const double *alpha,
+         const double *a,
+         const int    *lda,
+         const double *b,
+         const int    *ldb,
+         const double *beta,
+         double       *c,
+         const int    *ldc);
 }
 
 namespace palpate
@@ -38,6 +52,7 @@ namespace palpate
   void
   InverseBlock::terminate()
   {
+    factored = false;
     if (!initialized)
       return;
     const auto lock = library.lock();
@@ -45,6 +60,14 @@ namespace palpate
     library.call(&id);
     initialized = false;
     id          = {};
+  }
+
+
+
+  bool
+  InverseBlock::has_factors() const
+  {
+    return factored;
   }
 
 
@@ -169,6 +192,167 @@ namespace palpate
       for (unsigned int r = 0; r <= c; ++r)
         inverse[std::size_t(r) * k + c] = inverse[std::size_t(c) * k + r] =
           schur_inverse[std::size_t(c) * k + r];
+    block_inverse = inverse;
+    factored      = true;
     return true;
+  }
+
+
+
+  bool
+  InverseBlock::solve_many(std::vector<double> &block, const unsigned int n_rhs)
+  {
+    if (!factored)
+      {
+        message_ = "no factors to solve with";
+        return false;
+      }
+    if (n_rhs == 0)
+      return true;
+    const int n = pattern.n_rows, k = id.size_schur, columns = n_rhs;
+    rhs.assign(block.begin(), block.end());
+    reduced.resize(std::size_t(k) * n_rhs);
+    // Right-hand sides that are mostly zero (unit forces on a few nodes:
+    // the condensed contact's compliance columns, all on the patch's
+    // nodes) go in as a sparse matrix, so that the forward elimination
+    // visits only the branches of the elimination tree they touch: for
+    // forces on S alone, none but S's.
+    sparse_pointer.assign(1, 1);
+    sparse_row.clear();
+    sparse_value.clear();
+    for (unsigned int j = 0; j < n_rhs; ++j)
+      {
+        for (int i = 0; i < n; ++i)
+          if (const float v = rhs[std::size_t(j) * n + i]; v != 0)
+            {
+              sparse_row.push_back(i + 1);
+              sparse_value.push_back(v);
+            }
+        sparse_pointer.push_back(sparse_row.size() + 1);
+      }
+    if (sparse_row.empty())
+      return true; // B = 0 (which MUMPS refuses with a reduced RHS)
+    const bool sparse = 100 * sparse_row.size() <= rhs.size();
+    const auto lock   = library.lock();
+    id.nrhs           = columns;
+    id.lrhs           = n;
+    id.rhs            = rhs.data();
+    id.redrhs         = reduced.data();
+    id.lredrhs        = k;
+    if (sparse)
+      {
+        id.icntl[19]   = 1;
+        id.nz_rhs      = sparse_row.size();
+        id.irhs_ptr    = sparse_pointer.data();
+        id.irhs_sparse = sparse_row.data();
+        id.rhs_sparse  = sparse_value.data();
+      }
+    // The forward elimination, which leaves the right-hand sides
+    // condensed on S in REDRHS (ICNTL(26) = 1); then the Schur unknowns'
+    // solution x_S = S_A^-1 y_S by the block in double; then the backward
+    // substitution from it (ICNTL(26) = 2).
+    id.icntl[25] = 1;
+    id.job       = 3;
+    library.call(&id);
+    if (id.infog[0] >= 0)
+      {
+        reduced_double.assign(reduced.begin(), reduced.end());
+        solution_double.resize(reduced_double.size());
+        const double one = 1, zero = 0;
+        dgemm_("N",
+               "N",
+               &k,
+               &columns,
+               &k,
+               &one,
+               block_inverse.data(),
+               &k,
+               reduced_double.data(),
+               &k,
+               &zero,
+               solution_double.data(),
+               &k);
+        reduced.assign(solution_double.begin(), solution_double.end());
+        id.icntl[25] = 2;
+        library.call(&id);
+      }
+    id.icntl[25] = 0;
+    id.icntl[19] = 0;
+    id.nrhs      = 1;
+    if (id.infog[0] < 0)
+      {
+        message_ = "MUMPS solve with a Schur complement failed, INFOG(1) = " +
+                   std::to_string(id.infog[0]);
+        return false;
+      }
+    for (std::size_t i = 0; i < block.size(); ++i)
+      {
+        block[i] = rhs[i];
+        if (!std::isfinite(block[i]))
+          {
+            message_ = "MUMPS returned a non-finite solution";
+            return false;
+          }
+      }
+    return true;
+  }
+
+
+
+  SchurFactors::SchurFactors(InverseBlock &block)
+    : block(block)
+  {}
+
+
+
+  void
+  SchurFactors::analyze(const SparsityCSR &)
+  {}
+
+
+
+  bool
+  SchurFactors::factorize(const std::vector<double> &)
+  {
+    message_ = "the factors of a Schur complement are made by "
+               "InverseBlock::compute()";
+    return false;
+  }
+
+
+
+  bool
+  SchurFactors::solve(std::vector<double> &rhs)
+  {
+    return solve_many(rhs, 1);
+  }
+
+
+
+  bool
+  SchurFactors::solve_many(std::vector<double> &columns,
+                           const unsigned int   n_rhs)
+  {
+    if (block.solve_many(columns, n_rhs))
+      return true;
+    message_ = block.message();
+    return false;
+  }
+
+
+
+  bool
+  SchurFactors::exact() const
+  {
+    return false;
+  }
+
+
+
+  std::string
+  SchurFactors::name() const
+  {
+    return "MUMPS in single precision with a Schur complement on the "
+           "contact patch";
   }
 } // namespace palpate

@@ -475,6 +475,7 @@ namespace palpate
     // (this Newton solve): those of an increment before are of another
     // target.
     factors_of_state = false;
+    patch_of_state   = false;
     anderson.reset();
 
     for (unsigned int iteration = 0;; ++iteration)
@@ -493,16 +494,13 @@ namespace palpate
         record.assembly_time   = assembly_time;
 
         start = Clock::now();
-        if (!(condensed_path ? condensed_step(x, target, record, refactorize) :
-                               newton_step(record)))
-          {
-            outcome.status     = SolveStatus::linear_solver_failure;
-            outcome.iterations = iteration;
-            outcome.message    = linear_solver->message().empty() ?
-                                   "GMRES did not converge" :
-                                   linear_solver->message();
-            return outcome;
-          }
+        const bool with_patch =
+          condensed_path &&
+          patch_factors_due(record.residual_before, target, state);
+        if (!(condensed_path ?
+                condensed_step(x, target, record, refactorize, with_patch) :
+                newton_step(record)))
+          return linear_solver_failure(iteration, condensed_path);
         if (condensed_path)
           record.accelerated = accelerate(x, record.factorized);
         record.solve_time = seconds_since(start);
@@ -566,7 +564,8 @@ namespace palpate
           {
             steps_on_factors = record.factorized ? 0 : steps_on_factors + 1;
             refactorize =
-              worth_refactorizing(record, previous_rate, steps_on_factors);
+              worth_refactorizing(record, previous_rate, steps_on_factors) ||
+              patch_factors_due(record.residual_after, target, state);
             previous_rate = record.factorized ?
                               0 :
                               record.residual_after / record.residual_before;
@@ -585,6 +584,22 @@ namespace palpate
           }
         assembly_time = seconds_since(start);
       }
+  }
+
+
+
+  StateSolver::Impl::Outcome
+  StateSolver::Impl::linear_solver_failure(const unsigned int iteration,
+                                           const bool         condensed_path)
+  {
+    Outcome outcome;
+    outcome.status     = SolveStatus::linear_solver_failure;
+    outcome.iterations = iteration;
+    const LinearSolver &solver =
+      condensed_path ? kept_factors() : *linear_solver;
+    outcome.message =
+      solver.message().empty() ? "GMRES did not converge" : solver.message();
+    return outcome;
   }
 
 
@@ -655,8 +670,21 @@ namespace palpate
     if (impl->patch_reach > 0 && impl->system->has_contact())
       {
         impl->factors_of_state = false;
+        impl->patch_of_state   = false;
         impl->contact_patch(state, x);
       }
+    // With no load but the sphere's, the rest configuration is the free
+    // equilibrium: its residual is round-off, far below the force scale
+    // (at rest that is the floor 1e-12 E L^2; any other load makes the
+    // residual of the order of the scale, and a converged state without
+    // contact force shows the equilibrium later).
+    double scale = 0;
+    if (impl->system->has_contact() &&
+        impl->system->assemble(
+          x, state.active_displacement, impl->residual, nullptr, &scale) &&
+        impl->system->force_residual_norm(impl->residual) <= 1e-3 * scale &&
+        impl->system->constraint_violation(impl->residual) == 0)
+      impl->remember_if_free(state, x);
     return state;
   }
 
@@ -683,10 +711,13 @@ namespace palpate
     if (!impl->admissible_start(from, target, state))
       return state;
 
-    const auto         &s      = impl->settings;
-    std::vector<double> x      = impl->system->from_state(from);
-    const auto          a      = from.active_displacement;
-    const double        length = Utilities::distance(a, target);
+    const auto         &s = impl->settings;
+    std::vector<double> x = impl->system->from_state(from);
+    // A sphere that clears the body's free equilibrium leaves it there:
+    // the state is that equilibrium, with no path to walk to it.
+    const bool   free   = impl->start_free(target, x);
+    const auto   a      = free ? target : from.active_displacement;
+    const double length = Utilities::distance(a, target);
     // A path of more than 1000 increments is not a haptic interaction
     // but a mistake; refuse it rather than work for minutes.
     const double needed = impl->increments_needed(length);
@@ -719,8 +750,9 @@ namespace palpate
     // A state behind the source on the line to the target is the
     // increment before the first one: the secant predictor below then
     // extrapolates it to the first increment's end.
-    impl->predictor_from_behind(
-      from, target, behind, behind2, n, x, previous, previous_t);
+    if (!free)
+      impl->predictor_from_behind(
+        from, target, behind, behind2, n, x, previous, previous_t);
     const unsigned int                                work_limit = 2000 + 8 * n;
     std::function<bool(double, double, unsigned int)> increment =
       [&](const double t0, const double t1, const unsigned int depth) {
@@ -799,7 +831,7 @@ namespace palpate
       };
 
     bool ok = true;
-    for (unsigned int i = 1; i <= n && ok; ++i)
+    for (unsigned int i = 1; i <= n && ok && !free; ++i)
       ok = increment(double(i - 1) / n, double(i) / n, 0);
 
     impl->system->to_state(x, state);
@@ -815,7 +847,10 @@ namespace palpate
         state.force     = {{0, 0, 0}};
       }
     else
-      impl->derivatives(state, x);
+      {
+        impl->derivatives(state, x);
+        impl->remember_if_free(state, x);
+      }
     state.wall_time = seconds_since(start);
     return state;
   }

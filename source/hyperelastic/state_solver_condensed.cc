@@ -70,6 +70,7 @@ namespace palpate
     if (!system->assemble(x, target, trial_residual, &matrix, nullptr, false))
       return false;
     factorized = factorized_current = contact_free_factors = false;
+    kept_are_schur                                         = false;
     bool ok = linear_solver->factorize(matrix);
     if (!ok && fall_back_to_double())
       ok = linear_solver->factorize(matrix);
@@ -84,7 +85,8 @@ namespace palpate
   StateSolver::Impl::condensed_step(const std::vector<double> &x,
                                     const Utilities::Point3   &target,
                                     NewtonIteration           &record,
-                                    const bool                 refactorize)
+                                    const bool                 refactorize,
+                                    const bool                 with_patch)
   {
     // The factors are of the contact-free tangent of some earlier iterate,
     // possibly of an earlier state, renewed only where that pays
@@ -98,7 +100,11 @@ namespace palpate
       {
         factors_of_state  = true;
         factored_residual = record.residual_before;
-        if (!factorize_contact_free(x, target))
+        // Close to the state, the factors are made with the contact patch
+        // as a Schur complement: the same factors for these steps, and the
+        // patch's compliance without a factorisation of its own.
+        if (!(with_patch && factorize_with_patch(x, target)) &&
+            !factorize_contact_free(x, target))
           return false;
       }
     const double beta = system->constraint_scale();
@@ -114,8 +120,8 @@ namespace palpate
       }
     for (double &v : step)
       v = -v;
-    return linear_solver->solve(step) &&
-           condensed->step(*linear_solver,
+    return kept_factors().solve(step) &&
+           condensed->step(kept_factors(),
                            x,
                            rows,
                            step,
@@ -169,7 +175,58 @@ namespace palpate
           return false;
       }
     system->contact_rows(x, state.active_displacement, rows);
-    return condensed->stiffness(*linear_solver, x, rows, state.stiffness);
+    return condensed->stiffness(kept_factors(), x, rows, state.stiffness);
+  }
+
+
+
+  bool
+  StateSolver::Impl::factorize_with_patch(const std::vector<double> &x,
+                                          const Utilities::Point3   &target)
+  {
+    if (!inverse_block)
+      {
+        inverse_block = std::make_unique<InverseBlock>(system->sparsity());
+        schur_factors = std::make_unique<SchurFactors>(*inverse_block);
+      }
+    // A new partial factorisation replaces the one the kept factors may be.
+    if (kept_are_schur)
+      {
+        factorized = factorized_current = contact_free_factors = false;
+        condensed->reset();
+      }
+    kept_are_schur = false;
+    patch_nodes.clear();
+    if (!system->assemble(
+          x, target, trial_residual, &patch_tangent, nullptr, false))
+      return false;
+    system->contact_rows(x, target, patch_rows);
+    contact_patch_nodes(patch_rows, patch_reach, patch_nodes, patch_unknowns);
+    if (patch_nodes.empty())
+      {
+        // No node within reach: the state's patch is the empty one, and
+        // there is nothing to factorise it on.
+        patch_block.clear();
+        patch_of_state = true;
+        return false;
+      }
+    if (!inverse_block->compute(patch_tangent, patch_unknowns, patch_block))
+      return false;
+    patch_of_state = true;
+    // The condensed path iterates on these factors (the Newton steps
+    // after them, the next state's): they are of the contact-free tangent
+    // near the state, as its own would be.
+    if (settings.condensed_contact && condensed)
+      {
+        factorized = contact_free_factors = kept_are_schur = true;
+        factorized_current                                 = false;
+        condensed->reset();
+        schur_slot.assign(system->n_equations(), -1);
+        for (unsigned int i = 0; i < patch_unknowns.size(); ++i)
+          schur_slot[patch_unknowns[i]] = i;
+        condensed->use_block(schur_slot, patch_block);
+      }
+    return true;
   }
 
 
@@ -177,27 +234,23 @@ namespace palpate
   bool
   StateSolver::Impl::contact_patch(State &state, const std::vector<double> &x)
   {
-    // The patch's compliance is that of the state's own contact-free
-    // tangent, from a partial factorisation of its own (InverseBlock):
-    // the Newton steps' factors, which the next state starts from, are
-    // left as they are.
-    if (!inverse_block)
-      inverse_block = std::make_unique<InverseBlock>(system->sparsity());
-    ++state.stiffness_factorizations;
-    if (!system->assemble(x,
-                          state.active_displacement,
-                          trial_residual,
-                          &patch_tangent,
-                          nullptr,
-                          false))
-      return false;
+    // From the factors of an iterate of the state's last Newton solve if
+    // it made them (patch_factors_due()), else a partial factorisation of
+    // the converged tangent of its own.
+    if (!patch_of_state)
+      {
+        ++state.stiffness_factorizations;
+        // (An empty patch is made without factors.)
+        if (!factorize_with_patch(x, state.active_displacement) &&
+            !patch_of_state)
+          return false;
+      }
     state.contact_patch = make_contact_patch(*system,
-                                             *inverse_block,
-                                             patch_tangent,
+                                             patch_nodes,
+                                             patch_block,
                                              x,
                                              state.active_displacement,
-                                             patch_reach,
-                                             rows);
+                                             patch_rows);
     return state.contact_patch != nullptr;
   }
 

@@ -205,4 +205,52 @@ namespace palpate
       }
     return true;
   }
+
+
+  bool
+  StateSolver::Impl::clears_free_equilibrium(
+    const Utilities::Point3 &target) const
+  {
+    if (!settings.free_start || free_equilibrium.empty())
+      return false;
+    // No node touching it, and its centre a radius from the surface
+    // between the nodes too (a sphere can slip between them:
+    // acceptable_end()).
+    system->contact_rows(free_equilibrium, target, free_rows);
+    for (const auto &r : free_rows)
+      if (r.gap <= 0)
+        return false;
+    return system->sphere_center_distance(free_equilibrium, target) >=
+           system->sphere_radius();
+  }
+
+
+
+  bool
+  StateSolver::Impl::start_free(const Utilities::Point3 &target,
+                                std::vector<double>     &x)
+  {
+    if (!clears_free_equilibrium(target))
+      return false;
+    // Its residual is the one accepted when it was kept: the contact rows,
+    // the only ones the target changes, hold with no force. No Newton
+    // solve makes factors or a patch for this state.
+    x                = free_equilibrium;
+    factors_of_state = patch_of_state = false;
+    return true;
+  }
+
+
+
+  void
+  StateSolver::Impl::remember_if_free(const State               &state,
+                                      const std::vector<double> &x)
+  {
+    // Only the sphere's contact depends on the target; with no force from
+    // it this is the body under its other loads alone. (Kept once: every
+    // such state is the same equilibrium, to the solver's tolerance.)
+    if (system->has_contact() && free_equilibrium.empty() && state.converged &&
+        state.force[0] == 0 && state.force[1] == 0 && state.force[2] == 0)
+      free_equilibrium = x;
+  }
 } // namespace palpate

@@ -6,11 +6,15 @@
 // client's cache holds it for the haptic loop. On the beam pressed by a
 // 1 cm sphere (2 mm grid, 3.5 mm cloud, the HIP resting at three
 // positions), every point both engines computed has a patch on the
-// client too, of the same nodes, with the same force, positions and
-// compliance as the threaded engine's (1e-6 relative: the two engines
-// may reach a point from different neighbours); the rendered force
-// between the states (PatchContact::blend at positions between the grid
-// points) is the same from either cache.
+// client too, of the same nodes, with the same force and positions as
+// the threaded engine's (1e-6 relative: the two engines may reach a point
+// from different neighbours), and the same compliance to 1e-3: a state's
+// patch comes from the factors its Newton solve makes once the relative
+// residual is below 1e-4 (Nonlinear solver's patch_factor_residual), at an
+// iterate that depends on the neighbour it started from (measured 1.4e-4
+// apart). The rendered force between the states (PatchContact::blend at
+// positions between the grid points) is the same from either cache to
+// 1e-5 for the same reason (measured 8e-7).
 
 #include <palpate/engine/hip_channel.h>
 #include <palpate/engine/mpi_engine.h>
@@ -176,10 +180,9 @@ main(int argc, char **argv)
             << " (all: " << (with_patch == both ? "yes" : "NO")
             << "), the same nodes: " << (same_nodes == both ? "yes" : "NO")
             << ", touching: " << (touching > 0 ? "some" : "none") << std::endl;
-    deallog << "forces, positions and compliance as the threaded engine's "
-            << "(1e-6): "
-            << (force < 1e-6 && position < 1e-6 && compliance < 1e-6 ? "yes" :
-                                                                       "NO")
+    deallog << "forces and positions as the threaded engine's (1e-6): "
+            << (force < 1e-6 && position < 1e-6 ? "yes" : "NO")
+            << ", compliance (1e-3): " << (compliance < 1e-3 ? "yes" : "NO")
             << std::endl;
 
     palpate::PatchContact from_threads(1000, 200), from_mpi(1000, 200);
@@ -196,8 +199,8 @@ main(int argc, char **argv)
       }
     deallog << "rendered between the states: largest "
             << palpate::Utilities::to_string(largest, 2)
-            << " N, the same from either cache (1e-6): "
-            << (rendered_difference < 1e-6 * std::max(largest, 1e-3) ? "yes" :
+            << " N, the same from either cache (1e-5): "
+            << (rendered_difference < 1e-5 * std::max(largest, 1e-3) ? "yes" :
                                                                        "NO")
             << std::endl;
   }

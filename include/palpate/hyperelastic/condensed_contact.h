@@ -45,9 +45,20 @@ namespace palpate
     explicit CondensedContact(const HyperelasticSystem &system);
 
     /** The kept factors changed (or are of another matrix): drop every
-     * column. */
+     * column, and the block use_block() gave. */
     void
     reset();
+
+    /**
+     * The kept factors are a Schur complement's (SchurFactors) whose
+     * compliance @p block (k x k, row-major) on the DoFs with
+     * @p slot[e] >= 0 (their row in it) is known: while every candidate's
+     * DoFs are among them, H is read from it and the step's response to
+     * the candidates' forces is one solve, instead of three columns per
+     * candidate. Both are kept by reference until reset().
+     */
+    void
+    use_block(const std::vector<int> &slot, const std::vector<double> &block);
 
     /**
      * Turn @p step, on entry K^-1 (-R) with the contact forces lambda =
@@ -116,9 +127,11 @@ namespace palpate
                   const double                                       tolerance,
                   const bool settled_only);
 
-    /** step += Z v for a vector @p v of the candidates' 3m DoFs. */
-    void
-    add_columns(const std::vector<double> &v, std::vector<double> &step) const;
+    /** step += Z v for a vector @p v of the candidates' 3m DoFs: from the
+     * columns, or by one solve when H is from the block. False if that
+     * solve fails. */
+    bool
+    add_columns(const std::vector<double> &v, std::vector<double> &step);
 
     const HyperelasticSystem &system;
     const unsigned int        n;
@@ -131,8 +144,17 @@ namespace palpate
       v0, y;
     std::vector<unsigned int> pivot, pivot_W;
     /** Whether G, made by the last assemble_W(), is not zero. */
-    bool       curved = false;
-    ContactLCP lcp;
+    bool curved = false;
+    // use_block()'s block, whether the last condense() read H from it, and
+    // the solver of the current step (add_columns() solves with it then).
+    const std::vector<int>    *block_slot   = nullptr;
+    const std::vector<double> *block_values = nullptr;
+    bool                       from_block   = false;
+    LinearSolver              *solver_now   = nullptr;
+    std::vector<double>        response, backup;
+    // The candidates' DoFs (3 per candidate, -1 where fixed).
+    std::vector<int> candidate_eq;
+    ContactLCP       lcp;
   };
 } // namespace palpate
 

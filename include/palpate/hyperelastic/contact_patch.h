@@ -99,20 +99,33 @@ namespace palpate
   };
 
   /**
+   * The nodes a contact patch holds, from the sphere's candidate @p rows
+   * at some unknowns: those whose gap is at most @p reach (m), less any a
+   * boundary condition fixes in every direction (its compliance row would
+   * be zero and the contact problem singular). Into @p nodes, and their
+   * free DoFs in that order into @p unknowns: the block of the compliance
+   * that make_contact_patch() wants.
+   */
+  void
+  contact_patch_nodes(const std::vector<HyperelasticSystem::ContactRow> &rows,
+                      double                                             reach,
+                      std::vector<unsigned int>                         &nodes,
+                      std::vector<unsigned int> &unknowns);
+
+  /**
    * The contact patch of the converged state at unknowns @p x with the
-   * HIP at @p target: the surface nodes whose gap is at most @p reach (m),
-   * and their compliance, the block of the inverse of the contact-free
-   * @p tangent at @p x (its entries in the system's sparsity pattern) on
-   * their DoFs, by @p compliance; @p rows is work space. Null if that
-   * fails.
+   * HIP at @p target, on @p nodes (contact_patch_nodes()), whose
+   * compliance @p block is the block of the inverse of the contact-free
+   * tangent on their free DoFs (k x k, row-major, in the order of
+   * contact_patch_nodes()'s unknowns: InverseBlock::compute()), of the
+   * tangent at x or at an iterate close to it. @p rows is work space.
    */
   std::shared_ptr<const ContactPatch>
   make_contact_patch(const HyperelasticSystem                    &system,
-                     InverseBlock                                &compliance,
-                     const std::vector<double>                   &tangent,
+                     const std::vector<unsigned int>             &nodes,
+                     const std::vector<double>                   &block,
                      const std::vector<double>                   &x,
                      const Utilities::Point3                     &target,
-                     const double                                 reach,
                      std::vector<HyperelasticSystem::ContactRow> &rows);
 } // namespace palpate
 

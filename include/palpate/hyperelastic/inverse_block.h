@@ -30,6 +30,12 @@ namespace palpate
    * single precision (half the time of double, as for the Newton steps'
    * factors; the patch keeps H in single precision anyway): the caller's
    * factors stay as they are.
+   * The factors stay until the next compute(): solve_many() solves with
+   * them (MUMPS condenses the right-hand sides on S, the block solves
+   * there, MUMPS expands), so one partial factorisation of a state's
+   * tangent gives both its patch's compliance and the factors its Newton
+   * steps, and the next state's, iterate on.
+   *
    * Not thread-safe; one per state solver.
    */
   class InverseBlock
@@ -52,6 +58,19 @@ namespace palpate
             const std::vector<unsigned int> &unknowns,
             std::vector<double>             &inverse);
 
+    /**
+     * Solve A X = B in place for @p n_rhs right-hand sides stored one
+     * after the other in @p block (n rows each), with the factors of the
+     * last successful compute(): single precision, like the Newton steps'
+     * own factors. False, with message(), if there are none or MUMPS fails.
+     */
+    bool
+    solve_many(std::vector<double> &block, unsigned int n_rhs);
+
+    /** Whether compute() left factors that solve_many() can use. */
+    bool
+    has_factors() const;
+
     const std::string &
     message() const;
 
@@ -63,12 +82,53 @@ namespace palpate
     MumpsLibrary::Lease      library;
     SMUMPS_STRUC_C           id          = {};
     bool                     initialized = false;
+    bool                     factored    = false;
     std::vector<int>         irn, jcn, nested_dissection, permutation;
     std::vector<int>         schur_list;
     std::vector<std::size_t> upper;
     std::vector<float>       entries, schur;
-    std::vector<double>      schur_inverse;
-    std::string              message_;
+    std::vector<double>      schur_inverse, block_inverse;
+    // solve_many()'s work: the right-hand sides, their condensed parts and
+    // the block's solution there.
+    std::vector<float>  rhs, reduced, sparse_value;
+    std::vector<int>    sparse_pointer, sparse_row;
+    std::vector<double> reduced_double, solution_double;
+    std::string         message_;
+  };
+
+
+  /**
+   * An InverseBlock's factors seen as a LinearSolver, for the code that
+   * solves through one (the Newton steps, CondensedContact's compliance
+   * columns). Solves only: InverseBlock::compute() makes the factors, and
+   * factorize() here refuses. Not exact (single precision), like the
+   * Newton steps' own factors from 5,000 equations.
+   */
+  class SchurFactors : public LinearSolver
+  {
+  public:
+    explicit SchurFactors(InverseBlock &block);
+
+    void
+    analyze(const SparsityCSR &pattern) override;
+
+    bool
+    factorize(const std::vector<double> &values) override;
+
+    bool
+    solve(std::vector<double> &rhs) override;
+
+    bool
+    solve_many(std::vector<double> &block, unsigned int n_rhs) override;
+
+    bool
+    exact() const override;
+
+    std::string
+    name() const override;
+
+  private:
+    InverseBlock &block;
   };
 } // namespace palpate
 

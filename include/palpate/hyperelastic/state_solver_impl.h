@@ -17,6 +17,7 @@
 #include <palpate/hyperelastic/linear_solver.h>
 #include <palpate/hyperelastic/state_solver.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -129,14 +130,16 @@ namespace palpate
     /**
      * The Newton step of Contact solver = condensed into `step` (from
      * `residual` at @p x), with the factors renewed first if
-     * @p refactorize; fills @p record's solver fields. False if the linear
+     * @p refactorize (with the contact patch's Schur complement if
+     * @p with_patch); fills @p record's solver fields. False if the linear
      * solver failed.
      */
     bool
     condensed_step(const std::vector<double> &x,
                    const Utilities::Point3   &target,
                    NewtonIteration           &record,
-                   const bool                 refactorize);
+                   bool                       refactorize,
+                   bool                       with_patch);
 
     /** The line search along the step just made (the plain step if an
      * accelerated one does not reduce the residual at full length), its
@@ -182,10 +185,48 @@ namespace palpate
     derivatives(State &state, const std::vector<double> &x);
 
     /** The contact patch of the converged @p state at @p x, its
-     * compliance from the contact-free tangent there (inverse_block).
-     * False if that fails. */
+     * compliance from the contact-free tangent there (inverse_block), or
+     * from the factors factorize_with_patch() made at an iterate of its
+     * last Newton solve. False if that fails. */
     bool
     contact_patch(State &state, const std::vector<double> &x);
+
+    /**
+     * Assemble the contact-free tangent at @p x and factorise it with the
+     * DoFs of the contact patch's nodes there as a Schur complement
+     * (inverse_block): the patch's compliance block into patch_block, and
+     * its factors become the kept ones. False if that fails (then there
+     * are no kept factors) or there is no node within reach (then the
+     * state's patch is the empty one: patch_of_state).
+     */
+    bool
+    factorize_with_patch(const std::vector<double> &x,
+                         const Utilities::Point3   &target);
+
+    /** Whether the contact patch's factors are to be made now, in the
+     * Newton solve for @p target of @p state at relative residual
+     * @p residual: a patch is wanted, this is the state's last increment,
+     * the iterate is close enough to the state (or, with a tolerance too
+     * coarse for that, a step from converging) and none were made yet. */
+    bool
+    patch_factors_due(const double             residual,
+                      const Utilities::Point3 &target,
+                      const State             &state) const
+    {
+      return patch_reach > 0 && condensed && settings.condensed_contact &&
+             !patch_of_state &&
+             residual <= std::max(settings.patch_factor_residual,
+                                  10 * settings.residual_tolerance) &&
+             target == state.active_displacement;
+    }
+
+    /** The factors the condensed path's steps solve with: the linear
+     * solver's, or the Schur complement's of the last patch. */
+    LinearSolver &
+    kept_factors()
+    {
+      return kept_are_schur ? *schur_factors : *linear_solver;
+    }
 
     /** The active-node stiffness of a converged state from the condensed
      * contact problem on the kept factors (Contact solver = condensed). */
@@ -231,6 +272,29 @@ namespace palpate
                           const std::vector<double> &x,
                           std::vector<double>       &previous,
                           double                    &previous_t) const;
+
+    /** Whether the sphere at @p target clears the body's free equilibrium
+     * (free_equilibrium, once known): no node touches it and its centre
+     * is a radius from the surface. That equilibrium is then the state
+     * at @p target. */
+    bool
+    clears_free_equilibrium(const Utilities::Point3 &target) const;
+
+    /** If the sphere at @p target clears the free equilibrium: @p x is
+     * that equilibrium, the state at @p target without a Newton solve
+     * (true). */
+    bool
+    start_free(const Utilities::Point3 &target, std::vector<double> &x);
+
+    /** The failure of a Newton step whose linear solve failed, at
+     * @p iteration. */
+    Outcome
+    linear_solver_failure(unsigned int iteration, bool condensed_path);
+
+    /** Keep @p x as the free equilibrium if the converged @p state has no
+     * contact force (and none is kept yet). */
+    void
+    remember_if_free(const State &state, const std::vector<double> &x);
 
     /** Whether the converged end @p x (in @p state) is one to hand out: a
      * finite force and, with a sphere, a sphere still outside the deformed
@@ -326,6 +390,7 @@ namespace palpate
                         unsigned int        &krylov_iterations)
     {
       factorized = factorized_current = contact_free_factors = false;
+      kept_are_schur                                         = false;
       krylov_iterations                                      = 0;
       bool solved = linear_solver->factorize(matrix);
       if (solved && linear_solver->exact())
@@ -355,6 +420,7 @@ namespace palpate
       linear_solver = LinearSolver::create("MUMPS", ordering);
       linear_solver->analyze(system->sparsity());
       factorized = factorized_current = contact_free_factors = false;
+      kept_are_schur                                         = false;
       return true;
     }
 
@@ -371,12 +437,31 @@ namespace palpate
     AndersonAcceleration anderson;
     std::vector<double>  plain_step;
     std::vector<char>    in_contact, was_in_contact;
-    // The contact patches' compliance (made when the first is wanted).
+    // The contact patches' compliance (made when the first is wanted),
+    // its factors as a solver, and whether they are the kept factors.
     std::unique_ptr<InverseBlock> inverse_block;
+    std::unique_ptr<SchurFactors> schur_factors;
+    bool                          kept_are_schur = false;
     std::vector<double>           patch_tangent;
+    // The patch's nodes, DoFs and compliance block from the factors of
+    // the state's last Newton solve (patch_of_state), made once its
+    // relative residual is below settings.patch_factor_residual: the
+    // tangent there is the converged one's to that order, and the Newton
+    // steps after it and the next state's iterate on them.
+    bool                      patch_of_state = false;
+    std::vector<unsigned int> patch_nodes, patch_unknowns;
+    std::vector<double>       patch_block;
+    std::vector<int>          schur_slot; // DoF -> row
+
+    std::vector<HyperelasticSystem::ContactRow> patch_rows;
     // With Interpolation = contact patch: how far from the sphere a
     // patch's nodes may be (m); 0: no patches.
     double patch_reach = 0;
+
+    // The body's equilibrium with the sphere touching nothing (empty
+    // until a state shows it), and the rows of a check against it.
+    std::vector<double>                                 free_equilibrium;
+    mutable std::vector<HyperelasticSystem::ContactRow> free_rows;
 
     // Work vectors, reused from solve to solve.
     std::vector<double> residual, trial_residual, best_residual, matrix, step,

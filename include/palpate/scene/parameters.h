@@ -266,6 +266,19 @@ namespace palpate
        * quasi-Newton steps are combined into each new one
        * (AndersonAcceleration; 0: none). */
       unsigned int anderson_depth = 4;
+      /** With Contact solver = condensed and a contact patch per state:
+       * the relative residual below which the Newton solve makes its
+       * factors with the patch's Schur complement, so that they serve its
+       * last steps and give the patch (not an entry; 0: the patch from a
+       * partial factorisation of the converged tangent of its own, the
+       * path benchmarks/run organ-speed compares against). */
+      double patch_factor_residual = 1e-4;
+      /** With a sphere: a target whose sphere clears the body's free
+       * equilibrium (once a state without contact force showed it) is that
+       * equilibrium, without Newton steps (not an entry; false: every
+       * state walks from its neighbour, the path benchmarks/run
+       * organ-speed compares against). */
+      bool free_start = true;
 
       /** Fix reuse_factorization to @p on (no choice by size). */
       void
