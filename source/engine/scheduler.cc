@@ -63,17 +63,21 @@ namespace palpate
       Utilities::Point3 step;
       for (unsigned int k = 0; k < 3; ++k)
         step[k] = look_ahead * velocity[k];
-      // At least one grid spacing along the motion: at slow speeds the
+      // At least two grid spacings along the motion. At slow speeds the
       // look-ahead time covers a fraction of a cell, and the next cell's
       // corners would count as needed only once the HIP is in that cell,
       // while a state on a real organ takes seconds (3,976-node liver at
       // 2 mm/s: the HIP entered a cell whose corners were still
-      // unscheduled, 3.9 s without force; doc/benchmarks/organ-speed.md).
+      // unscheduled, 3.9 s without force). And the new corners of a cell
+      // take two workers about two state times: with a single cell ahead
+      // they became needed 0.36 s before the HIP reached them at 28 mm/s
+      // on the shipped liver's 10 mm grid, after the workers had taken
+      // cloud points off the path (doc/benchmarks/organ-speed.md).
       // Only the order changes: the cloud itself stays the look-ahead's.
       const double speed_step = Utilities::norm(step);
-      if (speed_step > 0 && speed_step < h)
+      if (speed_step > 0 && speed_step < 2 * h)
         for (unsigned int k = 0; k < 3; ++k)
-          step[k] *= h / speed_step;
+          step[k] *= 2 * h / speed_step;
       const double       length = Utilities::norm(step);
       const unsigned int samples =
         std::min(1000u, 1u + static_cast<unsigned int>(4 * length / h));
@@ -300,8 +304,9 @@ namespace palpate
                   known != PointKnowledge::computed &&
                   known != PointKnowledge::in_progress)
                 continue;
-              const double d = distance(p);
-              if (d > radius)
+              const double d   = distance(p);
+              const double arc = arc_to(needed, p);
+              if (d > radius && arc < 0)
                 continue;
               if (known == PointKnowledge::in_progress)
                 {
@@ -310,11 +315,10 @@ namespace palpate
                 }
               if (known == PointKnowledge::computed &&
                   !leads_to(g, [&](const unsigned int q) {
-                    return distance(q) <= radius;
+                    return distance(q) <= radius || arc_to(needed, q) >= 0;
                   }))
                 continue;
-              const int    source = find_source(g, any);
-              const double arc    = arc_to(needed, p);
+              const int source = find_source(g, any);
               if (source >= 0)
                 tasks.push_back({p,
                                  static_cast<unsigned int>(source),
@@ -401,6 +405,17 @@ namespace palpate
     // HIP will need them.
     const std::vector<std::pair<unsigned int, double>> needed =
       path_corners(hip, velocity);
+    // The path's corners are scheduled wherever they are: the path runs
+    // two cells ahead, beyond the cloud around the look-ahead's segment.
+    for (const auto &[point, arc] : needed)
+      {
+        const GridIndex g = grid.index(point);
+        for (unsigned int k = 0; k < 3; ++k)
+          {
+            low[k]  = std::min(low[k], g[k]);
+            high[k] = std::max(high[k], g[k]);
+          }
+      }
     Candidates steps(*this, grid, knowledge, hip, velocity, radius, candidates);
     steps.add_cloud(low, high, needed);
 

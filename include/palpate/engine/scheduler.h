@@ -177,7 +177,7 @@ namespace palpate
 
     /**
      * The corners of the cells the HIP is in and will pass through (its
-     * predicted path, at least a grid spacing long along the motion), each
+     * predicted path, at least two grid spacings long along the motion), each
      * with the arc length (m) at which the path first enters one of its
      * cells; sorted by point. plan() puts these first (Task::corner).
      */
