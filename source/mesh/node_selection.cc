@@ -548,7 +548,8 @@ namespace palpate
      * sphere pushed 1 cm into the beam, half the way to its fixed end,
      * converges (the indenter tests), and a deeper push's failure point
      * says where it failed.
-     * Measured: doc/changes/2026-11-27-deep-sphere-pushes.md.
+     * Measured 2026-11-27 (commit 6e87ee9; the table of every push is in
+     * that day's change note in git history, CHANGELOG.md has the rule).
      */
     constexpr double towards_support = 0.22;
 
