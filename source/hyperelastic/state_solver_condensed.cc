@@ -158,9 +158,20 @@ namespace palpate
   {
     // From the kept contact-free factors, like the Newton steps: within
     // their quasi-Newton distance of the converged tangent.
+    const std::vector<double> x = system->from_state(state);
+    // With no node in contact a small move of the sphere touches nothing:
+    // the stiffness is zero (a state in the air, its free start made no
+    // factors).
+    system->contact_rows(x, state.active_displacement, rows);
+    if (std::none_of(rows.begin(), rows.end(), [](const auto &r) {
+          return r.lambda_hat > 0;
+        }))
+      {
+        state.stiffness.fill(0.0);
+        return true;
+      }
     if (!contact_free_factors)
       return false;
-    const std::vector<double> x = system->from_state(state);
     // The stiffness is exact for the tangent the factors are of: within
     // one Newton step of the state it is within that step's distance, as
     // active_stiffness() is; older factors (another state's, an early
@@ -174,7 +185,6 @@ namespace palpate
         if (!factorize_contact_free(x, state.active_displacement))
           return false;
       }
-    system->contact_rows(x, state.active_displacement, rows);
     return condensed->stiffness(kept_factors(), x, rows, state.stiffness);
   }
 
