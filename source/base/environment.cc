@@ -31,7 +31,7 @@ namespace palpate
      * the fronts being most of it. Where the library fell back so and the
      * processor has AVX-512 (or AVX2 with FMA), switch to the SkylakeX (or
      * Haswell) kernels, as OPENBLAS_CORETYPE would at start-up: the
-     * library's own dynamic dispatch is re-run with that variable set.
+     * library's own dynamic dispatch runs again with that variable set.
      * This happens before anything calls the BLAS (no thread of palpate's
      * exists yet). A user's own OPENBLAS_CORETYPE is always kept, and a
      * BLAS other than OpenBLAS is left alone (the symbols are looked up
