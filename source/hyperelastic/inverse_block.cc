@@ -212,33 +212,20 @@ namespace palpate
     const int n = pattern.n_rows, k = id.size_schur, columns = n_rhs;
     rhs.assign(block.begin(), block.end());
     reduced.resize(std::size_t(k) * n_rhs);
-    // Right-hand sides that are mostly zero (unit forces on a few nodes:
-    // the condensed contact's compliance columns, all on the patch's
-    // nodes) go in as a sparse matrix, so that the forward elimination
-    // visits only the branches of the elimination tree they touch: for
-    // forces on S alone, none but S's.
-    sparse_pointer.assign(1, 1);
-    sparse_row.clear();
-    sparse_value.clear();
-    for (unsigned int j = 0; j < n_rhs; ++j)
-      {
-        for (int i = 0; i < n; ++i)
-          if (const float v = rhs[std::size_t(j) * n + i]; v != 0)
-            {
-              sparse_row.push_back(i + 1);
-              sparse_value.push_back(v);
-            }
-        sparse_pointer.push_back(sparse_row.size() + 1);
-      }
+    // Right-hand sides that are mostly zero (the condensed contact's
+    // compliance columns, all on the patch's nodes) go in as a sparse
+    // matrix: for forces on S alone the forward elimination visits none
+    // but S's branch.
+    const bool sparse =
+      sparse_columns(rhs, n_rhs, sparse_pointer, sparse_row, sparse_value);
     if (sparse_row.empty())
       return true; // B = 0 (which MUMPS refuses with a reduced RHS)
-    const bool sparse = 100 * sparse_row.size() <= rhs.size();
-    const auto lock   = library.lock();
-    id.nrhs           = columns;
-    id.lrhs           = n;
-    id.rhs            = rhs.data();
-    id.redrhs         = reduced.data();
-    id.lredrhs        = k;
+    const auto lock = library.lock();
+    id.nrhs         = columns;
+    id.lrhs         = n;
+    id.rhs          = rhs.data();
+    id.redrhs       = reduced.data();
+    id.lredrhs      = k;
     if (sparse)
       {
         id.icntl[19]   = 1;

@@ -341,25 +341,11 @@ namespace palpate
       solve_many(std::vector<double> &rhs, const unsigned int n_rhs) override
       {
         const std::size_t n = n_rhs > 0 ? rhs.size() / n_rhs : 0;
-        // Several right-hand sides that are mostly zero (a unit force at
-        // one node each: the condensed contact's compliance columns) go in
-        // as a sparse matrix (ICNTL(20) = 1): MUMPS then prunes the forward
-        // elimination to the branches of the elimination tree they touch.
-        // (Built first, used if at most one entry in 100 is non-zero.)
-        sparse_pointer.assign(1, 1);
-        sparse_row.clear();
-        sparse_value.clear();
-        for (unsigned int j = 0; n_rhs > 1 && j < n_rhs; ++j)
-          {
-            for (std::size_t i = 0; i < n; ++i)
-              if (const double v = rhs[j * n + i]; v != 0)
-                {
-                  sparse_row.push_back(i + 1);
-                  sparse_value.push_back(v);
-                }
-            sparse_pointer.push_back(sparse_row.size() + 1);
-          }
-        const bool sparse = n_rhs > 1 && 100 * sparse_row.size() <= rhs.size();
+        // Several right-hand sides that are mostly zero go in as a sparse
+        // matrix (sparse_columns()).
+        const bool sparse =
+          n_rhs > 1 &&
+          sparse_columns(rhs, n_rhs, sparse_pointer, sparse_row, sparse_value);
         {
           if constexpr (!Precision::exact)
             work.assign(rhs.begin(), rhs.end());

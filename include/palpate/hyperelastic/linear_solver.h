@@ -63,6 +63,40 @@ namespace palpate
                  std::vector<std::size_t> &upper);
 
   /**
+   * The @p n_rhs right-hand sides stored one after the other in @p dense
+   * as MUMPS's sparse input (ICNTL(20) = 1): 1-based column pointers, rows
+   * and values of their non-zeros. Whether it is worth passing so: at
+   * most one entry in 100 non-zero (unit forces at a few nodes, the
+   * condensed contact's compliance columns), where MUMPS prunes the
+   * forward elimination to the branches of the elimination tree they
+   * touch.
+   */
+  template <typename Number, typename Value>
+  bool
+  sparse_columns(const std::vector<Number> &dense,
+                 const unsigned int         n_rhs,
+                 std::vector<int>          &pointer,
+                 std::vector<int>          &row,
+                 std::vector<Value>        &value)
+  {
+    const std::size_t n = n_rhs > 0 ? dense.size() / n_rhs : 0;
+    pointer.assign(1, 1);
+    row.clear();
+    value.clear();
+    for (unsigned int j = 0; j < n_rhs; ++j)
+      {
+        for (std::size_t i = 0; i < n; ++i)
+          if (const Value v = dense[j * n + i]; v != 0)
+            {
+              row.push_back(i + 1);
+              value.push_back(v);
+            }
+        pointer.push_back(row.size() + 1);
+      }
+    return 100 * row.size() <= dense.size();
+  }
+
+  /**
    * A sparse direct solver for the symmetric (indefinite) linearised
    * systems of the Newton method. analyze() runs the symbolic analysis
    * (ordering, elimination tree) of a sparsity pattern; factorize() then
