@@ -264,4 +264,43 @@ end
 )" + more;
 }
 
+/** The seven-point Laplacian plus 0.1 I on an m^3 grid, full pattern: a
+ * symmetric positive definite test matrix for the linear solvers. */
+struct Laplacian
+{
+  palpate::SparsityCSR pattern;
+  std::vector<double>  values;
+
+  explicit Laplacian(const unsigned int m)
+  {
+    pattern.n_rows = m * m * m;
+    pattern.row_start.push_back(0);
+    for (unsigned int z = 0; z < m; ++z)
+      for (unsigned int y = 0; y < m; ++y)
+        for (unsigned int x = 0; x < m; ++x)
+          {
+            const unsigned int i = (z * m + y) * m + x;
+            // Sorted columns: -m^2, -m, -1, 0, +1, +m, +m^2.
+            const auto add = [&](const unsigned int j, const double a) {
+              pattern.column.push_back(j);
+              values.push_back(a);
+            };
+            if (z > 0)
+              add(i - m * m, -1);
+            if (y > 0)
+              add(i - m, -1);
+            if (x > 0)
+              add(i - 1, -1);
+            add(i, 6.1);
+            if (x + 1 < m)
+              add(i + 1, -1);
+            if (y + 1 < m)
+              add(i + m, -1);
+            if (z + 1 < m)
+              add(i + m * m, -1);
+            pattern.row_start.push_back(pattern.column.size());
+          }
+  }
+};
+
 #endif

@@ -8,9 +8,10 @@
 // MUMPS solvers (double, then single precision) factorise and solve a
 // 3-D Laplacian (n = 4,096) in two threads at once, 20 times each, through
 // their own copies; every solution equals the one the shared copy gives
-// alone to 1e-13 relative (double) and 1e-6 (single: its factors are a
-// preconditioner's). The same pair through the shared copy, under its
-// lock, checks the reference path.
+// alone to 1e-13 relative (double) and 1e-5 (single: the library built
+// otherwise rounds otherwise, and single precision's forward error on this
+// matrix is up to cond(A) eps = 120 x 6e-8). The same pair through the shared
+// copy, under its lock, checks the reference path.
 
 #include <palpate/base/environment.h>
 #include <palpate/hyperelastic/linear_solver.h>
@@ -23,44 +24,6 @@
 
 namespace
 {
-  /** The seven-point Laplacian plus 0.1 I on an m^3 grid, full pattern. */
-  struct Laplacian
-  {
-    palpate::SparsityCSR pattern;
-    std::vector<double>  values;
-
-    explicit Laplacian(const unsigned int m)
-    {
-      pattern.n_rows = m * m * m;
-      pattern.row_start.push_back(0);
-      for (unsigned int z = 0; z < m; ++z)
-        for (unsigned int y = 0; y < m; ++y)
-          for (unsigned int x = 0; x < m; ++x)
-            {
-              const unsigned int i = (z * m + y) * m + x;
-              // Sorted columns: -m^2, -m, -1, 0, +1, +m, +m^2.
-              const auto add = [&](const unsigned int j, const double a) {
-                pattern.column.push_back(j);
-                values.push_back(a);
-              };
-              if (z > 0)
-                add(i - m * m, -1);
-              if (y > 0)
-                add(i - m, -1);
-              if (x > 0)
-                add(i - 1, -1);
-              add(i, 6.1);
-              if (x + 1 < m)
-                add(i + 1, -1);
-              if (y + 1 < m)
-                add(i + m, -1);
-              if (z + 1 < m)
-                add(i + m * m, -1);
-              pattern.row_start.push_back(pattern.column.size());
-            }
-    }
-  };
-
   /** Factorise and solve for a right-hand side of ones, @p rounds times;
    * the last solution. */
   std::vector<double>
@@ -124,8 +87,8 @@ main(int argc, char **argv)
   const Laplacian system(16);
   for (const std::string name : {"MUMPS", "MUMPS single"})
     {
-      const double      tolerance = name == "MUMPS" ? 1e-13 : 1e-6;
-      const std::string shown     = name == "MUMPS" ? "1e-13" : "1e-6";
+      const double      tolerance = name == "MUMPS" ? 1e-13 : 1e-5;
+      const std::string shown     = name == "MUMPS" ? "1e-13" : "1e-5";
       MumpsLibrary::set_max_private_copies(0);
       const std::vector<double> alone =
         solve(*palpate::LinearSolver::create(name, "METIS"), system, 1);

@@ -139,47 +139,13 @@ namespace
             << (factors <= factors_reference ? "yes" : "NO") << std::endl;
   }
 
-  /** The seven-point Laplacian plus 0.1 I on an m^3 grid, full pattern. */
-  void
-  laplacian(const unsigned int    m,
-            palpate::SparsityCSR &pattern,
-            std::vector<double>  &values)
-  {
-    pattern.n_rows = m * m * m;
-    pattern.row_start.assign(1, 0);
-    for (unsigned int z = 0; z < m; ++z)
-      for (unsigned int y = 0; y < m; ++y)
-        for (unsigned int x = 0; x < m; ++x)
-          {
-            const unsigned int i   = (z * m + y) * m + x;
-            const auto         add = [&](const unsigned int j, const double a) {
-              pattern.column.push_back(j);
-              values.push_back(a);
-            };
-            if (z > 0)
-              add(i - m * m, -1);
-            if (y > 0)
-              add(i - m, -1);
-            if (x > 0)
-              add(i - 1, -1);
-            add(i, 6.1);
-            if (x + 1 < m)
-              add(i + 1, -1);
-            if (y + 1 < m)
-              add(i + m, -1);
-            if (z + 1 < m)
-              add(i + m * m, -1);
-            pattern.row_start.push_back(pattern.column.size());
-          }
-  }
-
   void
   schur_solves()
   {
-    palpate::SparsityCSR pattern;
-    std::vector<double>  values;
-    laplacian(12, pattern, values);
-    const unsigned int n = pattern.n_rows;
+    const Laplacian    system(12);
+    const auto        &pattern = system.pattern;
+    const auto        &values  = system.values;
+    const unsigned int n       = pattern.n_rows;
     // The block on the unknowns of two faces' middle rows.
     std::vector<unsigned int> unknowns;
     for (unsigned int x = 0; x < 12; ++x)
