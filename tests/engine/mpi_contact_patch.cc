@@ -30,36 +30,16 @@
 
 #include "../tests.h"
 
+#include "rest_until_idle.h"
+
 namespace
 {
   using palpate::Utilities::Point3;
-  using Clock = std::chrono::steady_clock;
 
   const std::vector<Point3> path = {{{0, 0, -0.001}},
                                     {{0.002, 0, -0.003}},
                                     {{0.002, 0.002, -0.003}}};
 
-  bool
-  run(palpate::PrecomputationEngine &engine, palpate::HipChannel &hip)
-  {
-    const Point3 zero{{0, 0, 0}};
-    hip.write(path[0], zero);
-    engine.start();
-    for (const Point3 &x : path)
-      {
-        hip.write(x, zero);
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        const auto start = Clock::now();
-        while (!engine.idle())
-          {
-            if (Clock::now() - start > std::chrono::minutes(5))
-              return false;
-            std::this_thread::sleep_for(std::chrono::milliseconds(10));
-          }
-      }
-    engine.stop();
-    return true;
-  }
 
   double
   relative(const std::vector<double> &a, const std::vector<double> &b)
@@ -141,13 +121,15 @@ main(int argc, char **argv)
   palpate::ThreadEngine threads(
     body.mesh, body.nodes, p, grid, threads_cache, threads_hip);
   deallog << "threads: idle at every stop: "
-          << (run(threads, threads_hip) ? "yes" : "NO") << std::endl;
+          << (rest_until_idle(threads, threads_hip, path) ? "yes" : "NO")
+          << std::endl;
 
   palpate::StateCache mpi_cache(grid, budget);
   palpate::HipChannel mpi_hip;
   {
     palpate::MpiEngine mpi(p, grid, mpi_cache, mpi_hip);
-    deallog << "mpi: idle at every stop: " << (run(mpi, mpi_hip) ? "yes" : "NO")
+    deallog << "mpi: idle at every stop: "
+            << (rest_until_idle(mpi, mpi_hip, path) ? "yes" : "NO")
             << std::endl;
 
     unsigned int both = 0, with_patch = 0, same_nodes = 0, touching = 0;

@@ -27,6 +27,8 @@
 
 #include "../tests.h"
 
+#include "rest_until_idle.h"
+
 namespace
 {
   using palpate::Utilities::Point3;
@@ -36,30 +38,6 @@ namespace
                                     {{0.003, 0, -0.002}},
                                     {{0.003, -0.003, -0.002}}};
 
-  /** Rest the HIP at each point of the path until the engine is idle. */
-  bool
-  run(palpate::PrecomputationEngine &engine, palpate::HipChannel &hip)
-  {
-    const Point3 zero{{0, 0, 0}};
-    hip.write(path[0], zero);
-    engine.start();
-    for (const Point3 &x : path)
-      {
-        hip.write(x, zero);
-        // Let the scheduler see the new position (100 Hz) before asking
-        // whether anything is left to do.
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        const auto start = Clock::now();
-        while (!engine.idle())
-          {
-            if (Clock::now() - start > std::chrono::minutes(5))
-              return false;
-            std::this_thread::sleep_for(std::chrono::milliseconds(10));
-          }
-      }
-    engine.stop();
-    return true;
-  }
 } // namespace
 
 int
@@ -89,7 +67,8 @@ main(int argc, char **argv)
   palpate::ThreadEngine threads(
     body.mesh, body.nodes, p, grid, threads_cache, threads_hip);
   deallog << "threads: " << threads.n_workers() << " solver threads, idle at "
-          << "every stop: " << (run(threads, threads_hip) ? "yes" : "NO")
+          << "every stop: "
+          << (rest_until_idle(threads, threads_hip, path) ? "yes" : "NO")
           << std::endl;
 
   palpate::StateCache mpi_cache(grid, budget);
@@ -97,7 +76,8 @@ main(int argc, char **argv)
   {
     palpate::MpiEngine mpi(p, grid, mpi_cache, mpi_hip);
     deallog << "mpi: " << mpi.n_workers() << " solver servers, idle at every "
-            << "stop: " << (run(mpi, mpi_hip) ? "yes" : "NO") << std::endl;
+            << "stop: " << (rest_until_idle(mpi, mpi_hip, path) ? "yes" : "NO")
+            << std::endl;
 
     // The same points, the same forces.
     unsigned int both = 0, only_one = 0;
