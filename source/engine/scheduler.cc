@@ -66,13 +66,10 @@ namespace palpate
       // At least two grid spacings along the motion. At slow speeds the
       // look-ahead time covers a fraction of a cell, and the next cell's
       // corners would count as needed only once the HIP is in that cell,
-      // while a state on a real organ takes seconds (3,976-node liver at
-      // 2 mm/s: the HIP entered a cell whose corners were still
-      // unscheduled, 3.9 s without force). And the new corners of a cell
-      // take two workers about two state times: with a single cell ahead
-      // they became needed 0.36 s before the HIP reached them at 28 mm/s
-      // on the shipped liver's 10 mm grid, after the workers had taken
-      // cloud points off the path (doc/benchmarks/organ-speed.md).
+      // while a state on a real organ takes seconds. And a cell's new
+      // corners take two workers about two state times, more than a hand
+      // at 28 mm/s takes to cross one 10 mm cell from the moment the next
+      // one is in view (doc/benchmarks/organ-speed.md, round 6).
       // Only the order changes: the cloud itself stays the look-ahead's.
       const double speed_step = Utilities::norm(step);
       if (speed_step > 0 && speed_step < 2 * h)

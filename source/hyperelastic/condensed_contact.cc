@@ -287,14 +287,9 @@ namespace palpate
     bool with_curvature = false;
     for (const unsigned int k : candidates)
       with_curvature = with_curvature || x[rows[k].multiplier_eq] > 0;
-    if (with_curvature && assemble_W(x, rows, true))
-      {
-        // (Unchanged unless the active-set method settles.)
-        backup = step;
-        if (solve_contact(x, rows, step, tolerance, true))
-          return true;
-        step.swap(backup);
-      }
+    if (with_curvature && assemble_W(x, rows, true) &&
+        solve_contact(x, rows, step, tolerance, true))
+      return true;
     assemble_W(x, rows, false);
     return solve_contact(x, rows, step, tolerance, false);
   }

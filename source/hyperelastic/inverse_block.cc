@@ -64,14 +64,6 @@ namespace palpate
 
 
 
-  bool
-  InverseBlock::has_factors() const
-  {
-    return factored;
-  }
-
-
-
   const std::string &
   InverseBlock::message() const
   {
@@ -86,6 +78,7 @@ namespace palpate
                         std::vector<double>             &inverse)
   {
     const unsigned int n = pattern.n_rows, k = unknowns.size();
+    factored = false; // whatever happens, not the old factors
     inverse.assign(std::size_t(k) * k, 0.0);
     if (k == 0)
       return true;

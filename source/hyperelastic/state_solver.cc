@@ -474,8 +474,9 @@ namespace palpate
     // Factors count as the state's only if made in its last increment
     // (this Newton solve): those of an increment before are of another
     // target.
-    factors_of_state = false;
-    patch_of_state   = false;
+    factors_of_state    = false;
+    patch_of_state      = false;
+    patch_factors_tried = false;
     anderson.reset();
 
     for (unsigned int iteration = 0;; ++iteration)
@@ -722,20 +723,15 @@ namespace palpate
     // but a mistake; refuse it rather than work for minutes.
     const double needed = impl->increments_needed(length);
     if (needed > 1000)
-      {
-        impl->system->to_state(x, state);
-        state.converged = false;
-        state.status    = SolveStatus::max_iterations;
-        state.message   = "the target is " + Utilities::to_string(length, 3) +
-                        " m away: more than 1000 increments";
-        state.force = {{0, 0, 0}};
-        return state;
-      }
-    const unsigned int n     = static_cast<unsigned int>(needed);
-    const auto         point = [&](const double t) {
-      return Utilities::Point3{{a[0] + t * (target[0] - a[0]),
-                                a[1] + t * (target[1] - a[1]),
-                                a[2] + t * (target[2] - a[2])}};
+      return impl->too_far(x, length, state);
+    const unsigned int n = static_cast<unsigned int>(needed);
+    // The path's end is the target itself, bit for bit: the last
+    // increment is told apart by it (patch_factors_due()).
+    const auto point = [&](const double t) {
+      return t == 1 ? target :
+                      Utilities::Point3{{a[0] + t * (target[0] - a[0]),
+                                         a[1] + t * (target[1] - a[1]),
+                                         a[2] + t * (target[2] - a[2])}};
     };
 
     // One increment from parameter t0 to t1 of the path, halved up to

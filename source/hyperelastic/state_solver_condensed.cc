@@ -103,6 +103,7 @@ namespace palpate
         // Close to the state, the factors are made with the contact patch
         // as a Schur complement: the same factors for these steps, and the
         // patch's compliance without a factorisation of its own.
+        patch_factors_tried = patch_factors_tried || with_patch;
         if (!(with_patch && factorize_with_patch(x, target)) &&
             !factorize_contact_free(x, target))
           return false;
@@ -199,37 +200,34 @@ namespace palpate
         inverse_block = std::make_unique<InverseBlock>(system->sparsity());
         schur_factors = std::make_unique<SchurFactors>(*inverse_block);
       }
-    // A new partial factorisation replaces the one the kept factors may be.
-    if (kept_are_schur)
-      {
-        factorized = factorized_current = contact_free_factors = false;
-        condensed->reset();
-      }
-    kept_are_schur = false;
-    patch_nodes.clear();
-    if (!system->assemble(
-          x, target, trial_residual, &patch_tangent, nullptr, false))
-      return false;
     system->contact_rows(x, target, patch_rows);
     contact_patch_nodes(patch_rows, patch_reach, patch_nodes, patch_unknowns);
     if (patch_nodes.empty())
       {
         // No node within reach: the state's patch is the empty one, and
-        // there is nothing to factorise it on.
-        patch_block.clear();
+        // there is nothing to factorise it on (the kept factors stay).
         patch_of_state = true;
         return false;
       }
-    if (!inverse_block->compute(patch_tangent, patch_unknowns, patch_block))
+    // A new partial factorisation replaces the one the kept factors may
+    // be, and the block the condensed contact reads.
+    if (kept_are_schur)
+      {
+        contact_free_factors = kept_are_schur = false;
+        condensed->reset();
+      }
+    if (!system->assemble(
+          x, target, trial_residual, &patch_tangent, nullptr, false) ||
+        !inverse_block->compute(patch_tangent, patch_unknowns, patch_block))
       return false;
     patch_of_state = true;
     // The condensed path iterates on these factors (the Newton steps
     // after them, the next state's): they are of the contact-free tangent
-    // near the state, as its own would be.
+    // near the state, as its own would be. (The linear solver's own
+    // factors, and what `factorized` says of them, stay as they are.)
     if (settings.condensed_contact && condensed)
       {
-        factorized = contact_free_factors = kept_are_schur = true;
-        factorized_current                                 = false;
+        contact_free_factors = kept_are_schur = true;
         condensed->reset();
         schur_slot.assign(system->n_equations(), -1);
         for (unsigned int i = 0; i < patch_unknowns.size(); ++i)
@@ -249,11 +247,11 @@ namespace palpate
     // the converged tangent of its own.
     if (!patch_of_state)
       {
-        ++state.stiffness_factorizations;
         // (An empty patch is made without factors.)
-        if (!factorize_with_patch(x, state.active_displacement) &&
-            !patch_of_state)
+        const bool made = factorize_with_patch(x, state.active_displacement);
+        if (!made && !patch_of_state)
           return false;
+        state.stiffness_factorizations += made;
       }
     state.contact_patch = make_contact_patch(*system,
                                              patch_nodes,

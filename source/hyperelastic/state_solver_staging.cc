@@ -226,6 +226,22 @@ namespace palpate
 
 
 
+  State
+  StateSolver::Impl::too_far(const std::vector<double> &x,
+                             const double               length,
+                             State                     &state) const
+  {
+    system->to_state(x, state);
+    state.converged = false;
+    state.status    = SolveStatus::max_iterations;
+    state.message   = "the target is " + Utilities::to_string(length, 3) +
+                    " m away: more than 1000 increments";
+    state.force = {{0, 0, 0}};
+    return state;
+  }
+
+
+
   bool
   StateSolver::Impl::start_free(const Utilities::Point3 &target,
                                 std::vector<double>     &x)

@@ -151,7 +151,7 @@ namespace palpate
     const std::vector<double> *block_values = nullptr;
     bool                       from_block   = false;
     LinearSolver              *solver_now   = nullptr;
-    std::vector<double>        response, backup;
+    std::vector<double>        response;
     // The candidates' DoFs (3 per candidate, -1 where fixed).
     std::vector<int> candidate_eq;
     ContactLCP       lcp;

@@ -67,10 +67,6 @@ namespace palpate
     bool
     solve_many(std::vector<double> &block, unsigned int n_rhs);
 
-    /** Whether compute() left factors that solve_many() can use. */
-    bool
-    has_factors() const;
-
     const std::string &
     message() const;
 

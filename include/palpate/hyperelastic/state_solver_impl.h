@@ -195,9 +195,10 @@ namespace palpate
      * Assemble the contact-free tangent at @p x and factorise it with the
      * DoFs of the contact patch's nodes there as a Schur complement
      * (inverse_block): the patch's compliance block into patch_block, and
-     * its factors become the kept ones. False if that fails (then there
-     * are no kept factors) or there is no node within reach (then the
-     * state's patch is the empty one: patch_of_state).
+     * its factors become the kept ones. False if that fails (then the
+     * condensed path has no kept factors) or there is no node within reach
+     * (then the state's patch is the empty one, patch_of_state, and the
+     * kept factors stay).
      */
     bool
     factorize_with_patch(const std::vector<double> &x,
@@ -214,7 +215,8 @@ namespace palpate
                       const State             &state) const
     {
       return patch_reach > 0 && condensed && settings.condensed_contact &&
-             !patch_of_state &&
+             settings.patch_factor_residual > 0 && !patch_of_state &&
+             !patch_factors_tried &&
              residual <= std::max(settings.patch_factor_residual,
                                   10 * settings.residual_tolerance) &&
              target == state.active_displacement;
@@ -279,6 +281,11 @@ namespace palpate
      * at @p target. */
     bool
     clears_free_equilibrium(const Utilities::Point3 &target) const;
+
+    /** The failure point of a target @p length (m) away, more than 1000
+     * increments: @p state at the start @p x, refused. */
+    State
+    too_far(const std::vector<double> &x, double length, State &state) const;
 
     /** If the sphere at @p target clears the free equilibrium: @p x is
      * that equilibrium, the state at @p target without a Newton solve
@@ -448,7 +455,11 @@ namespace palpate
     // relative residual is below settings.patch_factor_residual: the
     // tangent there is the converged one's to that order, and the Newton
     // steps after it and the next state's iterate on them.
-    bool                      patch_of_state = false;
+    bool patch_of_state = false;
+    // Whether this Newton solve tried them (once: a failed partial
+    // factorisation, say of a tangent single precision cannot take, is
+    // not tried again at every step).
+    bool                      patch_factors_tried = false;
     std::vector<unsigned int> patch_nodes, patch_unknowns;
     std::vector<double>       patch_block;
     std::vector<int>          schur_slot; // DoF -> row
