@@ -63,53 +63,15 @@ namespace palpate
 
 
 
-    namespace
-    {
-      /** The parts of a patch in the order they travel, for writing
-       * (Bytes = char) and reading (const char). */
-      template <typename Patch, typename Visit>
-      void
-      visit_arrays(Patch &patch, Visit &&visit)
-      {
-        visit(patch.nodes);
-        visit(patch.position);
-        visit(patch.normal);
-        visit(patch.free_position);
-        visit(patch.lambda);
-        visit(patch.offset);
-        visit(patch.W);
-        visit(patch.H);
-      }
-    } // namespace
-
-
-
-    // A patch travels as: header, the node count, target, centre, radius
-    // and force (10 doubles), then its arrays, whose lengths follow from
-    // the count (n, 3n, 3n, 3n, n, n, n^2 doubles and 9 n^2 floats for
-    // H). Its id is the receiving process's own.
+    // A patch travels as its header and its bytes (patch_bytes()). Its id
+    // is the receiving process's own.
     std::vector<char>
     pack(const Header &header, const ContactPatch &patch)
     {
-      const std::uint64_t n = patch.size();
-      std::size_t bytes     = sizeof(Header) + sizeof(n) + 10 * sizeof(double);
-      visit_arrays(patch,
-                   [&](const auto &v) { bytes += v.size() * sizeof(v[0]); });
-      std::vector<char> out(bytes);
-      char             *p   = out.data();
-      const auto        put = [&p](const void *data, const std::size_t size) {
-        std::memcpy(p, data, size);
-        p += size;
-      };
-      put(&header, sizeof(Header));
-      put(&n, sizeof(n));
-      put(patch.target.data(), 3 * sizeof(double));
-      put(patch.center.data(), 3 * sizeof(double));
-      put(&patch.radius, sizeof(double));
-      put(patch.force.data(), 3 * sizeof(double));
-      visit_arrays(patch, [&](const auto &v) {
-        put(v.data(), v.size() * sizeof(v[0]));
-      });
+      const std::vector<char> bytes = patch_bytes(patch);
+      std::vector<char>       out(sizeof(Header) + bytes.size());
+      std::memcpy(out.data(), &header, sizeof(Header));
+      std::memcpy(out.data() + sizeof(Header), bytes.data(), bytes.size());
       return out;
     }
 
@@ -118,44 +80,20 @@ namespace palpate
     std::shared_ptr<const ContactPatch>
     patch_of(const std::vector<char> &message)
     {
-      std::uint64_t n   = 0;
-      const char   *p   = message.data() + sizeof(Header);
-      const char   *end = message.data() + message.size();
-      const auto    get = [&](void *data, const std::size_t size) {
-        if (std::size_t(end - p) < size)
-          throw std::runtime_error(
-            "MPI engine: a contact patch message is truncated");
-        std::memcpy(data, p, size);
-        p += size;
-      };
       if (message.size() < sizeof(Header))
         throw std::runtime_error(
           "MPI engine: a contact patch message is truncated");
-      get(&n, sizeof(n));
-      // A patch of more nodes than bytes cannot be real: refused before
-      // the arrays are sized for it.
-      if (n > message.size())
-        throw std::runtime_error(
-          "MPI engine: a contact patch message has the wrong length");
-      auto patch = std::make_shared<ContactPatch>();
-      get(patch->target.data(), 3 * sizeof(double));
-      get(patch->center.data(), 3 * sizeof(double));
-      get(&patch->radius, sizeof(double));
-      get(patch->force.data(), 3 * sizeof(double));
-      patch->nodes.resize(n);
-      patch->position.resize(3 * n);
-      patch->normal.resize(3 * n);
-      patch->free_position.resize(3 * n);
-      patch->lambda.resize(n);
-      patch->offset.resize(n);
-      patch->W.resize(n * n);
-      patch->H.resize(9 * n * n);
-      visit_arrays(*patch,
-                   [&](auto &v) { get(v.data(), v.size() * sizeof(v[0])); });
-      if (p != end)
-        throw std::runtime_error(
-          "MPI engine: a contact patch message has the wrong length");
-      return patch;
+      try
+        {
+          return patch_from_bytes(message.data() + sizeof(Header),
+                                  message.size() - sizeof(Header));
+        }
+      catch (const std::runtime_error &e)
+        {
+          throw std::runtime_error(std::string("MPI engine: ") + e.what() +
+                                   " (message of " +
+                                   std::to_string(message.size()) + " bytes)");
+        }
     }
 
 

@@ -719,8 +719,11 @@ namespace palpate
     if (s.scene.parameters.state_space.store.empty())
       return "";
     std::string r =
-      "loaded " + std::to_string(s.loaded.states) + " states and " +
-      std::to_string(s.loaded.failures) + " failure points from " +
+      "loaded " + std::to_string(s.loaded.states) + " states" +
+      (s.loaded.patches > 0 ?
+         " (" + std::to_string(s.loaded.patches) + " with contact patches)" :
+         std::string()) +
+      " and " + std::to_string(s.loaded.failures) + " failure points from " +
       s.scene.parameters.state_space.store +
       (s.loaded.damaged > 0 ?
          " (" + std::to_string(s.loaded.damaged) +

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
+#include <stdexcept>
 
 namespace palpate
 {
@@ -25,6 +27,92 @@ namespace palpate
             lambda.size() + offset.size() + W.size()) *
              sizeof(double) +
            H.size() * sizeof(float);
+  }
+
+
+
+  namespace
+  {
+    /** The parts of a patch in the order its bytes hold them, for writing
+     * and for reading. */
+    template <typename Patch, typename Visit>
+    void
+    visit_arrays(Patch &patch, Visit &&visit)
+    {
+      visit(patch.nodes);
+      visit(patch.position);
+      visit(patch.normal);
+      visit(patch.free_position);
+      visit(patch.lambda);
+      visit(patch.offset);
+      visit(patch.W);
+      visit(patch.H);
+    }
+  } // namespace
+
+
+
+  std::vector<char>
+  patch_bytes(const ContactPatch &patch)
+  {
+    const std::uint64_t n     = patch.size();
+    std::size_t         bytes = sizeof(n) + 10 * sizeof(double);
+    visit_arrays(patch,
+                 [&](const auto &v) { bytes += v.size() * sizeof(v[0]); });
+    std::vector<char> out(bytes);
+    char             *p   = out.data();
+    const auto        put = [&p](const void *data, const std::size_t size) {
+      std::memcpy(p, data, size);
+      p += size;
+    };
+    put(&n, sizeof(n));
+    put(patch.target.data(), 3 * sizeof(double));
+    put(patch.center.data(), 3 * sizeof(double));
+    put(&patch.radius, sizeof(double));
+    put(patch.force.data(), 3 * sizeof(double));
+    visit_arrays(patch, [&](const auto &v) {
+      put(v.data(), v.size() * sizeof(v[0]));
+    });
+    return out;
+  }
+
+
+
+  std::shared_ptr<const ContactPatch>
+  patch_from_bytes(const char *data, const std::size_t size)
+  {
+    std::uint64_t n   = 0;
+    const char   *p   = data;
+    const char   *end = data + size;
+    const auto    get = [&](void *to, const std::size_t bytes) {
+      if (std::size_t(end - p) < bytes)
+        throw std::runtime_error("a contact patch is truncated");
+      std::memcpy(to, p, bytes);
+      p += bytes;
+    };
+    get(&n, sizeof(n));
+    // A patch of more nodes than bytes cannot be real: refused before the
+    // arrays are sized for it.
+    if (n > size)
+      throw std::runtime_error("a contact patch has the wrong length");
+    auto patch = std::make_shared<ContactPatch>();
+    get(patch->target.data(), 3 * sizeof(double));
+    get(patch->center.data(), 3 * sizeof(double));
+    get(&patch->radius, sizeof(double));
+    get(patch->force.data(), 3 * sizeof(double));
+    patch->nodes.resize(n);
+    patch->position.resize(3 * n);
+    patch->normal.resize(3 * n);
+    patch->free_position.resize(3 * n);
+    patch->lambda.resize(n);
+    patch->offset.resize(n);
+    patch->W.resize(n * n);
+    patch->H.resize(9 * n * n);
+    visit_arrays(*patch,
+                 [&](auto &v) { get(v.data(), v.size() * sizeof(v[0])); });
+    if (p != end)
+      throw std::runtime_error("a contact patch has the wrong length");
+    return patch;
   }
 
 

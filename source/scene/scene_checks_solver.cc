@@ -135,16 +135,6 @@ namespace palpate
                       "set Tip = sphere with a Tip radius, or Interpolation "
                       "= tricubic Hermite.",
                       {"Boundary conditions/Active node/Tip"});
-        // The patches travel with the states' forces (MPI results too);
-        // a store keeps none yet.
-        if (!p.state_space.store.empty())
-          throw error("State space/Interpolation",
-                      "contact patch needs each state's contact patch, and "
-                      "a State space / Store keeps forces and shapes only",
-                      "leave Store empty (set Store =) with contact patch, "
-                      "or use Interpolation = tricubic Hermite with a "
-                      "store.",
-                      {"State space/Store"});
       }
     if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
       throw error(

@@ -236,6 +236,21 @@ namespace palpate
 
 
 
+  std::shared_ptr<const ContactPatch>
+  StateCache::patch(const unsigned int point) const
+  {
+    // Under the lock no writer retires the entry's patch, so the held one
+    // is alive while its pointer is copied.
+    std::lock_guard<std::mutex> lock(mutex);
+    const HeldPatch            *held = entries[point].patch.load();
+    return held && held->generation ==
+                     current_generation.load(std::memory_order_acquire) ?
+             held->patch :
+             nullptr;
+  }
+
+
+
   std::uint64_t
   StateCache::generation() const noexcept
   {

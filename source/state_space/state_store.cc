@@ -62,6 +62,16 @@ namespace palpate
     for (const auto &[field, value] : fingerprint.fields)
       {
         const std::string stored = s.attribute(field);
+        if (stored != value && field == "contact patches")
+          s.fail(stored == "kept" ?
+                   "the store keeps contact patches (it was made with "
+                   "State space / Interpolation = contact patch), and this "
+                   "scene interpolates otherwise" :
+                   "the store keeps no contact patches (it was made with "
+                   "another State space / Interpolation), and contact patch "
+                   "needs each state's",
+                 "use another store file for this scene (State space / "
+                 "Store), or the interpolation the store was made with.");
         if (stored != value)
           s.fail("the store was computed for other physics: its " + field +
                    " is '" + stored + "', the scene's is '" + value +
@@ -113,6 +123,7 @@ namespace palpate
           {
             State copy               = state;
             copy.active_displacement = grid.position(point);
+            loaded.patches += copy.contact_patch != nullptr;
             cache.publish(point,
                           std::make_shared<const State>(std::move(copy)),
                           generation);
@@ -164,7 +175,9 @@ namespace palpate
         else if (status == PointStatus::available)
           if (const auto state = cache.state(p))
             {
-              append(p, *state);
+              const auto patch =
+                state->contact_patch ? state->contact_patch : cache.patch(p);
+              append(p, *state, patch.get());
               ++n;
             }
       }

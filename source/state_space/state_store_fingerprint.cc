@@ -117,6 +117,13 @@ namespace palpate
         e += "; density " + exact(p.material_model.density);
       f.fields.emplace_back("load effects", e.empty() ? "none" : e);
     }
+    // A store of states without their patches cannot serve Interpolation
+    // = contact patch (its cells would render without them), nor the
+    // reverse be told apart by the states alone.
+    f.fields.emplace_back("contact patches",
+                          p.state_space.interpolation == "contact patch" ?
+                            "kept" :
+                            "none");
     f.fields.emplace_back("palpate version", PALPATE_VERSION);
     return f;
   }

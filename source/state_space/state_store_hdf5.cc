@@ -24,8 +24,11 @@ namespace palpate
 {
   using internal::dataset_names;
   using internal::file_access;
+  using internal::first_format_datasets;
   using internal::hdf5_error;
   using internal::hdf5_system_error;
+  using internal::n_datasets;
+  using internal::record_datasets;
   using internal::WriteFailure;
 
   namespace internal
@@ -85,7 +88,7 @@ namespace palpate
   void
   StateStore::Impl::close_file()
   {
-    for (unsigned int d = 0; d < 8; ++d)
+    for (unsigned int d = 0; d < n_datasets; ++d)
       if (datasets[d] >= 0)
         {
           H5Dclose(datasets[d]);
@@ -136,11 +139,16 @@ namespace palpate
         H5Tclose(str);
       }
     H5Sclose(space);
-    for (unsigned int d = 0; d < 8; ++d)
+    for (unsigned int d = 0; d < n_datasets; ++d)
       {
-        const hsize_t dims[2]  = {0, columns(d)};
-        const hsize_t max[2]   = {H5S_UNLIMITED, columns(d)};
-        const hsize_t chunk[2] = {d == 5 || d == 6 ? 1u : 64u,
+        const hsize_t dims[2] = {0, columns(d)};
+        const hsize_t max[2]  = {H5S_UNLIMITED, columns(d)};
+        // A field per chunk for the long rows (a state's field), 64 rows
+        // of the short ones; patches' bytes in chunks of 64 KiB, a tenth
+        // of a patch on the liver.
+        const hsize_t chunk[2] = {d == 9           ? 65536u :
+                                  d == 5 || d == 6 ? 1u :
+                                                     64u,
                                   std::max<hsize_t>(columns(d), 1)};
         const hid_t s    = H5Screate_simple(2, dims, max);
         const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
@@ -151,7 +159,7 @@ namespace palpate
         H5Pclose(dcpl);
         H5Sclose(s);
       }
-    for (unsigned int d = 0; d < 8; ++d)
+    for (unsigned int d = 0; d < n_datasets; ++d)
       if (datasets[d] >= 0)
         H5Dclose(datasets[d]);
     std::fill(std::begin(datasets), std::end(datasets), hid_t(-1));
@@ -178,7 +186,7 @@ namespace palpate
   StateStore::Impl::store_datasets(const hid_t f)
   {
     int found = 0;
-    for (unsigned int d = 0; d < 8; ++d)
+    for (unsigned int d = 0; d < first_format_datasets; ++d)
       {
         const htri_t e = H5Lexists(f, dataset_names[d], H5P_DEFAULT);
         if (e < 0)
@@ -277,7 +285,19 @@ namespace palpate
            "(the states in it are lost).");
     if (store_datasets(h5) == 0)
       not_a_store();
-    for (unsigned int d = 0; d < 8; ++d)
+    // A store of the first format (before contact patches were kept) has
+    // its states, but the scene's contact patches would be missing from
+    // every one of them: refused as such, not as damage.
+    if (H5Lexists(h5, dataset_names[8], H5P_DEFAULT) == 0 &&
+        H5Lexists(h5, dataset_names[9], H5P_DEFAULT) == 0 &&
+        store_datasets(h5) == int(first_format_datasets))
+      fail("the store was written by an older palpate, whose stores keep "
+           "no contact patches (it has no datasets 'patch' and "
+           "'patch_bytes')",
+           "name a new store file (State space / Store), or delete this one: "
+           "palpate computes its states again and keeps them with their "
+           "patches.");
+    for (unsigned int d = 0; d < n_datasets; ++d)
       {
         datasets[d] = H5Dopen2(h5, dataset_names[d], H5P_DEFAULT);
         if (datasets[d] < 0)
@@ -298,7 +318,7 @@ namespace palpate
     // The rows: the fewest any dataset has (a record cut short by a
     // crash, or being written, has some datasets extended, not all).
     rows = std::numeric_limits<hsize_t>::max();
-    for (unsigned int d = 0; d < 8; ++d)
+    for (unsigned int d = 0; d < record_datasets; ++d)
       {
         const hid_t sp = H5Dget_space(datasets[d]);
         H5Sget_simple_extent_dims(sp, dims, nullptr);

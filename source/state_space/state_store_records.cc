@@ -8,6 +8,7 @@
 // record it was writing, and a reader never takes a record cut short.
 
 #include <palpate/base/exceptions.h>
+#include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/state_space/state_store_impl.h>
 
 #include <fcntl.h>
@@ -21,6 +22,7 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <stdexcept>
 
 namespace palpate
 {
@@ -77,14 +79,71 @@ namespace palpate
 
 
 
+  bool
+  StateStore::Impl::write_patch(const std::vector<char> &bytes, hsize_t &offset)
+  {
+    hsize_t     dims[2];
+    const hid_t space = H5Dget_space(datasets[9]);
+    H5Sget_simple_extent_dims(space, dims, nullptr);
+    H5Sclose(space);
+    offset = dims[0];
+    if (bytes.empty())
+      return true;
+    const hsize_t extent[2] = {offset + bytes.size(), 1};
+    if (H5Dset_extent(datasets[9], extent) < 0)
+      return false;
+    const hsize_t start[2] = {offset, 0}, count[2] = {bytes.size(), 1};
+    const hid_t   file_space = H5Dget_space(datasets[9]);
+    H5Sselect_hyperslab(
+      file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
+    const hid_t  memory  = H5Screate_simple(2, count, nullptr);
+    const herr_t written = H5Dwrite(
+      datasets[9], type(9), memory, file_space, H5P_DEFAULT, bytes.data());
+    H5Sclose(memory);
+    H5Sclose(file_space);
+    return written >= 0 && H5Dflush(datasets[9]) >= 0;
+  }
+
+
+
+  bool
+  StateStore::Impl::read_patch(const hsize_t      offset,
+                               const hsize_t      size,
+                               std::vector<char> &bytes) const
+  {
+    bytes.clear();
+    if (size == 0)
+      return true;
+    hsize_t     dims[2];
+    const hid_t file_space = H5Dget_space(datasets[9]);
+    H5Sget_simple_extent_dims(file_space, dims, nullptr);
+    if (offset > dims[0] || size > dims[0] - offset)
+      {
+        H5Sclose(file_space);
+        return false;
+      }
+    bytes.resize(size);
+    const hsize_t start[2] = {offset, 0}, count[2] = {size, 1};
+    H5Sselect_hyperslab(
+      file_space, H5S_SELECT_SET, start, nullptr, count, nullptr);
+    const hid_t  memory = H5Screate_simple(2, count, nullptr);
+    const herr_t read   = H5Dread(
+      datasets[9], type(9), memory, file_space, H5P_DEFAULT, bytes.data());
+    H5Sclose(memory);
+    H5Sclose(file_space);
+    return read >= 0;
+  }
+
+
+
   std::string
-  StateStore::Impl::reserve()
+  StateStore::Impl::reserve(const std::size_t patch_bytes)
   {
     haddr_t eoa = 0;
     if (H5Fget_eoa(h5, &eoa) < 0)
       return "";
     const off_t record =
-      (13 + n_solution + n_multipliers) * sizeof(double) + 16;
+      (13 + n_solution + n_multipliers) * sizeof(double) + 32 + patch_bytes;
     const off_t target = eoa + 4 * record + 128 * 1024;
     // A descriptor of our own, kept while the file is open (close_file()
     // closes it: create() renames a new file into place).
@@ -125,6 +184,10 @@ namespace palpate
     // the writer never got there, it was killed or is writing it now.
     if (checksum == 0)
       return Read::incomplete;
+    hsize_t patch[2] = {0, 0}; // offset and size in patch_bytes
+    read_row(row, 8, patch);
+    if (!read_patch(patch[0], patch[1], r.patch))
+      return Read::damaged;
     return checksum == r.checksum() && r.point >= 0 ? Read::intact :
                                                       Read::damaged;
   }
@@ -193,6 +256,16 @@ namespace palpate
   void
   StateStore::append(const unsigned int point, const State &state)
   {
+    append(point, state, state.contact_patch.get());
+  }
+
+
+
+  void
+  StateStore::append(const unsigned int  point,
+                     const State        &state,
+                     const ContactPatch *patch)
+  {
     Impl &s = *impl;
     if (s.stopped)
       return;
@@ -234,6 +307,7 @@ namespace palpate
                                         "grid",
                                         "tolerances",
                                         "load effects",
+                                        "contact patches",
                                         "palpate version"})
           keep.fields.emplace_back(field, s.attribute(field));
         s.close_file();
@@ -250,6 +324,8 @@ namespace palpate
       }
     r.solution.resize(s.n_solution, 0.0);
     r.multipliers.resize(s.n_multipliers, 0.0);
+    if (state.converged && patch != nullptr)
+      r.patch = patch_bytes(*patch);
     const std::uint64_t checksum = r.checksum();
     // Room first: a write that fails half-way leaves HDF5's superblock
     // promising space the file never got (it is then "truncated" to HDF5,
@@ -257,15 +333,17 @@ namespace palpate
     // more, is taken from the file system before HDF5 writes anything; if
     // it cannot be had (the disk full, a file size limit), appending stops
     // here and the file is as the last record left it.
-    if (const std::string refused = s.reserve(); !refused.empty())
+    if (const std::string refused = s.reserve(r.patch.size()); !refused.empty())
       s.stop(refused);
     // The checksum goes last: a record cut short has none and is skipped.
     // Each row is flushed as it is written, and the whole file's buffers
     // after the record, so that a killed writer loses at most the record
     // being written and a reader never sees a checksum before its record.
-    const hsize_t row = s.rows;
-    errno             = 0;
+    const hsize_t row   = s.rows;
+    errno               = 0;
+    hsize_t    where[2] = {0, r.patch.size()};
     const bool written =
+      s.write_patch(r.patch, where[0]) && s.write_row(row, 8, where) &&
       s.write_row(row, 0, &r.point) && s.write_row(row, 1, &r.status) &&
       s.write_row(row, 2, r.force) && s.write_row(row, 3, r.stiffness) &&
       s.write_row(row, 4, &r.wall_time) &&
@@ -327,6 +405,19 @@ namespace palpate
           {
             state.solution    = std::move(r.solution);
             state.multipliers = std::move(r.multipliers);
+            if (!r.patch.empty())
+              try
+                {
+                  state.contact_patch =
+                    patch_from_bytes(r.patch.data(), r.patch.size());
+                }
+              catch (const std::runtime_error &)
+                {
+                  // Checksummed bytes that are not a patch: written by a
+                  // palpate that lays patches out otherwise.
+                  ++damaged;
+                  continue;
+                }
           }
         else
           state.message =

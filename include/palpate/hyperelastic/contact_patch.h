@@ -99,6 +99,25 @@ namespace palpate
   };
 
   /**
+   * @p patch as bytes, the same on every machine of one byte order: its
+   * node count, target, centre, radius and force (10 doubles), then its
+   * arrays, whose lengths follow from the count (n node numbers, 3n, 3n,
+   * 3n, n, n and n^2 doubles, 9 n^2 floats for H). What an MPI result
+   * carries after its header and a state store keeps beside a state.
+   */
+  std::vector<char>
+  patch_bytes(const ContactPatch &patch);
+
+  /**
+   * The patch @p size bytes at @p data hold (patch_bytes()), with an id of
+   * this process. Throws std::runtime_error saying "truncated" or "the
+   * wrong length" if they are not one patch's bytes: the caller names the
+   * message or record they came from.
+   */
+  std::shared_ptr<const ContactPatch>
+  patch_from_bytes(const char *data, std::size_t size);
+
+  /**
    * The nodes a contact patch holds, from the sphere's candidate @p rows
    * at some unknowns: those whose gap is at most @p reach (m), less any a
    * boundary condition fixes in every direction (its compliance row would

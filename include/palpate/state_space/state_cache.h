@@ -184,6 +184,12 @@ namespace palpate
     void
     end_patch_reads() const noexcept;
 
+    /** The contact patch the cache holds for @p point in this generation
+     * (a state's or an MPI result's), or null. Not real-time: takes the
+     * lock. */
+    std::shared_ptr<const ContactPatch>
+    patch(const unsigned int point) const;
+
     /** Number of available and of failed points in this generation. */
     std::pair<unsigned int, unsigned int>
     counts() const;

@@ -13,6 +13,7 @@
 
 namespace palpate
 {
+  struct ContactPatch;
   class Mesh;
   class NodeSelection;
   class Scene;
@@ -146,6 +147,9 @@ namespace palpate
     {
       /** Intact states and failure points. */
       unsigned int states = 0, failures = 0;
+      /** The states with their contact patch (Interpolation = contact
+       * patch). */
+      unsigned int patches = 0;
       /** Records whose checksum does not match (changed on disk). */
       unsigned int damaged = 0;
       /** Records without a checksum: cut short by a writer that was
@@ -193,6 +197,14 @@ namespace palpate
      */
     void
     append(const unsigned int point, const State &state);
+
+    /** The same, with the state's contact patch @p patch (kept with it; a
+     * state of an MPI server comes without its patch, which the cache
+     * holds). */
+    void
+    append(const unsigned int  point,
+           const State        &state,
+           const ContactPatch *patch);
 
     /**
      * The records this object appended that the file holds: those written

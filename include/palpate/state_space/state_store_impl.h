@@ -83,6 +83,9 @@ namespace palpate
       double              stiffness[9];
       double              wall_time = 0;
       std::vector<double> solution, multipliers;
+      /** The state's contact patch as bytes (patch_bytes()); none if the
+       * state has no patch. */
+      std::vector<char> patch;
 
       std::uint64_t
       checksum() const
@@ -95,12 +98,16 @@ namespace palpate
         h.add(&wall_time, sizeof(wall_time));
         h.add(solution);
         h.add(multipliers);
+        h.add(patch);
         return h.value();
       }
     };
 
     /** The store's datasets, one per field of a Record, in its order: a
-     * record is row r of each. */
+     * record is row r of each of the first eight and of "patch" (where its
+     * patch's bytes start in "patch_bytes", and how many), written before
+     * the checksum. "patch_bytes" is one column of bytes, the patches one
+     * after the other. */
     inline const char *const dataset_names[] = {"point",
                                                 "status",
                                                 "force",
@@ -108,7 +115,14 @@ namespace palpate
                                                 "wall_time",
                                                 "solution",
                                                 "multipliers",
-                                                "checksum"};
+                                                "checksum",
+                                                "patch",
+                                                "patch_bytes"};
+    /** The datasets of a record's rows, and all of them. */
+    constexpr unsigned int record_datasets = 9, n_datasets = 10;
+    /** The datasets of a store that palpate wrote before patches were
+     * stored: any of them makes a file a store. */
+    constexpr unsigned int first_format_datasets = 8;
 
     /** Refuse the store @p store: throws InputError (entry State space /
      * Store) with @p problem and @p fix. */
@@ -192,7 +206,7 @@ namespace palpate
     std::string            file;
     Access                 access = Access::write;
     hid_t                  h5     = -1;
-    hid_t                  datasets[8];
+    hid_t                  datasets[internal::n_datasets];
     hsize_t                n_solution = 0, n_multipliers = 0;
     hsize_t                rows = 0;
     std::set<unsigned int> stored; // points with an intact record
@@ -245,6 +259,8 @@ namespace palpate
             return n_solution;
           case 6:
             return n_multipliers;
+          case 8:
+            return 2;
           default:
             return 1;
         }
@@ -254,9 +270,10 @@ namespace palpate
     hid_t
     type(const unsigned int d) const
     {
-      return d <= 1 ? H5T_NATIVE_INT32 :
-             d == 7 ? H5T_NATIVE_UINT64 :
-                      H5T_NATIVE_DOUBLE;
+      return d <= 1           ? H5T_NATIVE_INT32 :
+             d == 7 || d == 8 ? H5T_NATIVE_UINT64 :
+             d == 9           ? H5T_NATIVE_CHAR :
+                                H5T_NATIVE_DOUBLE;
     }
 
     /** Close the file (errors ignored: after a failed write HDF5 may not
@@ -303,7 +320,8 @@ namespace palpate
 
     /**
      * Make sure the file's blocks reach past HDF5's end of allocation by
-     * four records and 128 KiB: what one more record allocates (its rows,
+     * four records (of @p patch_bytes of patch each) and 128 KiB: what one
+     * more record allocates (its rows,
      * and the chunk index and metadata they add: pages of at most 1024
      * addresses, 8 KiB, for each of the 8 datasets) with a margin. Returns ""
      * on success, else why not. The blocks beyond the end of allocation stay as
@@ -311,7 +329,19 @@ namespace palpate
      * are used by the next records.
      */
     std::string
-    reserve();
+    reserve(const std::size_t patch_bytes);
+
+    /** Append @p bytes to "patch_bytes" (flushed); where they start, or
+     * false if HDF5 (the file system) refused. */
+    bool
+    write_patch(const std::vector<char> &bytes, hsize_t &offset);
+
+    /** Read @p size patch bytes from @p offset into @p bytes; false if the
+     * file does not hold them (a record cut short). */
+    bool
+    read_patch(const hsize_t      offset,
+               const hsize_t      size,
+               std::vector<char> &bytes) const;
 
     /** The result of reading one record. */
     enum class Read
