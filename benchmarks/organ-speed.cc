@@ -139,6 +139,17 @@ namespace
     p.mesh.surface_mesh_directory =
       std::string(PALPATE_BINARY_DIR) + "/organ-speed-meshes";
     p.nonlinear_solver.assembly_threads = 1;
+    // The levers start from the reference path, whatever the scene ships
+    // (since 2026-11-29 its on-line settings: condensed contact, contact
+    // patches on a 10 mm grid, the study's tolerance): contact in the
+    // factorised matrix, increments of 2.5 mm, tolerance 1e-8, Hermite on
+    // the 5 mm grid, no store.
+    p.nonlinear_solver.condensed_contact    = false;
+    p.nonlinear_solver.max_increment_length = 0.0025;
+    p.nonlinear_solver.residual_tolerance   = 1e-8;
+    p.state_space.interpolation             = "tricubic Hermite";
+    p.state_space.grid_spacing              = 0.005;
+    p.state_space.store                     = "";
     if (material == "nh")
       {
         p.material_model.model_name = "Neo-Hookean";

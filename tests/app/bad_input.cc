@@ -5,6 +5,8 @@
 // and must exit with status 2 (input error) and a message that names the
 // file, the line if there is one, the entry, and what to do.
 
+#include <palpate/state_space/state_store.h>
+
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -198,16 +200,31 @@ main(int argc, char **argv)
         interaction + beam_body +
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = /dev/zero\n  end\nend\n");
-  // State space / Interpolation = contact patch needs a sphere, and no
-  // store (a store keeps no patches).
+  // State space / Interpolation = contact patch needs a sphere, and a
+  // store that keeps patches.
   const std::string patch =
     "good.prm --set 'State space/Interpolation=contact patch'";
   const std::string sphere =
     " --set 'Boundary conditions/Active node/Tip=sphere' --set "
     "'Boundary conditions/Active node/Tip radius=0.02'";
   run("contact patch with a point probe", patch);
-  run("contact patch with a state store",
-      patch + sphere + " --set 'State space/Store=beam.h5'");
+  // A store made for another interpolation keeps no patches.
+  {
+    const Body hermite(palpate::Scene::read(
+      "good.prm",
+      {"State space/Interpolation=tricubic Hermite",
+       "Boundary conditions/Active node/Tip=sphere",
+       "Boundary conditions/Active node/Tip radius=0.02"}));
+    std::filesystem::remove("hermite.h5");
+    const palpate::StateStore made(
+      "hermite.h5",
+      palpate::StoreFingerprint::of(hermite.scene,
+                                    hermite.mesh,
+                                    hermite.nodes));
+  }
+  run("contact patch with a store made for tricubic Hermite",
+      patch + sphere +
+        " --set 'State space/Store=hermite.h5' --set 'Run/Mode=interaction'");
   run("a scene file that does not exist", "no-such-scene.prm");
   run("an unknown option", "--frobnicate");
 

@@ -166,9 +166,14 @@ main(int argc, char **argv)
   // the kept factors of the state before solve it (those the pressed
   // state's stiffness was computed with), until the residual is one step
   // from the state (1e-4), where the stiffness wants factors of its own.
+  // (The scene's contact patches want theirs from max(1e-4, 10 x
+  // tolerance) on: here the stiffness's Hermite and the tolerance of the
+  // condensed path's own tests.)
   {
-    palpate::Scene scene                                = liver;
-    scene.parameters.nonlinear_solver.condensed_contact = true;
+    palpate::Scene scene                                 = liver;
+    scene.parameters.nonlinear_solver.condensed_contact  = true;
+    scene.parameters.nonlinear_solver.residual_tolerance = 1e-8;
+    scene.parameters.state_space.interpolation           = "tricubic Hermite";
     const Body           body(scene);
     palpate::StateSolver solver(body.mesh, body.nodes, scene.parameters);
     const palpate::State pressed =
