@@ -166,7 +166,16 @@ namespace palpate
     const Interpolation   interpolation =
       interpolation_from_name(scene.parameters.state_space.interpolation);
     std::unique_ptr<PatchContact> patch_contact;
-    MissingCause                  previous_cause = MissingCause::none;
+    // With contact patches, the cache's read section stays open from one
+    // complete cell to the next, so that the last complete cell's patches
+    // stay alive (the cache frees a patch it lets go of only once no
+    // section can hold it) and answer while data are missing.
+    bool                                patch_section_open = false;
+    bool                                last_patches_valid = false;
+    std::array<const ContactPatch *, 8> last_patches       = {};
+    Utilities::Point3                   last_origin        = {{0, 0, 0}};
+    std::uint64_t                       last_generation    = 0;
+    MissingCause                        previous_cause     = MissingCause::none;
     // Whether the last tick's missing data was held (a held stretch that
     // turns into a fade, when a server's trouble ends before its states
     // came, is a new event: the summary counts fades and holds apart).
@@ -207,17 +216,57 @@ namespace palpate
     {
       const std::uint64_t                 generation = cache.generation();
       std::array<const ContactPatch *, 8> patches;
+      // The section of the last complete cell ends here: its patches are
+      // not read again.
+      if (patch_section_open)
+        cache.end_patch_reads();
       cache.begin_patch_reads();
-      bool all = true;
+      patch_section_open = true;
+      bool all           = true;
       for (unsigned int c = 0; c < 8 && all; ++c)
         all = (patches[c] = cache.read_patch(sample.corners[c], generation));
+      last_patches_valid = all;
       if (all)
-        patch_contact->blend(patches,
-                             trilinear_weights(sample.local),
-                             position,
-                             sample.force,
-                             &sample.stiffness);
-      cache.end_patch_reads();
+        {
+          patch_contact->blend(patches,
+                               trilinear_weights(sample.local),
+                               position,
+                               sample.force,
+                               &sample.stiffness);
+          last_patches    = patches;
+          last_origin     = grid.position(sample.corners[0]);
+          last_generation = generation;
+        }
+    }
+
+    /**
+     * While data are missing, with contact patches: the force at
+     * @p position from the last complete cell's patches, the sphere's
+     * contact against the surface and compliance last known there
+     * (weights of the position clamped to that cell, so that the force is
+     * continuous as the HIP leaves it). False, and the section ended, if
+     * there are none or the parameters changed since. Real-time safe.
+     */
+    bool
+    render_last_patches(const Utilities::Point3 &position,
+                        Utilities::Point3       &force,
+                        std::array<double, 9>   &stiffness) noexcept
+    {
+      if (last_patches_valid && cache.generation() != last_generation)
+        {
+          cache.end_patch_reads();
+          patch_section_open = false;
+          last_patches_valid = false;
+        }
+      if (!last_patches_valid)
+        return false;
+      std::array<double, 3> local;
+      for (unsigned int d = 0; d < 3; ++d)
+        local[d] =
+          std::clamp((position[d] - last_origin[d]) / grid.spacing(), 0.0, 1.0);
+      patch_contact->blend(
+        last_patches, trilinear_weights(local), position, force, &stiffness);
+      return true;
     }
 
     /** Seconds since the last force() call (1 ms at the first). */
@@ -363,6 +412,10 @@ namespace palpate
         s.previous_cause = MissingCause::none;
         s.previous_held  = false;
         s.hold.reset();
+        if (s.patch_section_open)
+          s.cache.end_patch_reads();
+        s.patch_section_open = false;
+        s.last_patches_valid = false;
       }
     // The time since the last call, and the HIP's position and velocity
     // for the scheduler; a non-finite position is treated as "outside":
@@ -447,6 +500,12 @@ namespace palpate
             render      = true;
             s.stiffness = s.hold.stiffness_matrix(position);
           }
+        // With contact patches the last complete cell's patches answer
+        // instead of the spring or the fade: the tissue there as last
+        // known, zero off its surface. Still an event of its kind.
+        if (s.patch_contact && s.in_contact && finite &&
+            s.render_last_patches(position, target, s.stiffness))
+          render = true;
         const unsigned int slot = cause == MissingCause::failure_region ? 0 :
                                   cause == MissingCause::outside        ? 1 :
                                                                           2;

@@ -48,7 +48,11 @@ namespace palpate
    * Haptics / Force limit and changing by at most Haptics / Maximum force
    * change per call. Where a corner is missing (not computed yet, a failure
    * point, outside the grid, detached) the force fades to zero at that
-   * rate, and the event is counted and reported (poll_events(), summary()).
+   * rate, or is held (a failure region, outside the grid: ForceHold), and
+   * the event is counted and reported (poll_events(), summary()). With
+   * Interpolation = contact patch the last complete cell's contact patches
+   * answer instead, wherever data are missing while in contact: the sphere
+   * against the surface and compliance last known there, zero off it.
    *
    * force() may be called from exactly one thread at a time. It never
    * blocks, never allocates and never returns NaN. Everything else is for
@@ -97,7 +101,7 @@ namespace palpate
      * d x_j) of the force field at the last force() call's position:
      * the interpolated field's (continuous across cells with tricubic
      * Hermite interpolation), the held spring's where a force is held,
-     * zero where none is rendered. For a device that renders a local model
+     * the last patches' where they answer, zero where none is rendered. For a device that renders a local model
      * f + K (x - x_last) between ticks. Call from the thread that calls
      * force(); real-time safe. (Not limited like the force: a device that
      * uses it must apply its own stiffness limit.)
