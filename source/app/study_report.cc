@@ -299,7 +299,7 @@ namespace palpate
               << "  In the scene: State space / Grid spacing = "
               << row.h_mm / 1000 << ", Interpolation = "
               << (row.interpolation == "Hermite" ? "tricubic Hermite" :
-                                                   "trilinear");
+                                                   row.interpolation);
           if (row.residual_tolerance != p0.nonlinear_solver.residual_tolerance)
             out << "; Nonlinear solver / Residual tolerance = "
                 << row.residual_tolerance;
