@@ -39,58 +39,67 @@ namespace palpate
     }
 
     /**
-     * Mesh / Source = surface: the volume mesh palpate made of the surface
-     * before, or a new one. Its name holds a hash of the surface file's
-     * bytes, the scale factor and the target, so a changed surface or
-     * setting is meshed again and an unchanged one never is.
+     * The bytes of the surface file Mesh / File name names (resolved to
+     * @p path), with errors that point at that entry.
      */
-    Mesh
-    from_surface(const Scene &scene)
+    std::string
+    surface_bytes(const Scene &scene, const std::string &path)
     {
-      namespace fs     = std::filesystem;
-      const auto &p    = scene.parameters.mesh;
-      const auto  path = scene.resolve_path(p.file_name);
-      std::string bytes;
-      {
-        try
-          {
-            check_file_size(path,
-                            "surface file",
-                            max_mesh_file_bytes,
-                            "an organ's surface of 100,000 triangles has "
-                            "about 5 MiB");
-          }
-        catch (const InputError &e)
-          {
-            throw scene.error("Mesh/File name", e.problem(), e.fix());
-          }
-        std::ifstream in(path, std::ios::binary);
-        if (!in)
-          {
-            // A name the file system refuses (a loop of links, too long,
-            // no permission) is said as such, not as a missing file.
-            bool              missing = false;
-            const std::string why     = why_cannot_open(path, &missing);
-            if (!missing && !why.empty())
-              throw scene.error("Mesh/File name",
-                                "the surface file '" + path +
-                                  "' cannot be read: " + why,
-                                "check the path, the links on the way and "
-                                "the permissions.");
-            throw scene.error(
-              "Mesh/File name",
-              "the surface file '" + p.file_name +
-                "' was not found: looked for " +
-                scene.where_looked(p.file_name),
-              "a relative path is relative to the scene file's directory; "
-              "the example organs are in the project's meshes/ (its "
-              "README), e.g. '../meshes/liver-tetgen/liver2k-surface.obj' "
-              "from parameters/.");
-          }
-        std::ostringstream s;
-        s << in.rdbuf();
-        bytes = s.str();
-      }
+      const auto &p = scene.parameters.mesh;
+      try
+        {
+          check_file_size(path,
+                          "surface file",
+                          max_mesh_file_bytes,
+                          "an organ's surface of 100,000 triangles has "
+                          "about 5 MiB");
+        }
+      catch (const InputError &e)
+        {
+          throw scene.error("Mesh/File name", e.problem(), e.fix());
+        }
+      std::ifstream in(path, std::ios::binary);
+      if (!in)
+        {
+          // A name the file system refuses (a loop of links, too long,
+          // no permission) is said as such, not as a missing file.
+          bool              missing = false;
+          const std::string why     = why_cannot_open(path, &missing);
+          if (!missing && !why.empty())
+            throw scene.error("Mesh/File name",
+                              "the surface file '" + path +
+                                "' cannot be read: " + why,
+                              "check the path, the links on the way and "
+                              "the permissions.");
+          throw scene.error(
+            "Mesh/File name",
+            "the surface file '" + p.file_name +
+              "' was not found: looked for " + scene.where_looked(p.file_name),
+            "a relative path is relative to the scene file's directory; "
+            "the example organs are in the project's meshes/ (its "
+            "README), e.g. '../meshes/liver-tetgen/liver2k-surface.obj' "
+            "from parameters/.");
+        }
+      std::ostringstream s;
+      s << in.rdbuf();
+      return s.str();
+    }
+
+
+
+    /**
+     * Where the volume mesh of the surface at @p path (its bytes @p bytes)
+     * is kept: in Mesh / Surface / Volume mesh directory, named by a hash
+     * of the bytes, the scale factor and the target, so a changed surface
+     * or setting is meshed again and an unchanged one never is.
+     */
+    std::filesystem::path
+    volume_mesh_file(const Scene       &scene,
+                     const std::string &path,
+                     const std::string &bytes)
+    {
+      namespace fs       = std::filesystem;
+      const auto   &p    = scene.parameters.mesh;
       std::uint64_t hash = 1469598103934665603ull; // FNV-1a
       for (const char c :
            bytes + "|" + Utilities::to_string(p.scale_factor, 17) + "|" +
@@ -115,10 +124,25 @@ namespace palpate
                           "the directory '" + directory.string() +
                             "' cannot be created (" + ec.message() + ")",
                           "name a directory palpate may write to.");
+      return directory / (fs::path(path).stem().string() + "-" +
+                          std::to_string(p.surface_target_nodes) + "-" +
+                          std::string(hex).substr(0, 8) + ".msh");
+    }
+
+
+
+    /**
+     * Mesh / Source = surface: the volume mesh palpate made of the surface
+     * before (volume_mesh_file()), or a new one.
+     */
+    Mesh
+    from_surface(const Scene &scene)
+    {
+      namespace fs        = std::filesystem;
+      const auto    &p    = scene.parameters.mesh;
+      const auto     path = scene.resolve_path(p.file_name);
       const fs::path file =
-        directory / (fs::path(path).stem().string() + "-" +
-                     std::to_string(p.surface_target_nodes) + "-" +
-                     std::string(hex).substr(0, 8) + ".msh");
+        volume_mesh_file(scene, path, surface_bytes(scene, path));
       std::string how = "reused";
       // A mesh whose node-count corrections the time limit stopped is
       // used once and not kept: with more time the next run does better.

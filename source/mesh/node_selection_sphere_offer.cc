@@ -86,6 +86,102 @@ namespace palpate
       }
 
       /**
+       * The refusal when, at rest, every radius tried (@p tried) fails some
+       * of the 26 grid points around rest; @p untried: larger radii than
+       * the last, @p r, were left untried for time.
+       */
+      [[noreturn]] void
+      refuse_at_rest(const Scene       &scene,
+                     const std::string &tried,
+                     const bool         untried,
+                     const double       r)
+      {
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "no sphere found here: radii that pass the checks (" + tried +
+            " m) were tried by static solves to the 26 grid points around "
+            "rest (State space / Grid spacing), and with each some "
+            "did not converge (failure points, no force there)" +
+            // (Taylor-Hood: the first radius's trials may take minutes.)
+            (untried ? "; larger ones were not tried (after the first radius, "
+                       "trials go on only within 10 s)" :
+                       ""),
+          "a mesh finer near the probe (Mesh / Source = surface with "
+          "Refinement size about a third of the radius), another Point or "
+          "Node id, or a smaller Grid spacing" +
+            std::string(
+              untried ? ", or try a larger Tip radius yourself, e.g. " +
+                          Utilities::to_string(r, 3) + " m (not solved here)" :
+                        ""));
+      }
+
+
+
+      /**
+       * With no radius converging to the push, a shorter push along the
+       * same line with the radius that got farthest (@p best, to
+       * @p best_reached of the way; @p radii those tried): what to name,
+       * or the refusal. (Shorter, it needs no larger a radius: the checks'
+       * margin grows with the depth and the slide.)
+       */
+      template <typename Reached>
+      TriedOffer
+      shorter_push(const Scene               &scene,
+                   const Utilities::Point3   &push,
+                   const std::vector<double> &radii,
+                   const double               best,
+                   const double               best_reached,
+                   const Reached             &reached)
+      {
+        const std::string   tried = list(radii);
+        std::vector<double> parts;
+        for (double part =
+               std::floor(0.9 * std::max(best_reached, 0.0) * 100) / 100;
+             part >= 0.05 && parts.size() < 2;
+             part = std::floor(0.5 * part * 100) / 100)
+          {
+            const Utilities::Point3 shorter = {
+              {part * push[0], part * push[1], part * push[2]}};
+            if (reached(best, shorter) >= 1)
+              {
+                std::vector<double> others;
+                for (const double r : radii)
+                  if (r != best)
+                    others.push_back(r);
+                return {" and, as the push (Prescribed displacement, --to, "
+                        "the trajectory), " +
+                          Utilities::to_string(part, 3) + " times this one: " +
+                          Utilities::to_string(shorter, 4) + " m",
+                        "; a static solve with these converged, while to this "
+                        "push it stopped at " +
+                          Utilities::to_string(best_reached, 2) +
+                          " of the way, a failure point" +
+                          (others.empty() ?
+                             std::string() :
+                             ", as with " + list(others) + " m") +
+                          " (Newton found no way on where the contact set "
+                          "keeps changing)"};
+              }
+            parts.push_back(part);
+          }
+        throw scene.error(
+          "Boundary conditions/Active node/Tip radius",
+          "no sphere found for this push: radii that pass the checks here (" +
+            tried +
+            " m) were tried by a static solve to it, and none converged (the "
+            "farthest got " +
+            Utilities::to_string(std::max(best_reached, 0.0), 2) +
+            " of the way)" +
+            (parts.empty() ? std::string() :
+                             ", nor to " + list(parts) + " times the push"),
+          "a shorter push (Prescribed displacement, --to, the trajectory), a "
+          "mesh finer near the probe (Mesh / Source = surface with Refinement "
+          "size about a third of the radius), or other fixed nodes");
+      }
+
+
+
+      /**
        * Try the radius @p offer a refusal names (it passes the checks) by a
        * static solve to the scene's push, or at rest to the 26 grid points
        * around it (where it must pass the checks too); if it does not
@@ -187,97 +283,29 @@ namespace palpate
           }
         const std::string tried = list(radii);
         if (at_rest)
-          throw scene.error(
-            "Boundary conditions/Active node/Tip radius",
-            "no sphere found here: radii that pass the checks (" + tried +
-              " m) were tried by static solves to the 26 grid points around "
-              "rest (State space / Grid spacing), and with each some "
-              "did not converge (failure points, no force there)" +
-              // (Taylor-Hood: the first radius's trials may take minutes.)
-              (n_tried < 3 && r <= largest ?
-                 "; larger ones were not tried (after the first radius, "
-                 "trials go on only within 10 s)" :
-                 ""),
-            "a mesh finer near the probe (Mesh / Source = surface with "
-            "Refinement size about a third of the radius), another Point or "
-            "Node id, or a smaller Grid spacing" +
-              std::string(n_tried < 3 && r <= largest ?
-                            ", or try a larger Tip radius yourself, e.g. " +
-                              Utilities::to_string(r, 3) +
-                              " m (not solved here)" :
-                            ""));
+          refuse_at_rest(scene, tried, n_tried < 3 && r <= largest, r);
         // None converged: a shorter push along the same line, with the
-        // radius that got farthest, tried too. (Shorter, it needs no larger
-        // a radius: the checks' margin grows with the depth and the slide.)
+        // radius that got farthest, tried too.
         offer = best;
-        std::vector<double> parts;
-        for (double part =
-               std::floor(0.9 * std::max(best_reached, 0.0) * 100) / 100;
-             part >= 0.05 && parts.size() < 2;
-             part = std::floor(0.5 * part * 100) / 100)
-          {
-            const Utilities::Point3 shorter = {
-              {part * push[0], part * push[1], part * push[2]}};
-            if (reached(best, shorter) >= 1)
-              {
-                std::vector<double> others;
-                for (const double r : radii)
-                  if (r != best)
-                    others.push_back(r);
-                return {" and, as the push (Prescribed displacement, --to, "
-                        "the trajectory), " +
-                          Utilities::to_string(part, 3) + " times this one: " +
-                          Utilities::to_string(shorter, 4) + " m",
-                        "; a static solve with these converged, while to this "
-                        "push it stopped at " +
-                          Utilities::to_string(best_reached, 2) +
-                          " of the way, a failure point" +
-                          (others.empty() ?
-                             std::string() :
-                             ", as with " + list(others) + " m") +
-                          " (Newton found no way on where the contact set "
-                          "keeps changing)"};
-              }
-            parts.push_back(part);
-          }
-        throw scene.error(
-          "Boundary conditions/Active node/Tip radius",
-          "no sphere found for this push: radii that pass the checks here (" +
-            tried +
-            " m) were tried by a static solve to it, and none converged (the "
-            "farthest got " +
-            Utilities::to_string(std::max(best_reached, 0.0), 2) +
-            " of the way)" +
-            (parts.empty() ? std::string() :
-                             ", nor to " + list(parts) + " times the push"),
-          "a shorter push (Prescribed displacement, --to, the trajectory), a "
-          "mesh finer near the probe (Mesh / Source = surface with Refinement "
-          "size about a third of the radius), or other fixed nodes");
+        return shorter_push(scene, push, radii, best, best_reached, reached);
       }
-    } // namespace
 
 
 
-    void
-    place_sphere_tip(const Scene                      &scene,
-                     const Mesh                       &mesh,
-                     NodeSelection                    &selection,
-                     const NodeSelection::SphereTrial &trial)
-    {
-      const auto     &a   = scene.parameters.boundary_conditions.active_node;
-      const double    R   = a.tip_radius;
-      const SphereFit fit = fit_sphere(scene, mesh, selection, R);
-      if (fit.passes)
-        {
-          selection = fit.placed;
-          return;
-        }
-      // Beyond towards_support no radius is offered: the one the checks
-      // find can be a failure point there (above); the push is what to
-      // change.
-      const double no_deeper =
-        std::floor(towards_support * fit.support * 1e4) / 1e4;
-      if (!fit.supported)
+      /**
+       * The refusal of a sphere of radius @p R pushed farther towards the
+       * fixed nodes than a radius is offered for (@p fit.supported false).
+       */
+      [[noreturn]] void
+      refuse_beyond_support(const Scene     &scene,
+                            const double     R,
+                            const SphereFit &fit)
+      {
+        // Beyond towards_support no radius is offered: the one the checks
+        // find can be a failure point there (above); the push is what to
+        // change.
+        const double no_deeper =
+          std::floor(towards_support * fit.support * 1e4) / 1e4;
         throw scene.error(
           "Boundary conditions/Active node/Tip radius",
           "a sphere of " + Utilities::to_string(R, 3) + " m radius " +
@@ -298,6 +326,27 @@ namespace palpate
             "0.26; such a push already asks 5 - 8 N, about what a haptic "
             "device renders). Or fixed nodes farther from the probe "
             "(Boundary conditions / Fixed nodes).");
+      }
+    } // namespace
+
+
+
+    void
+    place_sphere_tip(const Scene                      &scene,
+                     const Mesh                       &mesh,
+                     NodeSelection                    &selection,
+                     const NodeSelection::SphereTrial &trial)
+    {
+      const auto     &a   = scene.parameters.boundary_conditions.active_node;
+      const double    R   = a.tip_radius;
+      const SphereFit fit = fit_sphere(scene, mesh, selection, R);
+      if (fit.passes)
+        {
+          selection = fit.placed;
+          return;
+        }
+      if (!fit.supported)
+        refuse_beyond_support(scene, R, fit);
       // The radius to offer: the smallest that passes, found by trying
       // radii 2 % apart from what the figures at R ask for. R's figures
       // alone do not say what another radius needs: it touches another

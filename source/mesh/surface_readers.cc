@@ -163,6 +163,158 @@ namespace palpate
 
     // ---------------------------------------------------------------- PLY
 
+    namespace
+    {
+      struct Property
+      {
+        std::string name, type, count_type; // count_type: lists only
+      };
+      struct Element
+      {
+        std::string           name;
+        std::size_t           count = 0;
+        std::vector<Property> properties;
+      };
+
+      /** A PLY header's format and elements. */
+      struct PlyHeader
+      {
+        std::string          format;
+        std::vector<Element> elements;
+      };
+
+
+
+      /**
+       * The header of the PLY file @p filename (its text @p data, the
+       * header ending at @p header_end), checked.
+       */
+      PlyHeader
+      read_ply_header(const std::string &filename,
+                      const std::string &data,
+                      const std::size_t  header_end)
+      {
+        PlyHeader ply;
+        auto     &elements = ply.elements;
+        auto     &format   = ply.format;
+        {
+          std::istringstream header(data.substr(0, header_end));
+          std::string        line;
+          unsigned int       line_number = 0;
+          while (std::getline(header, line))
+            {
+              ++line_number;
+              std::istringstream words(line);
+              std::string        word;
+              words >> word;
+              if (word == "format")
+                words >> format;
+              else if (word == "element")
+                {
+                  Element e;
+                  if (!(words >> e.name >> e.count))
+                    throw bad(filename,
+                              line_number,
+                              "an 'element' line without a name and count",
+                              damaged);
+                  elements.push_back(e);
+                }
+              else if (word == "property")
+                {
+                  if (elements.empty())
+                    throw bad(filename,
+                              line_number,
+                              "a property before any element",
+                              damaged);
+                  Property p;
+                  words >> p.type;
+                  if (p.type == "list")
+                    words >> p.count_type >> p.type;
+                  words >> p.name;
+                  elements.back().properties.push_back(p);
+                }
+            }
+        }
+        if (format != "ascii" && format != "binary_little_endian" &&
+            format != "binary_big_endian")
+          throw bad(filename,
+                    2,
+                    "unknown PLY format '" + format + "'",
+                    "export as ascii or binary PLY.");
+        return ply;
+      }
+
+
+
+      /**
+       * The vertices and faces of the PLY file @p filename (its text
+       * @p data, its data from @p body on), as @p ply's elements say.
+       */
+      Surface
+      read_ply_data(const std::string &filename,
+                    const std::string &data,
+                    const std::size_t  body,
+                    const PlyHeader   &ply)
+      {
+        const auto &elements = ply.elements;
+        const auto &format   = ply.format;
+        Surface     s;
+        s.format                 = "PLY " + format;
+        const bool         ascii = format == "ascii";
+        std::istringstream text(ascii ? data.substr(body) : std::string());
+        Bytes      bytes(filename, data, body, format == "binary_big_endian");
+        const auto value = [&](const std::string &type) {
+          if (!ascii)
+            return bytes.get_typed(type);
+          double x;
+          if (!(text >> x))
+            throw bad(filename, 0, "the PLY data end early", damaged);
+          return x;
+        };
+        for (const auto &e : elements)
+          for (std::size_t i = 0; i < e.count; ++i)
+            {
+              Point3                 x{{0, 0, 0}};
+              std::vector<long long> polygon;
+              for (const auto &p : e.properties)
+                {
+                  if (!p.count_type.empty())
+                    {
+                      const auto n =
+                        static_cast<long long>(value(p.count_type));
+                      for (long long k = 0; k < n; ++k)
+                        {
+                          const double v = value(p.type);
+                          if (p.name == "vertex_indices" ||
+                              p.name == "vertex_index")
+                            polygon.push_back(static_cast<long long>(v));
+                        }
+                      continue;
+                    }
+                  const double v = value(p.type);
+                  if (e.name == "vertex" && p.name.size() == 1 &&
+                      p.name[0] >= 'x' && p.name[0] <= 'z')
+                    x[p.name[0] - 'x'] = v;
+                }
+              if (e.name == "vertex")
+                s.vertices.push_back(x);
+              else if (e.name == "face")
+                {
+                  if (polygon.size() < 3)
+                    throw bad(filename,
+                              0,
+                              "face " + std::to_string(i) +
+                                " has fewer than three vertices",
+                              damaged);
+                  add_polygon(s, polygon, filename, 0);
+                }
+            }
+        return s;
+      }
+    } // namespace
+
+
+
     Surface
     read_ply(const std::string &filename)
     {
@@ -180,114 +332,8 @@ namespace palpate
         throw bad(filename, 0, "the file ends after its header", damaged);
       ++body;
 
-      struct Property
-      {
-        std::string name, type, count_type; // count_type: lists only
-      };
-      struct Element
-      {
-        std::string           name;
-        std::size_t           count = 0;
-        std::vector<Property> properties;
-      };
-      std::vector<Element> elements;
-      std::string          format;
-      {
-        std::istringstream header(data.substr(0, header_end));
-        std::string        line;
-        unsigned int       line_number = 0;
-        while (std::getline(header, line))
-          {
-            ++line_number;
-            std::istringstream words(line);
-            std::string        word;
-            words >> word;
-            if (word == "format")
-              words >> format;
-            else if (word == "element")
-              {
-                Element e;
-                if (!(words >> e.name >> e.count))
-                  throw bad(filename,
-                            line_number,
-                            "an 'element' line without a name and count",
-                            damaged);
-                elements.push_back(e);
-              }
-            else if (word == "property")
-              {
-                if (elements.empty())
-                  throw bad(filename,
-                            line_number,
-                            "a property before any element",
-                            damaged);
-                Property p;
-                words >> p.type;
-                if (p.type == "list")
-                  words >> p.count_type >> p.type;
-                words >> p.name;
-                elements.back().properties.push_back(p);
-              }
-          }
-      }
-      if (format != "ascii" && format != "binary_little_endian" &&
-          format != "binary_big_endian")
-        throw bad(filename,
-                  2,
-                  "unknown PLY format '" + format + "'",
-                  "export as ascii or binary PLY.");
-
-      Surface s;
-      s.format                 = "PLY " + format;
-      const bool         ascii = format == "ascii";
-      std::istringstream text(ascii ? data.substr(body) : std::string());
-      Bytes      bytes(filename, data, body, format == "binary_big_endian");
-      const auto value = [&](const std::string &type) {
-        if (!ascii)
-          return bytes.get_typed(type);
-        double x;
-        if (!(text >> x))
-          throw bad(filename, 0, "the PLY data end early", damaged);
-        return x;
-      };
-      for (const auto &e : elements)
-        for (std::size_t i = 0; i < e.count; ++i)
-          {
-            Point3                 x{{0, 0, 0}};
-            std::vector<long long> polygon;
-            for (const auto &p : e.properties)
-              {
-                if (!p.count_type.empty())
-                  {
-                    const auto n = static_cast<long long>(value(p.count_type));
-                    for (long long k = 0; k < n; ++k)
-                      {
-                        const double v = value(p.type);
-                        if (p.name == "vertex_indices" ||
-                            p.name == "vertex_index")
-                          polygon.push_back(static_cast<long long>(v));
-                      }
-                    continue;
-                  }
-                const double v = value(p.type);
-                if (e.name == "vertex" && p.name.size() == 1 &&
-                    p.name[0] >= 'x' && p.name[0] <= 'z')
-                  x[p.name[0] - 'x'] = v;
-              }
-            if (e.name == "vertex")
-              s.vertices.push_back(x);
-            else if (e.name == "face")
-              {
-                if (polygon.size() < 3)
-                  throw bad(filename,
-                            0,
-                            "face " + std::to_string(i) +
-                              " has fewer than three vertices",
-                            damaged);
-                add_polygon(s, polygon, filename, 0);
-              }
-          }
-      return s;
+      const PlyHeader ply = read_ply_header(filename, data, header_end);
+      return read_ply_data(filename, data, body, ply);
     }
   } // namespace internal
 } // namespace palpate
