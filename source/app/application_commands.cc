@@ -100,6 +100,145 @@ namespace palpate
 
 
 
+    namespace
+    {
+      /** What palpate mesh's options ask for. */
+      struct MeshOptions
+      {
+        double       scale = 1, time_limit = 60;
+        unsigned int nodes = 1500;
+        MeshGrading  grading;
+      };
+
+
+
+      /** palpate mesh's options, from args[3] on, read and checked. */
+      MeshOptions
+      mesh_options(const std::vector<std::string> &args)
+      {
+        MeshOptions   options;
+        double       &scale = options.scale, &time_limit = options.time_limit;
+        unsigned int &nodes   = options.nodes;
+        MeshGrading  &grading = options.grading;
+        bool          refine = false, radius_given = false;
+        for (unsigned int i = 3; i < args.size(); ++i)
+          {
+            const bool has_value = i + 1 < args.size();
+            if (args[i] == "--nodes" && has_value)
+              nodes = static_cast<unsigned int>(
+                number_argument("--nodes", args[++i], 50, 200000, "1500"));
+            else if (args[i] == "--scale" && has_value)
+              scale = number_argument("--scale", args[++i], 1e-9, 1e9, "0.001");
+            else if (args[i] == "--time-limit" && has_value)
+              time_limit =
+                number_argument("--time-limit", args[++i], 0.01, 86400, "60");
+            else if (args[i] == "--refine" && has_value)
+              {
+                const std::string value = args[++i];
+                try
+                  {
+                    grading.center = Utilities::parse_point(value);
+                  }
+                catch (const std::exception &)
+                  {
+                    throw InputError("command line",
+                                     0,
+                                     "--refine " + value,
+                                     "expected a point x,y,z in metres (after "
+                                     "--scale)",
+                                     "e.g. --refine -0.0936,0.1107,0.0994.");
+                  }
+                refine = true;
+              }
+            else if (args[i] == "--fine-size" && has_value)
+              grading.fine_size =
+                number_argument("--fine-size", args[++i], 1e-5, 1, "0.003");
+            else if (args[i] == "--fine-radius" && has_value)
+              {
+                grading.radius =
+                  number_argument("--fine-radius", args[++i], 0, 10, "0.02");
+                radius_given = true;
+              }
+            else
+              throw unexpected(args[i]);
+          }
+        if (refine != (grading.fine_size > 0))
+          throw InputError("command line",
+                           0,
+                           refine ? "--refine" : "--fine-size",
+                           "--refine and --fine-size go together: where to "
+                           "refine and to what element size",
+                           "e.g. --refine -0.0936,0.1107,0.0994 --fine-size "
+                           "0.003.");
+        if (!radius_given)
+          grading.radius = 2 * grading.fine_size;
+        return options;
+      }
+
+
+
+      /**
+       * That palpate mesh may write its output args[2]: a .msh, no link to
+       * nowhere, no file of the user's that is no mesh, a directory it can
+       * write in.
+       */
+      void
+      check_mesh_output(const std::vector<std::string> &args)
+      {
+        if (std::filesystem::path(args[2]).extension() != ".msh")
+          throw InputError("command line",
+                           0,
+                           args[2],
+                           "the volume mesh is written as Gmsh 2.2, so its "
+                           "name must end in .msh",
+                           "e.g. 'palpate mesh " + args[1] + " organ.msh'.");
+        // A link to nowhere would be replaced by the mesh (its target left
+        // empty), and a file of the user's that is no mesh overwritten: both
+        // are refused.
+        if (const std::string link = dangling_link(args[2]); !link.empty())
+          throw InputError("command line",
+                           0,
+                           args[2],
+                           link,
+                           "name the mesh by the link's target (in a directory "
+                           "that exists), or remove the link first.");
+        if (std::filesystem::is_regular_file(args[2]))
+          {
+            std::ifstream in(args[2], std::ios::binary);
+            std::string   head(11, '\0');
+            in.read(head.data(), head.size());
+            head.resize(in.gcount());
+            if (!head.empty() && head != "$MeshFormat")
+              throw InputError("command line",
+                               0,
+                               args[2],
+                               "'" + args[2] +
+                                 "' exists and is not a Gmsh mesh: it would "
+                                 "be overwritten",
+                               "name a new file, or remove this one first if "
+                               "it is no longer needed.");
+          }
+        {
+          // Check that the output can be written before any work.
+          const auto      dir = std::filesystem::path(args[2]).parent_path();
+          std::error_code ec;
+          if (!dir.empty())
+            std::filesystem::create_directories(dir, ec);
+          const bool    existed = std::filesystem::exists(args[2]);
+          std::ofstream probe(args[2], std::ios::app);
+          if (!probe)
+            throw OutputError("cannot write '" + args[2] +
+                              "': check that its directory exists and is "
+                              "writable");
+          probe.close();
+          if (!existed)
+            std::filesystem::remove(args[2], ec);
+        }
+      }
+    } // namespace
+
+
+
     int
     run_mesh(const std::vector<std::string> &args, std::ostream &out)
     {
@@ -118,118 +257,21 @@ namespace palpate
                      {"--refine", "--refine -0.0936,0.1107,0.0994"},
                      {"--fine-size", "--fine-size 0.003"},
                      {"--fine-radius", "--fine-radius 0.02"}});
-      double       scale = 1, time_limit = 60;
-      unsigned int nodes = 1500;
-      MeshGrading  grading;
-      bool         refine = false, radius_given = false;
-      for (unsigned int i = 3; i < args.size(); ++i)
-        {
-          const bool has_value = i + 1 < args.size();
-          if (args[i] == "--nodes" && has_value)
-            nodes = static_cast<unsigned int>(
-              number_argument("--nodes", args[++i], 50, 200000, "1500"));
-          else if (args[i] == "--scale" && has_value)
-            scale = number_argument("--scale", args[++i], 1e-9, 1e9, "0.001");
-          else if (args[i] == "--time-limit" && has_value)
-            time_limit =
-              number_argument("--time-limit", args[++i], 0.01, 86400, "60");
-          else if (args[i] == "--refine" && has_value)
-            {
-              const std::string value = args[++i];
-              try
-                {
-                  grading.center = Utilities::parse_point(value);
-                }
-              catch (const std::exception &)
-                {
-                  throw InputError("command line",
-                                   0,
-                                   "--refine " + value,
-                                   "expected a point x,y,z in metres (after "
-                                   "--scale)",
-                                   "e.g. --refine -0.0936,0.1107,0.0994.");
-                }
-              refine = true;
-            }
-          else if (args[i] == "--fine-size" && has_value)
-            grading.fine_size =
-              number_argument("--fine-size", args[++i], 1e-5, 1, "0.003");
-          else if (args[i] == "--fine-radius" && has_value)
-            {
-              grading.radius =
-                number_argument("--fine-radius", args[++i], 0, 10, "0.02");
-              radius_given = true;
-            }
-          else
-            throw unexpected(args[i]);
-        }
-      if (refine != (grading.fine_size > 0))
-        throw InputError("command line",
-                         0,
-                         refine ? "--refine" : "--fine-size",
-                         "--refine and --fine-size go together: where to "
-                         "refine and to what element size",
-                         "e.g. --refine -0.0936,0.1107,0.0994 --fine-size "
-                         "0.003.");
-      if (!radius_given)
-        grading.radius = 2 * grading.fine_size;
-      if (std::filesystem::path(args[2]).extension() != ".msh")
-        throw InputError("command line",
-                         0,
-                         args[2],
-                         "the volume mesh is written as Gmsh 2.2, so its "
-                         "name must end in .msh",
-                         "e.g. 'palpate mesh " + args[1] + " organ.msh'.");
-      // A link to nowhere would be replaced by the mesh (its target left
-      // empty), and a file of the user's that is no mesh overwritten: both
-      // are refused.
-      if (const std::string link = dangling_link(args[2]); !link.empty())
-        throw InputError("command line",
-                         0,
-                         args[2],
-                         link,
-                         "name the mesh by the link's target (in a directory "
-                         "that exists), or remove the link first.");
-      if (std::filesystem::is_regular_file(args[2]))
-        {
-          std::ifstream in(args[2], std::ios::binary);
-          std::string   head(11, '\0');
-          in.read(head.data(), head.size());
-          head.resize(in.gcount());
-          if (!head.empty() && head != "$MeshFormat")
-            throw InputError("command line",
-                             0,
-                             args[2],
-                             "'" + args[2] +
-                               "' exists and is not a Gmsh mesh: it would "
-                               "be overwritten",
-                             "name a new file, or remove this one first if "
-                             "it is no longer needed.");
-        }
-      {
-        // Check that the output can be written before any work.
-        const auto      dir = std::filesystem::path(args[2]).parent_path();
-        std::error_code ec;
-        if (!dir.empty())
-          std::filesystem::create_directories(dir, ec);
-        const bool    existed = std::filesystem::exists(args[2]);
-        std::ofstream probe(args[2], std::ios::app);
-        if (!probe)
-          throw OutputError("cannot write '" + args[2] +
-                            "': check that its directory exists and is "
-                            "writable");
-        probe.close();
-        if (!existed)
-          std::filesystem::remove(args[2], ec);
-      }
+      const MeshOptions options = mesh_options(args);
+      check_mesh_output(args);
       out << "palpate mesh: " << args[1] << " -> " << args[2] << " (about "
-          << nodes << " nodes, " << Utilities::to_string(scale, 6)
-          << " m per file unit)\n";
+          << options.nodes << " nodes, "
+          << Utilities::to_string(options.scale, 6) << " m per file unit)\n";
       // A stop signal ends the meshing child and removes its files
       // (StoppedError); without it the child outlived palpate.
       const StopRequest       stop;
-      const SurfaceMeshReport report = mesh_surface_file(
-        args[1], scale, "--scale", nodes, time_limit, args[2], grading);
+      const SurfaceMeshReport report = mesh_surface_file(args[1],
+                                                         options.scale,
+                                                         "--scale",
+                                                         options.nodes,
+                                                         options.time_limit,
+                                                         args[2],
+                                                         options.grading);
       for (const auto &line : report.lines())
         out << "  " << line << "\n";
       out << "  use it:        subsection Mesh: set Source = file, set File "
