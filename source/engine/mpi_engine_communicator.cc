@@ -169,86 +169,8 @@ namespace palpate
             cache.mark_dropped(h.point);
           break;
         case Kind::result:
-          {
-            server.messages_sent = h.messages_sent;
-            server.bytes_sent    = h.bytes_sent;
-            if (server.tasks.empty() || server.tasks.front() != h.point)
-              break; // not what we asked it for (cannot happen)
-            const double start =
-              std::chrono::duration<double>(server.task_start - t0).count();
-            server.tasks.pop_front();
-            server.task_start    = Clock::now(); // the next one starts now
-            in_progress[h.point] = 0;
-            --busy;
-            ++finished;
-            replan = true;
-            if (h.flags & Flags::source_missing)
-              {
-                // The holder dropped it (or died) after the plan: not a
-                // failure point, just plan again without that holder.
-                holders[h.source] &= ~(h.source == origin ? 0 : bit(h.holder));
-                break;
-              }
-            if (h.flags & Flags::fetched_source)
-              {
-                ++stats.fetched_sources;
-                stats.transfer_seconds.push_back(h.fetch_seconds);
-                holders[h.source] |= bit(from);
-              }
-            cancel_limit.erase(h.point);
-            if (static_cast<SolveStatus>(h.status) == SolveStatus::stopped)
-              {
-                // Cancelled (the HIP moved away) or preempted: nothing
-                // learnt.
-                ++(preempted_points.erase(h.point) > 0 ? stats.preempted :
-                                                         stats.cancelled);
-                stats.busy_time += h.duration;
-                break;
-              }
-            const bool converged = h.flags & Flags::converged;
-            if (h.generation != cache.generation())
-              ++stats.discarded;
-            else if (converged)
-              {
-                holders[h.point] |= bit(from);
-                std::array<double, 9> stiffness;
-                std::copy(h.stiffness, h.stiffness + 9, stiffness.begin());
-                cache.publish_force(
-                  h.point,
-                  {{h.force[0], h.force[1], h.force[2]}},
-                  h.generation,
-                  (h.flags & Flags::stiffness) ? &stiffness : nullptr,
-                  (h.flags & Flags::patch) ? patch_of(message) : nullptr);
-                ++stats.computed;
-              }
-            else
-              {
-                // A solve that threw reports "converged" as its status:
-                // count it with the solver's failures.
-                const auto reason = static_cast<SolveStatus>(h.status);
-                cache.publish_failure(h.point,
-                                      h.generation,
-                                      reason == SolveStatus::converged ?
-                                        SolveStatus::linear_solver_failure :
-                                        reason);
-                ++stats.failed;
-              }
-            if (h.flags & Flags::error)
-              {
-                ++stats.errors;
-                stats.last_error = h.text;
-              }
-            stats.busy_time += h.duration;
-            stats.tasks.push_back({h.point,
-                                   h.source,
-                                   start,
-                                   h.duration,
-                                   converged,
-                                   static_cast<SolveStatus>(h.status),
-                                   h.newton_iterations,
-                                   static_cast<unsigned int>(from)});
-            break;
-          }
+          handle_result(from, h, message);
+          break;
         case Kind::state:
           {
             const auto r = requested.find(h.point);
@@ -271,6 +193,94 @@ namespace palpate
           break;
       }
   }
+
+
+
+  void
+  MpiEngine::Impl::handle_result(const int                  from,
+                                 const MpiProtocol::Header &h,
+                                 const std::vector<char>   &message)
+  {
+    Server &server       = servers[from];
+    server.messages_sent = h.messages_sent;
+    server.bytes_sent    = h.bytes_sent;
+    if (server.tasks.empty() || server.tasks.front() != h.point)
+      return; // not what we asked it for (cannot happen)
+    const double start =
+      std::chrono::duration<double>(server.task_start - t0).count();
+    server.tasks.pop_front();
+    server.task_start    = Clock::now(); // the next one starts now
+    in_progress[h.point] = 0;
+    --busy;
+    ++finished;
+    replan = true;
+    if (h.flags & Flags::source_missing)
+      {
+        // The holder dropped it (or died) after the plan: not a
+        // failure point, just plan again without that holder.
+        holders[h.source] &= ~(h.source == origin ? 0 : bit(h.holder));
+        return;
+      }
+    if (h.flags & Flags::fetched_source)
+      {
+        ++stats.fetched_sources;
+        stats.transfer_seconds.push_back(h.fetch_seconds);
+        holders[h.source] |= bit(from);
+      }
+    cancel_limit.erase(h.point);
+    if (static_cast<SolveStatus>(h.status) == SolveStatus::stopped)
+      {
+        // Cancelled (the HIP moved away) or preempted: nothing
+        // learnt.
+        ++(preempted_points.erase(h.point) > 0 ? stats.preempted :
+                                                 stats.cancelled);
+        stats.busy_time += h.duration;
+        return;
+      }
+    const bool converged = h.flags & Flags::converged;
+    if (h.generation != cache.generation())
+      ++stats.discarded;
+    else if (converged)
+      {
+        holders[h.point] |= bit(from);
+        std::array<double, 9> stiffness;
+        std::copy(h.stiffness, h.stiffness + 9, stiffness.begin());
+        cache.publish_force(h.point,
+                            {{h.force[0], h.force[1], h.force[2]}},
+                            h.generation,
+                            (h.flags & Flags::stiffness) ? &stiffness : nullptr,
+                            (h.flags & Flags::patch) ? patch_of(message) :
+                                                       nullptr);
+        ++stats.computed;
+      }
+    else
+      {
+        // A solve that threw reports "converged" as its status:
+        // count it with the solver's failures.
+        const auto reason = static_cast<SolveStatus>(h.status);
+        cache.publish_failure(h.point,
+                              h.generation,
+                              reason == SolveStatus::converged ?
+                                SolveStatus::linear_solver_failure :
+                                reason);
+        ++stats.failed;
+      }
+    if (h.flags & Flags::error)
+      {
+        ++stats.errors;
+        stats.last_error = h.text;
+      }
+    stats.busy_time += h.duration;
+    stats.tasks.push_back({h.point,
+                           h.source,
+                           start,
+                           h.duration,
+                           converged,
+                           static_cast<SolveStatus>(h.status),
+                           h.newton_iterations,
+                           static_cast<unsigned int>(from)});
+  }
+
 
 
   void

@@ -122,78 +122,90 @@ namespace palpate
           }
         if (!schedulable(knowledge(task.target)) || holders[task.source] == 0)
           continue;
-        // Among the places of the least loaded servers (an idle server
-        // never waits while another gets a second task), one whose server
-        // holds the source.
-        const std::size_t depth = servers[free.front()].tasks.size();
-        const auto last = std::find_if(free.begin(), free.end(), [&](int r) {
-          return servers[r].tasks.size() > depth;
-        });
-        // Best of all, one that also holds the state behind the source on
-        // the same grid line: its solve then starts from a second-order
-        // extrapolation (StateSolver::solve with behind).
-        unsigned int  b           = 0;
-        std::uint64_t with_behind = 0;
-        if (grid.behind(task.source, task.target, b))
-          with_behind = holders[b];
-        auto chosen = std::find_if(free.begin(), last, [&](int r) {
-          return (holders[task.source] & with_behind & bit(r)) != 0;
-        });
-        if (chosen == last)
-          chosen = std::find_if(free.begin(), last, [&](int r) {
-            return (holders[task.source] & bit(r)) != 0;
-          });
-        const bool local = chosen != last;
-        if (!local)
-          chosen = free.begin();
-        const int rank   = *chosen;
-        int       holder = rank;
-        if (!local)
-          for (unsigned int r = 1; r < servers.size(); ++r)
-            if ((holders[task.source] & bit(r)) && !servers[r].lost)
-              {
-                holder = r;
-                break;
-              }
-        Header h;
-        h.kind       = Kind::task;
-        h.point      = task.target;
-        h.source     = task.source;
-        h.holder     = holder;
-        h.generation = cache.generation();
-        const auto x = grid.position(task.target);
-        for (unsigned int d = 0; d < 3; ++d)
-          h.position[d] = x[d];
-        if (!messenger.send(rank, pack(h)))
-          {
-            lose(rank, "MPI could not send it a task");
-            free.erase(chosen);
-            continue;
-          }
-        if (local && task.source != origin)
-          ++stats.local_sources;
-        Server &s = servers[rank];
-        if (s.tasks.empty())
-          s.task_start = Clock::now();
-        else if (task.corner)
-          queued_corners.push_back(rank); // behind the task it runs
-        s.tasks.push_back(task.target);
-        in_progress[task.target] = rank;
-        // Cancelled once farther from the predicted path than the cloud
-        // reaches, and than now, each by two grid spacings (as the thread
-        // engine's workers do).
-        cancel_limit[task.target] = {
-          std::max(parameters.scheduler.cloud_radius,
-                   scheduler.distance_to_path(x, position, velocity)) +
-            2 * grid.spacing(),
-          false};
-        ++busy;
-        free.erase(chosen);
+        send_task(task, free, queued_corners, position, velocity);
       }
     preempt_for_path_corners(corners_waiting,
                              queued_corners,
                              position,
                              velocity);
+  }
+
+
+
+  void
+  MpiEngine::Impl::send_task(const Task              &task,
+                             std::vector<int>        &free,
+                             std::vector<int>        &queued_corners,
+                             const Utilities::Point3 &position,
+                             const Utilities::Point3 &velocity)
+  {
+    // Among the places of the least loaded servers (an idle server
+    // never waits while another gets a second task), one whose server
+    // holds the source.
+    const std::size_t depth = servers[free.front()].tasks.size();
+    const auto        last = std::find_if(free.begin(), free.end(), [&](int r) {
+      return servers[r].tasks.size() > depth;
+    });
+    // Best of all, one that also holds the state behind the source on
+    // the same grid line: its solve then starts from a second-order
+    // extrapolation (StateSolver::solve with behind).
+    unsigned int  b           = 0;
+    std::uint64_t with_behind = 0;
+    if (grid.behind(task.source, task.target, b))
+      with_behind = holders[b];
+    auto chosen = std::find_if(free.begin(), last, [&](int r) {
+      return (holders[task.source] & with_behind & bit(r)) != 0;
+    });
+    if (chosen == last)
+      chosen = std::find_if(free.begin(), last, [&](int r) {
+        return (holders[task.source] & bit(r)) != 0;
+      });
+    const bool local = chosen != last;
+    if (!local)
+      chosen = free.begin();
+    const int rank   = *chosen;
+    int       holder = rank;
+    if (!local)
+      for (unsigned int r = 1; r < servers.size(); ++r)
+        if ((holders[task.source] & bit(r)) && !servers[r].lost)
+          {
+            holder = r;
+            break;
+          }
+    Header h;
+    h.kind       = Kind::task;
+    h.point      = task.target;
+    h.source     = task.source;
+    h.holder     = holder;
+    h.generation = cache.generation();
+    const auto x = grid.position(task.target);
+    for (unsigned int d = 0; d < 3; ++d)
+      h.position[d] = x[d];
+    if (!messenger.send(rank, pack(h)))
+      {
+        lose(rank, "MPI could not send it a task");
+        free.erase(chosen);
+        return;
+      }
+    if (local && task.source != origin)
+      ++stats.local_sources;
+    Server &s = servers[rank];
+    if (s.tasks.empty())
+      s.task_start = Clock::now();
+    else if (task.corner)
+      queued_corners.push_back(rank); // behind the task it runs
+    s.tasks.push_back(task.target);
+    in_progress[task.target] = rank;
+    // Cancelled once farther from the predicted path than the cloud
+    // reaches, and than now, each by two grid spacings (as the thread
+    // engine's workers do).
+    cancel_limit[task.target] = {
+      std::max(parameters.scheduler.cloud_radius,
+               scheduler.distance_to_path(x, position, velocity)) +
+        2 * grid.spacing(),
+      false};
+    ++busy;
+    free.erase(chosen);
   }
 
 

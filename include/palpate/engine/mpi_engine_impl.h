@@ -147,8 +147,27 @@ namespace palpate
     void
     handle(const int from, const std::vector<char> &message);
 
+    /** A server's result (Kind::result, header @p h) for the task it was
+     * given first: published to the cache, counted, and the server's next
+     * task started (call with the mutex held). */
+    void
+    handle_result(const int                  from,
+                  const MpiProtocol::Header &h,
+                  const std::vector<char>   &message);
+
     void
     plan_and_dispatch();
+
+    /** Send @p task to one of the @p free servers (taken from them): one
+     * that holds its source if there is one, else the first, told where to
+     * fetch the source; a server with a path corner queued second is added
+     * to @p queued_corners. */
+    void
+    send_task(const Task              &task,
+              std::vector<int>        &free,
+              std::vector<int>        &queued_corners,
+              const Utilities::Point3 &position,
+              const Utilities::Point3 &velocity);
 
     void
     lose(const int rank, const std::string &why);
