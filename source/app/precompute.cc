@@ -176,34 +176,51 @@ namespace palpate
 
 
 
+  namespace
+  {
+    /**
+     * That the scene names a store, and @p radius (unless 0) is within the
+     * state space: the scheduler's cloud then reaches it, and the cache
+     * holds it all (the states are written from it).
+     */
+    void
+    set_region(Scene &scene, const double radius)
+    {
+      auto &p = scene.parameters;
+      if (p.state_space.store.empty())
+        throw scene.error("State space/Store",
+                          "palpate precompute writes the states into the "
+                          "scene's store, and the scene names none",
+                          "set State space / Store = FILE.h5 in the scene.");
+      if (radius > 0)
+        {
+          if (radius > p.state_space.extent)
+            throw InputError("command line",
+                             0,
+                             "--radius " + Utilities::to_string(radius),
+                             "the radius is beyond the state space's extent (" +
+                               Utilities::to_string(p.state_space.extent) +
+                               " m): no grid point is there",
+                             "give a radius of at most State space / Extent, "
+                             "or enlarge the extent.");
+          // The cache must hold the whole region (the states are written
+          // from it): make room for it.
+          p.engine.memory_budget =
+            std::max(p.engine.memory_budget,
+                     p.engine.memory_budget *
+                       std::pow(radius / p.scheduler.cloud_radius, 3));
+          p.scheduler.cloud_radius = radius;
+        }
+    }
+  } // namespace
+
+
+
   int
   run_precompute(std::ostream &out, Scene scene, const double radius)
   {
+    set_region(scene, radius);
     auto &p = scene.parameters;
-    if (p.state_space.store.empty())
-      throw scene.error("State space/Store",
-                        "palpate precompute writes the states into the "
-                        "scene's store, and the scene names none",
-                        "set State space / Store = FILE.h5 in the scene.");
-    if (radius > 0)
-      {
-        if (radius > p.state_space.extent)
-          throw InputError("command line",
-                           0,
-                           "--radius " + Utilities::to_string(radius),
-                           "the radius is beyond the state space's extent (" +
-                             Utilities::to_string(p.state_space.extent) +
-                             " m): no grid point is there",
-                           "give a radius of at most State space / Extent, "
-                           "or enlarge the extent.");
-        // The cache must hold the whole region (the states are written
-        // from it): make room for it.
-        p.engine.memory_budget =
-          std::max(p.engine.memory_budget,
-                   p.engine.memory_budget *
-                     std::pow(radius / p.scheduler.cloud_radius, 3));
-        p.scheduler.cloud_radius = radius;
-      }
     // One writer per store: the lock is taken before the interaction
     // opens the store, and held until what the store kept has been counted
     // and exported, so that no other process writes in between (the

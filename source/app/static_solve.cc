@@ -229,6 +229,40 @@ namespace palpate
 
 
 
+  namespace
+  {
+    /**
+     * What the solve of @p state cost: the factorisation's figures, and
+     * (Output / Print timings) where the time went, summed over the
+     * iterations.
+     */
+    void
+    print_costs(std::ostream                    &out,
+                const Parameters::AllParameters &p,
+                const StateSolver               &solver,
+                const State                     &state)
+    {
+      if (!solver.linear_solver_statistics().empty())
+        out << "  factorisation:  " << solver.linear_solver_statistics()
+            << "\n";
+      // Where the time went, summed over the iterations.
+      double assembly = 0, solve = 0, line_search = 0;
+      for (const auto &h : state.history)
+        assembly += h.assembly_time, solve += h.solve_time,
+          line_search += h.line_search_time;
+      if (p.output.print_timings)
+        out << std::setprecision(3) << "  time:           set-up "
+            << 1000 * solver.setup_time() << " ms; solve "
+            << 1000 * state.wall_time << " ms = assembly " << 1000 * assembly
+            << " + linear solves " << 1000 * solve << " + line search "
+            << 1000 * line_search << " + other "
+            << 1000 * (state.wall_time - assembly - solve - line_search)
+            << " ms\n";
+    }
+  } // namespace
+
+
+
   int
   run_static_solve(std::ostream            &out,
                    const Scene             &scene,
@@ -300,21 +334,7 @@ namespace palpate
     print_newton_history(out, state);
     print_outcome(out, scene, state, stop, reached, reached_at, reached_force);
 
-    if (!solver.linear_solver_statistics().empty())
-      out << "  factorisation:  " << solver.linear_solver_statistics() << "\n";
-    // Where the time went, summed over the iterations.
-    double assembly = 0, solve = 0, line_search = 0;
-    for (const auto &h : state.history)
-      assembly += h.assembly_time, solve += h.solve_time,
-        line_search += h.line_search_time;
-    if (p.output.print_timings)
-      out << std::setprecision(3) << "  time:           set-up "
-          << 1000 * solver.setup_time() << " ms; solve "
-          << 1000 * state.wall_time << " ms = assembly " << 1000 * assembly
-          << " + linear solves " << 1000 * solve << " + line search "
-          << 1000 * line_search << " + other "
-          << 1000 * (state.wall_time - assembly - solve - line_search)
-          << " ms\n";
+    print_costs(out, p, solver, state);
 
     // Effects: only when the scene asks for them.
     if (p.effects.vtu_export || p.effects.force_log)

@@ -300,6 +300,48 @@ namespace palpate
         return Utilities::distance(f, reference) /
                std::max(Utilities::norm(reference), force_floor);
       }
+
+
+
+      /**
+       * How far the shape interpolated on @p grid (the trilinear blend of
+       * the corners' displacement fields, @p g) is from each reference
+       * solve's, at the positions whose cell's corners all converged.
+       */
+      std::vector<double>
+      shape_errors(const StateGrid           &grid,
+                   const GridStates          &g,
+                   const std::vector<Point3> &positions,
+                   const std::vector<Sample> &reference,
+                   const std::vector<int>    &node_of_dof)
+      {
+        std::vector<double> shape;
+        for (std::size_t k = 0; k < positions.size(); ++k)
+          {
+            if (!reference[k].ok)
+              continue;
+            GridIndex             lower;
+            std::array<double, 3> local;
+            if (!grid.locate(positions[k], lower, local))
+              continue;
+            const auto          c = grid.corners(lower);
+            const auto          w = trilinear_weights(local);
+            std::vector<double> u(reference[k].solution.size(), 0.0);
+            bool                complete = true;
+            for (unsigned int j = 0; j < 8 && complete; ++j)
+              {
+                const auto i = g.states.find(c[j]);
+                complete     = i != g.states.end();
+                if (complete)
+                  for (std::size_t d = 0; d < u.size(); ++d)
+                    u[d] += w[j] * i->second->solution[d];
+              }
+            if (complete)
+              shape.push_back(
+                shape_difference(node_of_dof, u, reference[k].solution));
+          }
+        return shape;
+      }
     } // namespace
 
 
@@ -366,31 +408,8 @@ namespace palpate
       const double per_cm = states_per_cm(grid.spacing());
 
       // Shape: trilinear blend of the corners' displacement fields.
-      std::vector<double> shape;
-      for (std::size_t k = 0; k < positions.size(); ++k)
-        {
-          if (!reference[k].ok)
-            continue;
-          GridIndex             lower;
-          std::array<double, 3> local;
-          if (!grid.locate(positions[k], lower, local))
-            continue;
-          const auto          c = grid.corners(lower);
-          const auto          w = trilinear_weights(local);
-          std::vector<double> u(reference[k].solution.size(), 0.0);
-          bool                complete = true;
-          for (unsigned int j = 0; j < 8 && complete; ++j)
-            {
-              const auto i = g.states.find(c[j]);
-              complete     = i != g.states.end();
-              if (complete)
-                for (std::size_t d = 0; d < u.size(); ++d)
-                  u[d] += w[j] * i->second->solution[d];
-            }
-          if (complete)
-            shape.push_back(
-              shape_difference(node_of_dof, u, reference[k].solution));
-        }
+      const std::vector<double> shape =
+        shape_errors(grid, g, positions, reference, node_of_dof);
 
       std::vector<std::pair<Interpolation, bool>> schemes = {
         {Interpolation::trilinear, false}, {Interpolation::hermite, false}};

@@ -202,6 +202,11 @@ namespace palpate
       bool
       handle(const int from, const std::vector<char> &message);
 
+      /** A state this server asked another for (Kind::state), or its
+       * holder's word that it has none (Kind::state_missing). */
+      void
+      take_state(const Header &h, const std::vector<char> &message);
+
       /** Send the solver thread's requests, results and drops; whether
        * there were any. */
       bool
@@ -590,25 +595,8 @@ namespace palpate
             }
           case Kind::state:
           case Kind::state_missing:
-            {
-              std::lock_guard<std::mutex> lock(shared.mutex);
-              if (!shared.requested.erase(h.point))
-                break; // not asked for (any more)
-              if (h.kind == Kind::state)
-                {
-                  if (!shared.store.count(h.point))
-                    {
-                      auto s = std::make_shared<const State>(state_of(message));
-                      shared.bytes += bytes_of(*s);
-                      shared.store[h.point] = std::move(s);
-                    }
-                  shared.transferred.insert(h.point);
-                }
-              else
-                shared.failed.insert(h.point);
-              shared.wake_solver.notify_all();
-              break;
-            }
+            take_state(h, message);
+            break;
           case Kind::peer_lost:
             {
               // Sources asked of the lost server never come: the tasks
@@ -651,6 +639,29 @@ namespace palpate
             break;
         }
       return true;
+    }
+
+
+
+    void
+    SolverServer::take_state(const Header &h, const std::vector<char> &message)
+    {
+      std::lock_guard<std::mutex> lock(shared.mutex);
+      if (!shared.requested.erase(h.point))
+        return; // not asked for (any more)
+      if (h.kind == Kind::state)
+        {
+          if (!shared.store.count(h.point))
+            {
+              auto s = std::make_shared<const State>(state_of(message));
+              shared.bytes += bytes_of(*s);
+              shared.store[h.point] = std::move(s);
+            }
+          shared.transferred.insert(h.point);
+        }
+      else
+        shared.failed.insert(h.point);
+      shared.wake_solver.notify_all();
     }
 
 

@@ -103,6 +103,19 @@ namespace palpate
     void
     worker_loop(const unsigned int worker);
 
+    /** Count the task @p worker finished (started at @p start, its
+     * solution @p result for the cache's @p generation; @p solved: solved
+     * or failed rather than cancelled; @p error: what it threw), and free
+     * its place. */
+    void
+    record_task(const unsigned int  worker,
+                const Task         &task,
+                const State        &result,
+                const bool          solved,
+                const std::string  &error,
+                const double        start,
+                const std::uint64_t generation);
+
     /** @p task's state by @p solver from @p source, the task's source. */
     State
     solve(StateSolver &solver, const Task &task, const State &source);
@@ -455,46 +468,57 @@ namespace palpate
                                   generation,
                                   SolveStatus::linear_solver_failure);
           }
-        const double duration = now() - start;
-
-        {
-          std::lock_guard<std::mutex> lock(mutex);
-          in_progress[task.target] = 0;
-          solving[worker]          = ~0u;
-          --busy;
-          running_since -= start;
-          ++finished;
-          replan = true;
-          if (result.status == SolveStatus::stopped)
-            {
-              ++(preempted[worker].load() ? stats.preempted : stats.cancelled);
-              stats.busy_time += duration;
-            }
-          if (solved)
-            {
-              if (generation != cache.generation())
-                ++stats.discarded;
-              else if (result.converged)
-                ++stats.computed;
-              else
-                ++stats.failed;
-              if (!error.empty())
-                {
-                  ++stats.errors;
-                  stats.last_error = error;
-                }
-              stats.busy_time += duration;
-              stats.tasks.push_back({task.target,
-                                     task.source,
-                                     start,
-                                     duration,
-                                     result.converged,
-                                     result.status,
-                                     result.newton_iterations,
-                                     worker});
-            }
-        }
+        record_task(worker, task, result, solved, error, start, generation);
         work_done.notify_all();
+      }
+  }
+
+
+
+  void
+  ThreadEngine::Impl::record_task(const unsigned int  worker,
+                                  const Task         &task,
+                                  const State        &result,
+                                  const bool          solved,
+                                  const std::string  &error,
+                                  const double        start,
+                                  const std::uint64_t generation)
+  {
+    const double                duration = now() - start;
+    std::lock_guard<std::mutex> lock(mutex);
+    in_progress[task.target] = 0;
+    solving[worker]          = ~0u;
+    --busy;
+    running_since -= start;
+    ++finished;
+    replan = true;
+    if (result.status == SolveStatus::stopped)
+      {
+        ++(preempted[worker].load() ? stats.preempted : stats.cancelled);
+        stats.busy_time += duration;
+      }
+    if (solved)
+      {
+        if (generation != cache.generation())
+          ++stats.discarded;
+        else if (result.converged)
+          ++stats.computed;
+        else
+          ++stats.failed;
+        if (!error.empty())
+          {
+            ++stats.errors;
+            stats.last_error = error;
+          }
+        stats.busy_time += duration;
+        stats.tasks.push_back({task.target,
+                               task.source,
+                               start,
+                               duration,
+                               result.converged,
+                               result.status,
+                               result.newton_iterations,
+                               worker});
       }
   }
 

@@ -375,6 +375,109 @@ namespace palpate
 
 
 
+  namespace
+  {
+    /**
+     * The child's side of mesh_volume(): mesh, report through the pipe
+     * @p channel, leave without running the parent's atexit handlers (MPI,
+     * deal.II). It dies with the parent (@p parent), however the parent
+     * ends.
+     */
+    [[noreturn]] void
+    mesh_in_child_and_exit(const pid_t        parent,
+                           const Surface     &surface,
+                           const unsigned int target_nodes,
+                           const std::string &tmp,
+                           const MeshGrading &grading,
+                           const double       time_limit,
+                           const int          channel[2])
+    {
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent)
+        ::_exit(1);
+      ::close(channel[0]);
+      std::string report;
+      try
+        {
+          report = mesh_in_child(
+            surface, target_nodes, tmp, grading, time_limit, channel[1]);
+        }
+      catch (const std::exception &e)
+        {
+          report = std::string("ERROR ") + e.what();
+        }
+      catch (...)
+        {
+          report = "ERROR Gmsh failed";
+        }
+      std::size_t written = 0;
+      while (written < report.size())
+        {
+          const auto n = ::write(channel[1],
+                                 report.data() + written,
+                                 report.size() - written);
+          if (n <= 0)
+            break;
+          written += n;
+        }
+      ::close(channel[1]);
+      ::_exit(0);
+    }
+
+
+
+    /**
+     * The parent's wait for the meshing child @p child, at most
+     * @p time_limit seconds from @p start: whether it finished (exited)
+     * rather than being killed at the limit. A stop request kills it and
+     * removes its files (@p tmp), then throws StoppedError.
+     */
+    bool
+    wait_for_child(const pid_t             child,
+                   const Clock::time_point start,
+                   const double            time_limit,
+                   const int               from_child,
+                   const std::string      &tmp,
+                   const std::string      &surface_name)
+    {
+      bool finished = false;
+      while (true)
+        {
+          int         status = 0;
+          const pid_t done   = ::waitpid(child, &status, WNOHANG);
+          if (done == child)
+            {
+              finished = WIFEXITED(status);
+              break;
+            }
+          if (std::chrono::duration<double>(Clock::now() - start).count() >
+              time_limit)
+            {
+              ::kill(child, SIGKILL);
+              ::waitpid(child, &status, 0);
+              break;
+            }
+          // Ctrl-C or kill: the child goes, and its files with it (left
+          // alone, it meshes on after palpate has ended and leaves a
+          // temporary file of megabytes behind).
+          if (StopRequest::pending())
+            {
+              ::kill(child, SIGKILL);
+              ::waitpid(child, &status, 0);
+              ::close(from_child);
+              std::error_code ec;
+              std::filesystem::remove(tmp, ec);
+              std::filesystem::remove(tmp + ".pass.msh", ec);
+              throw StoppedError("meshing '" + surface_name + "'");
+            }
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+      return finished;
+    }
+  } // namespace
+
+
+
   VolumeMeshing
   mesh_volume(const Surface     &surface,
               const unsigned int target_nodes,
@@ -396,77 +499,14 @@ namespace palpate
     if (child < 0)
       throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
     if (child == 0)
-      {
-        // The child: mesh, report through the pipe, leave without running
-        // the parent's atexit handlers (MPI, deal.II). It dies with the
-        // parent, however the parent ends.
-        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-        if (::getppid() != parent)
-          ::_exit(1);
-        ::close(channel[0]);
-        std::string report;
-        try
-          {
-            report = mesh_in_child(
-              surface, target_nodes, tmp, grading, time_limit, channel[1]);
-          }
-        catch (const std::exception &e)
-          {
-            report = std::string("ERROR ") + e.what();
-          }
-        catch (...)
-          {
-            report = "ERROR Gmsh failed";
-          }
-        std::size_t written = 0;
-        while (written < report.size())
-          {
-            const auto n = ::write(channel[1],
-                                   report.data() + written,
-                                   report.size() - written);
-            if (n <= 0)
-              break;
-            written += n;
-          }
-        ::close(channel[1]);
-        ::_exit(0);
-      }
+      mesh_in_child_and_exit(
+        parent, surface, target_nodes, tmp, grading, time_limit, channel);
 
     // The parent: wait for the report, at most time_limit seconds.
     ::close(channel[1]);
     std::string report;
-    bool        finished = false;
-    while (true)
-      {
-        int         status = 0;
-        const pid_t done   = ::waitpid(child, &status, WNOHANG);
-        if (done == child)
-          {
-            finished = WIFEXITED(status);
-            break;
-          }
-        if (std::chrono::duration<double>(Clock::now() - start).count() >
-            time_limit)
-          {
-            ::kill(child, SIGKILL);
-            ::waitpid(child, &status, 0);
-            break;
-          }
-        // Ctrl-C or kill: the child goes, and its files with it (left
-        // alone, it meshes on after palpate has ended and leaves a
-        // temporary file of megabytes behind).
-        if (StopRequest::pending())
-          {
-            ::kill(child, SIGKILL);
-            ::waitpid(child, &status, 0);
-            ::close(channel[0]);
-            std::error_code ec;
-            std::filesystem::remove(tmp, ec);
-            std::filesystem::remove(tmp + ".pass.msh", ec);
-            throw StoppedError("meshing '" + surface_name + "'");
-          }
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      }
+    bool        finished =
+      wait_for_child(child, start, time_limit, channel[0], tmp, surface_name);
     {
       char buffer[4096];
       // The pipe holds everything the child wrote (far less than its
@@ -635,113 +675,114 @@ namespace palpate
 
 
 
-  SurfaceMeshReport
-  mesh_surface_file(const std::string &surface_file,
-                    const double       scale,
-                    const std::string &scale_entry,
-                    const unsigned int target_nodes,
-                    const double       time_limit,
-                    const std::string &out_msh,
-                    const MeshGrading &grading)
+  namespace
   {
-    SurfaceMeshReport report;
-    Surface           s = read_surface(surface_file, scale);
-    report.format       = s.format;
-    report.vertices     = s.vertices.size();
-    report.triangles    = s.triangles.size();
-    report.diameter     = s.diameter();
-    report.box          = s.bounding_box();
-    report.area         = s.area();
-    // Coordinates so large that their distances overflow (every one
-    // times 1e300): no vertex is the outlier, and the outlier check below
-    // would name a healthy one.
-    if (!std::isfinite(report.diameter))
-      throw InputError(
-        surface_file,
-        0,
-        scale_entry + " = " + Utilities::to_string(scale, 6),
-        "the surface's coordinates reach " +
-          Utilities::to_string(Utilities::scaled(report.box[1], 1 / scale), 3) +
-          " (file units): the distances between them overflow",
-        "check the file: it is corrupted or in a unit no "
-        "scale factor from 1e-9 to 1e9 can make an organ of.");
-    // One wild vertex (1e308) is not a unit mistake: name it, rather than
-    // advise a scale factor of 0.
-    if (const long far = far_outlier(s.vertices); far >= 0)
-      throw InputError(surface_file,
-                       0,
-                       "vertex " + std::to_string(far + 1),
-                       "the vertex at (" +
-                         Utilities::to_string(
-                           Utilities::scaled(s.vertices[far], 1 / scale), 6) +
-                         ") (file units) lies more than 1000 times farther "
-                         "from the surface's centre than the median vertex: "
-                         "a mistyped or corrupted coordinate",
-                       "correct that vertex in the file, or export the "
-                       "surface again.");
-    // An organ is 2 cm to 1 m across: anything else is a unit mistake.
-    if (const std::string advice = unit_advice(report.diameter, scale);
-        !advice.empty())
-      throw InputError(surface_file,
-                       0,
-                       scale_entry + " = " + Utilities::to_string(scale, 6),
-                       "with this scale factor the body is " +
-                         Utilities::to_string(report.diameter, 3) +
-                         " m across (the diagonal of its bounding box); an "
-                         "organ is 0.02 to 1 m across",
-                       advice + ".");
-    // A refinement centred far from the organ refines nothing, silently
-    // (--refine 100,0,0 beside a 25 cm liver gives the uniform mesh):
-    // the centre must lie within its radius of the bounding box.
-    if (grading.fine_size > 0)
-      {
-        double outside = 0;
-        for (unsigned int d = 0; d < 3; ++d)
-          outside = std::hypot(outside,
-                               std::max({report.box[0][d] - grading.center[d],
-                                         grading.center[d] - report.box[1][d],
-                                         0.0}));
-        if (!(outside <= grading.radius))
-          throw InputError(
-            scale_entry.rfind("--", 0) == 0 ? "command line" : surface_file,
-            0,
-            scale_entry.rfind("--", 0) == 0 ?
-              "--refine " + Utilities::to_string(grading.center, 6) :
-              "Boundary conditions / Active node / Point = " +
-                Utilities::to_string(grading.center, 6) +
-                " (the centre of Mesh / Surface / Refinement)",
-            "the refinement's centre is " + Utilities::to_string(outside, 3) +
-              " m outside the surface's bounding box (" +
-              Utilities::to_string(report.box[0], 3) + " to " +
-              Utilities::to_string(report.box[1], 3) +
-              " m), farther than its radius (" +
-              Utilities::to_string(grading.radius, 3) +
-              " m): it would refine nothing",
-            "give the point where the probe touches, in metres (after "
-            "--scale), e.g. a vertex of the surface.");
-      }
-    report.repairs = repair_surface(s, surface_file);
-    report.volume  = s.volume();
-    // A closed surface that encloses (next to) nothing: a flat or folded
-    // shell. The mesher would try for the whole time limit and then blame
-    // the node count.
-    if (!(std::abs(report.volume) >= 1e-6 * std::pow(report.diameter, 3)))
-      throw InputError(surface_file,
-                       0,
-                       "surface",
-                       "the surface encloses " +
-                         Utilities::to_string(std::abs(report.volume), 3) +
-                         " m^3, nothing next to a body " +
-                         Utilities::to_string(report.diameter, 3) +
-                         " m across: it is flat or folded onto itself",
-                       "export the organ's closed outer surface (a solid, "
-                       "not a sheet).");
-    report.self_intersections =
-      count_self_intersections(s, report.intersection);
-    report.meshing =
-      mesh_volume(s, target_nodes, time_limit, out_msh, surface_file, grading);
-    const MeshData data = read_mesh_file(out_msh);
-    report.quality      = mesh_quality(data.nodes, data.tetrahedra);
+    /**
+     * That the surface @p s, read at @p scale (the entry @p scale_entry
+     * sets it), has sizes an organ has: no overflow, no wild vertex, 2 cm
+     * to 1 m across (@p report: its measures).
+     */
+    void
+    check_surface_size(const Surface           &s,
+                       const SurfaceMeshReport &report,
+                       const std::string       &surface_file,
+                       const double             scale,
+                       const std::string       &scale_entry)
+    {
+      // Coordinates so large that their distances overflow (every one
+      // times 1e300): no vertex is the outlier, and the outlier check below
+      // would name a healthy one.
+      if (!std::isfinite(report.diameter))
+        throw InputError(surface_file,
+                         0,
+                         scale_entry + " = " + Utilities::to_string(scale, 6),
+                         "the surface's coordinates reach " +
+                           Utilities::to_string(
+                             Utilities::scaled(report.box[1], 1 / scale), 3) +
+                           " (file units): the distances between them overflow",
+                         "check the file: it is corrupted or in a unit no "
+                         "scale factor from 1e-9 to 1e9 can make an organ of.");
+      // One wild vertex (1e308) is not a unit mistake: name it, rather than
+      // advise a scale factor of 0.
+      if (const long far = far_outlier(s.vertices); far >= 0)
+        throw InputError(surface_file,
+                         0,
+                         "vertex " + std::to_string(far + 1),
+                         "the vertex at (" +
+                           Utilities::to_string(
+                             Utilities::scaled(s.vertices[far], 1 / scale), 6) +
+                           ") (file units) lies more than 1000 times farther "
+                           "from the surface's centre than the median vertex: "
+                           "a mistyped or corrupted coordinate",
+                         "correct that vertex in the file, or export the "
+                         "surface again.");
+      // An organ is 2 cm to 1 m across: anything else is a unit mistake.
+      if (const std::string advice = unit_advice(report.diameter, scale);
+          !advice.empty())
+        throw InputError(surface_file,
+                         0,
+                         scale_entry + " = " + Utilities::to_string(scale, 6),
+                         "with this scale factor the body is " +
+                           Utilities::to_string(report.diameter, 3) +
+                           " m across (the diagonal of its bounding box); an "
+                           "organ is 0.02 to 1 m across",
+                         advice + ".");
+    }
+
+
+
+    /**
+     * That the refinement @p grading, if there is one, is centred within
+     * its radius of the surface's bounding box @p box.
+     */
+    void
+    check_refinement_centre(const std::array<Utilities::Point3, 2> &box,
+                            const MeshGrading                      &grading,
+                            const std::string &surface_file,
+                            const std::string &scale_entry)
+    {
+      // A refinement centred far from the organ refines nothing, silently
+      // (--refine 100,0,0 beside a 25 cm liver gives the uniform mesh):
+      // the centre must lie within its radius of the bounding box.
+      if (grading.fine_size > 0)
+        {
+          double outside = 0;
+          for (unsigned int d = 0; d < 3; ++d)
+            outside = std::hypot(outside,
+                                 std::max({box[0][d] - grading.center[d],
+                                           grading.center[d] - box[1][d],
+                                           0.0}));
+          if (!(outside <= grading.radius))
+            throw InputError(
+              scale_entry.rfind("--", 0) == 0 ? "command line" : surface_file,
+              0,
+              scale_entry.rfind("--", 0) == 0 ?
+                "--refine " + Utilities::to_string(grading.center, 6) :
+                "Boundary conditions / Active node / Point = " +
+                  Utilities::to_string(grading.center, 6) +
+                  " (the centre of Mesh / Surface / Refinement)",
+              "the refinement's centre is " + Utilities::to_string(outside, 3) +
+                " m outside the surface's bounding box (" +
+                Utilities::to_string(box[0], 3) + " to " +
+                Utilities::to_string(box[1], 3) +
+                " m), farther than its radius (" +
+                Utilities::to_string(grading.radius, 3) +
+                " m): it would refine nothing",
+              "give the point where the probe touches, in metres (after "
+              "--scale), e.g. a vertex of the surface.");
+        }
+    }
+
+
+
+    /**
+     * That the boundary of the volume mesh @p data (written to @p out_msh,
+     * removed if not) does not cross itself.
+     */
+    void
+    check_remeshed_boundary(const MeshData    &data,
+                            const std::string &out_msh,
+                            const std::string &surface_file)
     {
       // The remeshed boundary must not cross itself: a fold larger than
       // the elements survives remeshing, and Gmsh's volume mesh of it
@@ -768,6 +809,52 @@ namespace palpate
             "fewer nodes: a coarser surface smooths small folds away.");
         }
     }
+  } // namespace
+
+
+
+  SurfaceMeshReport
+  mesh_surface_file(const std::string &surface_file,
+                    const double       scale,
+                    const std::string &scale_entry,
+                    const unsigned int target_nodes,
+                    const double       time_limit,
+                    const std::string &out_msh,
+                    const MeshGrading &grading)
+  {
+    SurfaceMeshReport report;
+    Surface           s = read_surface(surface_file, scale);
+    report.format       = s.format;
+    report.vertices     = s.vertices.size();
+    report.triangles    = s.triangles.size();
+    report.diameter     = s.diameter();
+    report.box          = s.bounding_box();
+    report.area         = s.area();
+    check_surface_size(s, report, surface_file, scale, scale_entry);
+    check_refinement_centre(report.box, grading, surface_file, scale_entry);
+    report.repairs = repair_surface(s, surface_file);
+    report.volume  = s.volume();
+    // A closed surface that encloses (next to) nothing: a flat or folded
+    // shell. The mesher would try for the whole time limit and then blame
+    // the node count.
+    if (!(std::abs(report.volume) >= 1e-6 * std::pow(report.diameter, 3)))
+      throw InputError(surface_file,
+                       0,
+                       "surface",
+                       "the surface encloses " +
+                         Utilities::to_string(std::abs(report.volume), 3) +
+                         " m^3, nothing next to a body " +
+                         Utilities::to_string(report.diameter, 3) +
+                         " m across: it is flat or folded onto itself",
+                       "export the organ's closed outer surface (a solid, "
+                       "not a sheet).");
+    report.self_intersections =
+      count_self_intersections(s, report.intersection);
+    report.meshing =
+      mesh_volume(s, target_nodes, time_limit, out_msh, surface_file, grading);
+    const MeshData data = read_mesh_file(out_msh);
+    report.quality      = mesh_quality(data.nodes, data.tetrahedra);
+    check_remeshed_boundary(data, out_msh, surface_file);
     for (const auto &t : data.tetrahedra)
       {
         using namespace Utilities;
