@@ -94,6 +94,9 @@ namespace
     std::string engine;
     /** Part 1's grid step (--step MM; 0: the scene's 5 mm). */
     double step = 0;
+    /** The longest increment after the levers, in part 1 (--increment MM;
+     * 0: as the levers leave it). */
+    double increment = 0;
   };
 
   /** A solver configuration: the scene's settings with some levers. */
@@ -301,6 +304,8 @@ namespace
     /** Contact solver = condensed (--stroke-contact condensed, the
      * default) or in matrix (--stroke-contact matrix). */
     bool condensed = true;
+    /** The longest increment (--increment MM; 0: a grid step). */
+    double increment = 0;
   } stroke_grid;
 
   /** The stroke's settings: the best lever configuration, the engine. */
@@ -316,7 +321,9 @@ namespace
     // Named in the RESULT line, so set either way (the scene's own is
     // Hermite since 2026-11-27).
     p.state_space.interpolation             = stroke_grid.interpolation_name();
-    p.nonlinear_solver.max_increment_length = p.state_space.grid_spacing;
+    p.nonlinear_solver.max_increment_length = stroke_grid.increment > 0 ?
+                                                stroke_grid.increment :
+                                                p.state_space.grid_spacing;
     p.nonlinear_solver.condensed_contact    = stroke_grid.condensed;
     // The accuracy study's residual tolerance (part 1's last lever).
     p.nonlinear_solver.residual_tolerance = 1e-3;
@@ -360,7 +367,8 @@ namespace
         std::ostringstream a;
         a << std::setprecision(17) << "--child " << fine_size << " " << material
           << " " << speed << " " << stroke_grid.spacing << " "
-          << stroke_grid.interpolation << " " << stroke_grid.condensed;
+          << stroke_grid.interpolation << " " << stroke_grid.condensed << " "
+          << stroke_grid.increment;
         const auto v = mpi_child::run(mpi_child::command(3, a.str()));
         Trial      t;
         t.speed           = speed;
@@ -484,6 +492,7 @@ namespace
     stroke_grid.spacing       = std::stod(a[3]);
     stroke_grid.interpolation = std::stoul(a[4]);
     stroke_grid.condensed     = a.size() > 5 && a[5] == "1";
+    stroke_grid.increment     = a.size() > 6 ? std::stod(a[6]) : 0.0;
     if (mpi_rank() > 0)
       {
         const Scene         scene = stroke_scene(fine_size, a[1], "mpi");
@@ -509,7 +518,7 @@ static int
 run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
-  if (argc == 8 && std::string(argv[1]) == "--child")
+  if (argc == 9 && std::string(argv[1]) == "--child")
     return child(std::vector<std::string>(argv + 2, argv + argc));
   Options o;
   for (int i = 1; i < argc; ++i)
@@ -552,6 +561,8 @@ run_benchmark(int argc, char **argv)
         o.csv = argv[++i];
       else if (a == "--step" && i + 1 < argc)
         o.step = 1e-3 * std::stod(argv[++i]);
+      else if (a == "--increment" && i + 1 < argc)
+        o.increment = stroke_grid.increment = 1e-3 * std::stod(argv[++i]);
       else if (a == "--engine" && i + 1 < argc)
         o.engine = argv[++i];
       else if (a == "--interpolation" && i + 1 < argc)
@@ -575,7 +586,7 @@ run_benchmark(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K] [--interpolation NAME] [--step MM] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
+               "[--cores K] [--interpolation NAME] [--step MM] [--increment MM] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
                "[--stroke-contact condensed|matrix]\n";
           return 2;
         }
@@ -672,11 +683,13 @@ run_benchmark(int argc, char **argv)
   };
   const unsigned int amg_lever = levers.size() - 1;
   // Configuration l: every lever up to l.
-  const auto configuration = [&levers](const unsigned int l) {
+  const auto configuration = [&levers, &o](const unsigned int l) {
     Lever c = levers[l];
-    c.apply = [&levers, l](Parameters::AllParameters &p) {
+    c.apply = [&levers, l, &o](Parameters::AllParameters &p) {
       for (unsigned int i = 0; i <= l; ++i)
         levers[i].apply(p);
+      if (o.increment > 0)
+        p.nonlinear_solver.max_increment_length = o.increment;
     };
     for (unsigned int i = 0; i <= l; ++i)
       c.extrapolate = c.extrapolate || levers[i].extrapolate;

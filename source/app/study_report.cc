@@ -309,13 +309,36 @@ namespace palpate
           out << ".\n";
         }
       else
-        out << "  none of the settings keeps the p95 error below "
-            << result.threshold_pct << " % on 95 % of the positions"
-            << (result.discretization_pct >= result.threshold_pct ?
-                  ": the discretisation alone is off by " +
-                    fixed(result.discretization_pct, 2) +
-                    " %; use a finer mesh or element.\n" :
-                  ": use a finer grid or Hermite.\n");
+        {
+          // The most accurate interpolation measured is what a finer grid
+          // should use; the discretisation's share may be what leaves no
+          // room for any.
+          const StudyRow *best = nullptr;
+          for (const auto &row : result.rows)
+            if (row.knob == "grid" && row.samples > 0 &&
+                row.covered >= 0.95 * row.samples &&
+                (best == nullptr || row.err_p95_pct < best->err_p95_pct))
+              best = &row;
+          out << "  none of the settings keeps the p95 error below "
+              << result.threshold_pct << " % on 95 % of the positions";
+          if (result.discretization_pct >= result.threshold_pct)
+            out << ": the discretisation alone is off by "
+                << fixed(result.discretization_pct, 2)
+                << " %; use a finer mesh or element.\n";
+          else if (result.discretization_pct >= 0 && best != nullptr)
+            out << " with the discretisation's " +
+                     fixed(result.discretization_pct, 2) + " %: the best, "
+                << best->interpolation << " at " << best->h_mm
+                << " mm, is off by " << fixed(best->err_p95_pct, 2)
+                << " % itself; use a finer mesh near the probe (Mesh / "
+                   "Surface / Refinement size) or a finer grid with "
+                << best->interpolation << ".\n";
+          else
+            out << ": use a finer grid"
+                << (best != nullptr ? " with " + best->interpolation :
+                                      std::string())
+                << ".\n";
+        }
     }
 
     void
