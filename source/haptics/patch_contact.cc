@@ -17,81 +17,48 @@ namespace palpate
     // far above the round-off of metres.
     constexpr double gap_tolerance = 1e-12;
 
-    /** Cholesky factor L (lower, in place) of the symmetric m x m A, rows
-     * @p ld apart; false if A is not positive definite. */
+    /** Cholesky factor L (lower, in place) of the symmetric m x m A;
+     * false if A is not positive definite. */
     bool
-    cholesky(double *A, const unsigned int m, const unsigned int ld) noexcept
+    cholesky(double *A, const unsigned int m) noexcept
     {
       for (unsigned int j = 0; j < m; ++j)
         {
-          double d = A[j * ld + j];
+          double d = A[j * m + j];
           for (unsigned int k = 0; k < j; ++k)
-            d -= A[j * ld + k] * A[j * ld + k];
+            d -= A[j * m + k] * A[j * m + k];
           if (!(d > 0))
             return false;
-          d             = std::sqrt(d);
-          A[j * ld + j] = d;
+          d            = std::sqrt(d);
+          A[j * m + j] = d;
           for (unsigned int i = j + 1; i < m; ++i)
             {
-              double v = A[i * ld + j];
+              double v = A[i * m + j];
               for (unsigned int k = 0; k < j; ++k)
-                v -= A[i * ld + k] * A[j * ld + k];
-              A[i * ld + j] = v / d;
+                v -= A[i * m + k] * A[j * m + k];
+              A[i * m + j] = v / d;
             }
         }
       return true;
     }
 
-    /** Solve L L^T x = b in place of @p b (L's rows @p ld apart). */
+    /** Solve L L^T x = b in place of @p b. */
     void
-    cholesky_solve(const double      *L,
-                   const unsigned int m,
-                   const unsigned int ld,
-                   double            *b) noexcept
+    cholesky_solve(const double *L, const unsigned int m, double *b) noexcept
     {
       for (unsigned int i = 0; i < m; ++i)
         {
           double v = b[i];
           for (unsigned int k = 0; k < i; ++k)
-            v -= L[i * ld + k] * b[k];
-          b[i] = v / L[i * ld + i];
+            v -= L[i * m + k] * b[k];
+          b[i] = v / L[i * m + i];
         }
       for (int i = int(m) - 1; i >= 0; --i)
         {
           double v = b[i];
           for (unsigned int k = i + 1; k < m; ++k)
-            v -= L[k * ld + i] * b[k];
-          b[i] = v / L[i * ld + i];
-        }
-    }
-
-    /**
-     * The Cholesky factor L (m x m, rows @p ld apart) of A with its row and
-     * column @p p removed, in place: L without row p is lower triangular
-     * but for one entry right of the diagonal in each row from p on, which
-     * Givens rotations of neighbouring columns take out (L Q Q^T L^T is
-     * still the reduced A). O((m - p)^2) where a new factor is O(m^3).
-     */
-    void
-    cholesky_delete(double            *L,
-                    const unsigned int m,
-                    const unsigned int ld,
-                    const unsigned int p) noexcept
-    {
-      for (unsigned int i = p; i + 1 < m; ++i)
-        std::copy(L + (i + 1) * ld, L + (i + 1) * ld + i + 2, L + i * ld);
-      for (unsigned int j = p; j + 1 < m; ++j)
-        {
-          const double a = L[j * ld + j], b = L[j * ld + j + 1];
-          const double r = std::hypot(a, b);
-          const double c = a / r, s = b / r;
-          for (unsigned int i = j; i + 1 < m; ++i)
-            {
-              const double x = L[i * ld + j], y = L[i * ld + j + 1];
-              L[i * ld + j]     = c * x + s * y;
-              L[i * ld + j + 1] = -s * x + c * y;
-            }
-          L[j * ld + j + 1] = 0;
+            v -= L[k * m + i] * b[k];
+          b[i] = v / L[i * m + i];
         }
     }
 
@@ -153,7 +120,6 @@ namespace palpate
         s.lambda.resize(max_nodes);
         s.y.resize(3 * std::size_t(max_nodes));
         s.active.resize(max_nodes);
-        s.in_factor.resize(max_nodes);
         s.index.resize(this->max_active);
         s.LU.resize(std::size_t(this->max_active) * this->max_active);
         s.pivot.resize(this->max_active);
@@ -196,27 +162,23 @@ namespace palpate
   bool
   PatchContact::factorize_active(const ContactPatch &patch, Slot &s) noexcept
   {
-    const unsigned int n = patch.size(), ld = max_active;
+    const unsigned int n = patch.size();
     unsigned int       m = 0;
     for (unsigned int i = 0; i < n; ++i)
-      {
-        s.in_factor[i] = false;
-        if (s.active[i])
-          {
-            if (m == max_active)
-              return false;
-            s.index[m++] = i;
-          }
-      }
+      if (s.active[i])
+        {
+          if (m == max_active)
+            return false;
+          s.index[m++] = i;
+        }
     for (unsigned int a = 0; a < m; ++a)
-      for (unsigned int b = 0; b <= a; ++b)
-        s.LU[a * ld + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
+      for (unsigned int b = 0; b < m; ++b)
+        s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
     s.n_active = m;
     // W is a compliance, symmetric positive definite at a stable state:
-    // Cholesky, half the work of LU, and a factor that the active set's
-    // changes update (update_active()). LU where round-off (or an unstable
+    // Cholesky, half the work of LU. LU where round-off (or an unstable
     // state's tangent) makes the block indefinite.
-    s.cholesky = cholesky(s.LU.data(), m, ld);
+    s.cholesky = cholesky(s.LU.data(), m);
     if (!s.cholesky)
       {
         for (unsigned int a = 0; a < m; ++a)
@@ -226,62 +188,7 @@ namespace palpate
       }
     else
       s.factored = true;
-    if (s.factored)
-      for (unsigned int a = 0; a < m; ++a)
-        s.in_factor[s.index[a]] = true;
     return s.factored;
-  }
-
-
-
-  bool
-  PatchContact::update_active(const ContactPatch &patch, Slot &s) noexcept
-  {
-    if (!s.factored || !s.cholesky)
-      return false;
-    const unsigned int n = patch.size(), ld = max_active;
-    unsigned int       changes = 0, m = s.n_active;
-    for (unsigned int i = 0; i < n; ++i)
-      changes += bool(s.active[i]) != bool(s.in_factor[i]);
-    // An update costs O(m^2) a node, a new factor O(m^3) for all.
-    if (3 * changes > m + 3)
-      return false;
-    // Nodes that left, from the last (the least to rotate), ...
-    for (unsigned int a = m; a-- > 0;)
-      if (!s.active[s.index[a]])
-        {
-          s.in_factor[s.index[a]] = false;
-          cholesky_delete(s.LU.data(), m, ld, a);
-          std::copy(s.index.begin() + a + 1,
-                    s.index.begin() + m,
-                    s.index.begin() + a);
-          --m;
-        }
-    // ... then those that joined, each a new last row: L l = W_Ai,
-    // d^2 = W_ii - l.l.
-    for (unsigned int i = 0; i < n; ++i)
-      if (s.active[i] && !s.in_factor[i])
-        {
-          if (m == max_active)
-            return false;
-          double *row = s.LU.data() + std::size_t(m) * ld;
-          double  d   = patch.W[std::size_t(i) * n + i];
-          for (unsigned int a = 0; a < m; ++a)
-            {
-              double v = patch.W[std::size_t(i) * n + s.index[a]];
-              for (unsigned int k = 0; k < a; ++k)
-                v -= s.LU[std::size_t(a) * ld + k] * row[k];
-              row[a] = v / s.LU[std::size_t(a) * ld + a];
-              d -= row[a] * row[a];
-            }
-          if (!(d > 0))
-            return false;
-          row[m]         = std::sqrt(d);
-          s.index[m++]   = i;
-          s.in_factor[i] = true;
-        }
-    s.n_active = m;
-    return true;
   }
 
 
@@ -290,7 +197,7 @@ namespace palpate
   PatchContact::solve_active(const Slot &s, double *b) const noexcept
   {
     if (s.cholesky)
-      cholesky_solve(s.LU.data(), s.n_active, max_active, b);
+      cholesky_solve(s.LU.data(), s.n_active, b);
     else
       lu_solve(s.LU.data(), s.n_active, s.pivot.data(), b);
   }
@@ -386,7 +293,7 @@ namespace palpate
                 settled     = false;
               }
           }
-        if (!settled && !update_active(patch, s))
+        if (!settled)
           s.factored = false;
       }
 

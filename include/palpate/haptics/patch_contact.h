@@ -120,10 +120,8 @@ namespace palpate
       // The nodes' positions under those forces (3 per node).
       std::vector<double> y;
       std::vector<char>   active;
-      // The active set the factors are of (valid if factored), in the
-      // factors' order, and whether each node is in it.
+      // The active set the factors are of (valid if factored).
       std::vector<unsigned int> index;
-      std::vector<char>         in_factor;
       std::vector<double>       LU;
       std::vector<unsigned int> pivot;
       unsigned int              n_active = 0;
@@ -145,13 +143,6 @@ namespace palpate
      * if it is singular or larger than the work space. */
     bool
     factorize_active(const ContactPatch &patch, Slot &s) noexcept;
-
-    /** The Cholesky factor of @p s brought to its new active set by
-     * removing the nodes that left and appending those that joined; false
-     * (the factor then spoilt) where a new one is due instead: an LU
-     * factor, more changes than a third of the set, or a breakdown. */
-    bool
-    update_active(const ContactPatch &patch, Slot &s) noexcept;
 
     unsigned int                       max_nodes, max_active;
     std::vector<Slot>                  slots;
