@@ -53,6 +53,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -231,9 +232,19 @@ namespace
   {
     std::string body, interpolation;
     double spacing_mm = 0, p95 = 0, max = 0, tick_p999 = 0, states_per_cm = 0;
-    double held_p50 = 0, held_p999 = 0;
+    double held_p50 = 0, held_p999 = 0, cpu_p999 = 0;
     unsigned int samples = 0, uncovered = 0;
   };
+
+  /** The CPU time this thread has used (s): a tick's work without the
+   * time the VM or the scheduler took the core away. */
+  double
+  thread_cpu_seconds()
+  {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+  }
 
   /** Everything measured on one body. */
   void
@@ -431,7 +442,7 @@ namespace
         row.interpolation = "contact_patch";
         row.spacing_mm    = 1e3 * h;
         row.states_per_cm = path_corners.size() / path_cm;
-        std::vector<double> err, tick_us, err_plain;
+        std::vector<double> err, tick_us, err_plain, cpu_us;
         PatchContact        plain_contact(contact.size(), 256);
         Point3              f_plain;
         unsigned int        unsettled = 0;
@@ -451,11 +462,13 @@ namespace
               patches[c] = s->contact_patch.get();
             }
           std::array<double, 9> K;
-          const auto            w = trilinear_weights(local);
+          const auto            w   = trilinear_weights(local);
+          const double          cpu = thread_cpu_seconds();
           const auto            start = std::chrono::steady_clock::now();
           if (!patch_contact.blend(patches, w, x, f, &K))
             ++unsettled;
           tick_us.push_back(1e6 * Utilities::seconds_since(start));
+          cpu_us.push_back(1e6 * (thread_cpu_seconds() - cpu));
           // The corners' forces blended by the trilinear weights alone,
           // without the confidence (a solver of its own: the same warm
           // starts), for comparison.
@@ -513,12 +526,14 @@ namespace
             held_us.assign(tick_us.begin() + settled, tick_us.end());
             tick_us.resize(n_ticks);
           }
+        cpu_us.resize(tick_us.size());
         row.samples   = err.size();
         row.p95       = percentile(err, 0.95);
         row.max       = percentile(err, 1.0);
         row.tick_p999 = percentile(tick_us, 0.999);
         row.held_p50  = percentile(held_us, 0.5);
         row.held_p999 = percentile(held_us, 0.999);
+        row.cpu_p999  = percentile(cpu_us, 0.999);
         rows.push_back(row);
         Row plain           = row;
         plain.interpolation = "patch_plain";
@@ -536,6 +551,10 @@ namespace
                   << percentile(tick_us, 0.999) << " us; held in place: p50 "
                   << row.held_p50 << " us, p999 " << row.held_p999 << " us"
                   << std::endl;
+        std::cout << "  the same ticks' thread CPU time: p50 "
+                  << percentile(cpu_us, 0.5) << " us, p99 "
+                  << percentile(cpu_us, 0.99) << " us, p999 " << row.cpu_p999
+                  << " us" << std::endl;
       }
   }
 
@@ -606,6 +625,8 @@ namespace
                 << (r.interpolation == "contact_patch" ? r.tick_p999 : 0.0)
                 << " held_tick_us_p999="
                 << (r.interpolation == "contact_patch" ? r.held_p999 : 0.0)
+                << " tick_cpu_us_p999="
+                << (r.interpolation == "contact_patch" ? r.cpu_p999 : 0.0)
                 << " states_per_cm=" << r.states_per_cm
                 << " samples=" << r.samples << " uncovered=" << r.uncovered
                 << "\n";
