@@ -306,6 +306,96 @@ namespace palpate
       previous_position = position;
       return true;
     }
+
+    /** force(), a step: forget the contact, the hold and the patches
+     * read, as reset_contact() asked (a new interaction starts). */
+    void
+    apply_reset() noexcept
+    {
+      in_contact     = false;
+      was_complete   = false;
+      previous_cause = MissingCause::none;
+      previous_held  = false;
+      hold.reset();
+      if (patch_section_open)
+        cache.end_patch_reads();
+      patch_section_open = false;
+      last_patches_valid = false;
+    }
+
+    /** force(), a step: the force at @p position interpolated from the 8
+     * corners (with contact patches, solved against them), and the corners
+     * counted as read and used. */
+    ForceSample
+    sample_at(const Utilities::Point3 &position) noexcept
+    {
+      ForceSample sample =
+        interpolate_force(grid, cache, position, interpolation);
+      if (sample.complete && patch_contact)
+        render_contact_patch(position, sample);
+      if (sample.hits > 0 || sample.complete)
+        {
+          corner_reads.fetch_add(8, std::memory_order_relaxed);
+          corner_hits.fetch_add(sample.hits, std::memory_order_relaxed);
+        }
+      if (sample.complete)
+        for (const unsigned int c : sample.corners)
+          used[c].store(1, std::memory_order_relaxed);
+      return sample;
+    }
+
+    /** force(), a step: a tick with data missing for @p cause counted,
+     * held or not (@p held), over @p dt s; a change of cause or hold is a
+     * new event, reported with the (finite or not) @p position. */
+    void
+    count_missing(const MissingCause       cause,
+                  const bool               held,
+                  const Utilities::Point3 &position,
+                  const bool               finite,
+                  const double             dt) noexcept
+    {
+      const unsigned int slot = cause == MissingCause::failure_region ? 0 :
+                                cause == MissingCause::outside        ? 1 :
+                                                                        2;
+      if (cause != previous_cause || held != previous_held)
+        {
+          for (unsigned int d = 0; d < 3; ++d)
+            event_position[d].store(finite ? position[d] : 0.0,
+                                    std::memory_order_relaxed);
+          event_cause.store(static_cast<std::uint8_t>(cause) |
+                              (held ? 0x10 : 0) | (hold.valid() ? 0 : 0x20),
+                            std::memory_order_relaxed);
+          event_stiffness.store(hold.held_stiffness(),
+                                std::memory_order_relaxed);
+          if (held)
+            held_events[slot].fetch_add(1, std::memory_order_release);
+          else
+            missing_events.fetch_add(1, std::memory_order_release);
+        }
+      const auto nanoseconds = static_cast<std::uint64_t>(dt * 1e9);
+      if (held)
+        held_nanoseconds[slot].fetch_add(nanoseconds,
+                                         std::memory_order_relaxed);
+      else
+        missing_nanoseconds.fetch_add(nanoseconds, std::memory_order_relaxed);
+    }
+
+    /** force(), a step: @p target (rendered or faded, @p render) through
+     * the filter, with the largest force and change it made. */
+    Utilities::Point3
+    filtered(const Utilities::Point3 &target, const bool render) noexcept
+    {
+      bool                    rejected;
+      const Utilities::Point3 f = filter.next(target, render, rejected);
+      if (rejected)
+        non_finite.fetch_add(1, std::memory_order_relaxed);
+      if (filter.change() > largest_change.load(std::memory_order_relaxed))
+        largest_change.store(filter.change(), std::memory_order_relaxed);
+      const double magnitude = Utilities::norm(f);
+      if (magnitude > largest_force.load(std::memory_order_relaxed))
+        largest_force.store(magnitude, std::memory_order_relaxed);
+      return f;
+    }
   };
 
 
@@ -406,17 +496,7 @@ namespace palpate
   {
     Impl &s = *impl;
     if (s.reset.exchange(false, std::memory_order_acq_rel))
-      {
-        s.in_contact     = false;
-        s.was_complete   = false;
-        s.previous_cause = MissingCause::none;
-        s.previous_held  = false;
-        s.hold.reset();
-        if (s.patch_section_open)
-          s.cache.end_patch_reads();
-        s.patch_section_open = false;
-        s.last_patches_valid = false;
-      }
+      s.apply_reset();
     // The time since the last call, and the HIP's position and velocity
     // for the scheduler; a non-finite position is treated as "outside":
     // no force.
@@ -428,19 +508,7 @@ namespace palpate
     const bool  attached = s.is_attached.load(std::memory_order_relaxed);
     ForceSample sample;
     if (attached && finite)
-      {
-        sample = interpolate_force(s.grid, s.cache, position, s.interpolation);
-        if (sample.complete && s.patch_contact)
-          s.render_contact_patch(position, sample);
-        if (sample.hits > 0 || sample.complete)
-          {
-            s.corner_reads.fetch_add(8, std::memory_order_relaxed);
-            s.corner_hits.fetch_add(sample.hits, std::memory_order_relaxed);
-          }
-        if (sample.complete)
-          for (const unsigned int c : sample.corners)
-            s.used[c].store(1, std::memory_order_relaxed);
-      }
+      sample = s.sample_at(position);
     const bool complete = sample.complete;
     if (complete)
       {
@@ -506,32 +574,7 @@ namespace palpate
         if (s.patch_contact && s.in_contact && finite &&
             s.render_last_patches(position, target, s.stiffness))
           render = true;
-        const unsigned int slot = cause == MissingCause::failure_region ? 0 :
-                                  cause == MissingCause::outside        ? 1 :
-                                                                          2;
-        if (cause != s.previous_cause || held != s.previous_held)
-          {
-            for (unsigned int d = 0; d < 3; ++d)
-              s.event_position[d].store(finite ? position[d] : 0.0,
-                                        std::memory_order_relaxed);
-            s.event_cause.store(static_cast<std::uint8_t>(cause) |
-                                  (held ? 0x10 : 0) |
-                                  (s.hold.valid() ? 0 : 0x20),
-                                std::memory_order_relaxed);
-            s.event_stiffness.store(s.hold.held_stiffness(),
-                                    std::memory_order_relaxed);
-            if (held)
-              s.held_events[slot].fetch_add(1, std::memory_order_release);
-            else
-              s.missing_events.fetch_add(1, std::memory_order_release);
-          }
-        const auto nanoseconds = static_cast<std::uint64_t>(dt * 1e9);
-        if (held)
-          s.held_nanoseconds[slot].fetch_add(nanoseconds,
-                                             std::memory_order_relaxed);
-        else
-          s.missing_nanoseconds.fetch_add(nanoseconds,
-                                          std::memory_order_relaxed);
+        s.count_missing(cause, held, position, finite, dt);
       }
     s.previous_held  = held;
     s.previous_cause = event ? cause : MissingCause::none;
@@ -541,16 +584,7 @@ namespace palpate
     s.complete.store(complete, std::memory_order_relaxed);
 
     // Never a NaN, never more than the device's limit, never a jump.
-    bool                    rejected;
-    const Utilities::Point3 f = s.filter.next(target, render, rejected);
-    if (rejected)
-      s.non_finite.fetch_add(1, std::memory_order_relaxed);
-    if (s.filter.change() > s.largest_change.load(std::memory_order_relaxed))
-      s.largest_change.store(s.filter.change(), std::memory_order_relaxed);
-    const double magnitude = Utilities::norm(f);
-    if (magnitude > s.largest_force.load(std::memory_order_relaxed))
-      s.largest_force.store(magnitude, std::memory_order_relaxed);
-    return f;
+    return s.filtered(target, render);
   }
 
 
