@@ -101,10 +101,10 @@ namespace palpate
      * d x_j) of the force field at the last force() call's position:
      * the interpolated field's (continuous across cells with tricubic
      * Hermite interpolation), the held spring's where a force is held,
-     * the last patches' where they answer, zero where none is rendered. For a device that renders a local model
-     * f + K (x - x_last) between ticks. Call from the thread that calls
-     * force(); real-time safe. (Not limited like the force: a device that
-     * uses it must apply its own stiffness limit.)
+     * the last patches' where they answer, zero where none is rendered. For a
+     * device that renders a local model f + K (x - x_last) between ticks. Call
+     * from the thread that calls force(); real-time safe. (Not limited like the
+     * force: a device that uses it must apply its own stiffness limit.)
      */
     const std::array<double, 9> &
     stiffness() const noexcept;
