@@ -6,7 +6,8 @@
 
 // Not an interface: StateSolver's implementation, shared by its source
 // files (state_solver.cc: Newton's method and the staging's driver;
-// state_solver_staging.cc: the staging's checks and predictors;
+// state_solver_staging.cc: the staging's checks and predictors, and
+// solve()'s steps around each increment;
 // state_solver_condensed.cc: the condensed contact's Newton steps).
 
 #include <palpate/hyperelastic/anderson_acceleration.h>
