@@ -88,6 +88,34 @@ namespace palpate
     void
     run();
 
+    /** run(), before the first tick: real-time priority, memory locked,
+     * and the force path run once, so that no tick pays for them. */
+    void
+    prepare_realtime() noexcept;
+
+    /** run(): sleep until @p deadline plus one period of @p period_ns,
+     * count the missed deadlines and move @p deadline past those that
+     * passed; returns the wake time (ns) and its lateness @p late (s). */
+    long long
+    wait_for_tick(long long      &deadline,
+                  const long long period_ns,
+                  double         &late) noexcept;
+
+    /** run(): one tick's work in statistics slot @p i, woken at @p wake
+     * (ns, the loop started at @p t0): the device's position, the force
+     * timed, rendered and logged. Returns whether the motion is over. */
+    bool
+    render_tick(const std::size_t i,
+                const long long   wake,
+                const long long   t0) noexcept;
+
+    /** render_tick(): the row (@p t, @p x, @p f) into the force log, or
+     * counted as dropped when the ring is full (never waiting). */
+    void
+    log_force(const double             t,
+              const Utilities::Point3 &x,
+              const Utilities::Point3 &f) noexcept;
+
     /** Whether the loop is to hold (see HapticLoop::hold()); says so. */
     bool
     held() noexcept
@@ -121,7 +149,7 @@ namespace palpate
 
 
   void
-  HapticLoop::Impl::run()
+  HapticLoop::Impl::prepare_realtime() noexcept
   {
     // Real-time priority if the system allows it (root, or CAP_SYS_NICE,
     // or an rtprio limit); otherwise normal priority, and the summary says
@@ -142,6 +170,95 @@ namespace palpate
     }
     if (!held())
       interaction.force(device.position(0));
+  }
+
+
+
+  long long
+  HapticLoop::Impl::wait_for_tick(long long      &deadline,
+                                  const long long period_ns,
+                                  double         &late) noexcept
+  {
+    deadline += period_ns;
+    const timespec next = to_timespec(deadline);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) ==
+           EINTR)
+      {} // a signal: sleep on until the deadline
+    timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const long long wake = nanoseconds(now);
+    late                 = 1e-9 * (wake - deadline);
+    if (late > 0.5e-3)
+      ++misses;
+    // After a stall, no burst of catch-up ticks (each would be allowed
+    // the maximum force change): the deadlines that passed are missed.
+    if (wake - deadline >= period_ns)
+      {
+        const long long passed = (wake - deadline) / period_ns;
+        deadline += passed * period_ns;
+        misses += passed;
+      }
+    return wake;
+  }
+
+
+
+  bool
+  HapticLoop::Impl::render_tick(const std::size_t i,
+                                const long long   wake,
+                                const long long   t0) noexcept
+  {
+    // The device's clock: the motion starts at the first tick after
+    // start_motion().
+    long long start = motion_start_ns.load(std::memory_order_relaxed);
+    if (start < 0 && motion_requested.load(std::memory_order_acquire))
+      {
+        start             = wake - t0;
+        motion_started_at = 1e-9 * start;
+        motion_start_ns.store(start, std::memory_order_release);
+      }
+    const double t            = start < 0 ? 0.0 : 1e-9 * (wake - t0 - start);
+    motion_elapsed            = std::min(t, motion_duration);
+    const Utilities::Point3 x = device.position(t);
+
+    timespec a, b;
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    const Utilities::Point3 f = interaction.force(x);
+    clock_gettime(CLOCK_MONOTONIC, &b);
+    interpolation[i] = 1e-9 * (nanoseconds(b) - nanoseconds(a));
+    device.render(f);
+    if (t > 0 && !log.empty())
+      log_force(t, x, f);
+    ++n;
+
+    return start >= 0 && (device.finished(t) || t > motion_duration);
+  }
+
+
+
+  void
+  HapticLoop::Impl::log_force(const double             t,
+                              const Utilities::Point3 &x,
+                              const Utilities::Point3 &f) noexcept
+  {
+    const std::size_t h = log_head.load(std::memory_order_relaxed);
+    if (h - log_tail.load(std::memory_order_acquire) < log.size())
+      {
+        log[h % log.size()] = {t, x, f};
+        log_head.store(h + 1, std::memory_order_release);
+      }
+    else
+      log_dropped.fetch_add(1, std::memory_order_relaxed);
+  }
+
+
+
+  // The loop at the device's rate: each tick waits for its deadline, then
+  // (unless held) samples the timing and renders the force.
+  void
+  HapticLoop::Impl::run()
+  {
+    prepare_realtime();
 
     const long long period_ns =
       static_cast<long long>(std::llround(1e9 / rate));
@@ -160,25 +277,8 @@ namespace palpate
             truncated = !motion_over;
             break;
           }
-        deadline += period_ns;
-        const timespec next = to_timespec(deadline);
-        while (
-          clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) ==
-          EINTR)
-          {} // a signal: sleep on until the deadline
-        clock_gettime(CLOCK_MONOTONIC, &now);
-        const long long wake = nanoseconds(now);
-        const double    late = 1e-9 * (wake - deadline);
-        if (late > 0.5e-3)
-          ++misses;
-        // After a stall, no burst of catch-up ticks (each would be allowed
-        // the maximum force change): the deadlines that passed are missed.
-        if (wake - deadline >= period_ns)
-          {
-            const long long passed = (wake - deadline) / period_ns;
-            deadline += passed * period_ns;
-            misses += passed;
-          }
+        double          late;
+        const long long wake = wait_for_tick(deadline, period_ns, late);
         // Held (another thread changes the interaction): keep time only.
         // The tick is not sampled (it did no work).
         if (held())
@@ -191,39 +291,7 @@ namespace palpate
         period[i]           = 1e-9 * (wake - previous_wake);
         previous_wake       = wake;
 
-        // The device's clock: the motion starts at the first tick after
-        // start_motion().
-        long long start = motion_start_ns.load(std::memory_order_relaxed);
-        if (start < 0 && motion_requested.load(std::memory_order_acquire))
-          {
-            start             = wake - t0;
-            motion_started_at = 1e-9 * start;
-            motion_start_ns.store(start, std::memory_order_release);
-          }
-        const double t = start < 0 ? 0.0 : 1e-9 * (wake - t0 - start);
-        motion_elapsed = std::min(t, motion_duration);
-        const Utilities::Point3 x = device.position(t);
-
-        timespec a, b;
-        clock_gettime(CLOCK_MONOTONIC, &a);
-        const Utilities::Point3 f = interaction.force(x);
-        clock_gettime(CLOCK_MONOTONIC, &b);
-        interpolation[i] = 1e-9 * (nanoseconds(b) - nanoseconds(a));
-        device.render(f);
-        if (t > 0 && !log.empty())
-          {
-            const std::size_t h = log_head.load(std::memory_order_relaxed);
-            if (h - log_tail.load(std::memory_order_acquire) < log.size())
-              {
-                log[h % log.size()] = {t, x, f};
-                log_head.store(h + 1, std::memory_order_release);
-              }
-            else
-              log_dropped.fetch_add(1, std::memory_order_relaxed);
-          }
-        ++n;
-
-        if (start >= 0 && (device.finished(t) || t > motion_duration))
+        if (render_tick(i, wake, t0))
           {
             motion_over = true;
             break;

@@ -205,28 +205,16 @@ namespace palpate
 
 
   bool
-  PatchContact::force(const ContactPatch      &patch,
-                      const Utilities::Point3 &x,
-                      Utilities::Point3       &force,
-                      std::array<double, 9>   *stiffness) noexcept
+  PatchContact::measure_gaps(const ContactPatch      &patch,
+                             const Utilities::Point3 &x,
+                             const Slot              &s,
+                             unsigned int            &n_loaded) noexcept
   {
-    force = {{0, 0, 0}};
-    if (stiffness)
-      stiffness->fill(0.0);
     const unsigned int n = patch.size();
-    if (n == 0)
-      return true;
-    if (n > max_nodes)
-      return false;
-    Slot &s = slot_of(patch);
-
-    // The gaps at the nodes' current positions, for the sphere's centre at
-    // this HIP, and the directions nu_i of their forces.
-    Utilities::Point3 c;
+    Utilities::Point3  c;
     for (unsigned int a = 0; a < 3; ++a)
       c[a] = patch.center[a] + x[a] - patch.target[a];
-    bool         touching = false;
-    unsigned int n_loaded = 0;
+    bool touching = false;
     for (unsigned int i = 0; i < n; ++i)
       {
         // u_i from the centre to the node, normalised below only for the
@@ -244,11 +232,17 @@ namespace palpate
         if (s.lambda[i] > 0)
           loaded[n_loaded++] = i;
       }
-    // Off the surface and nothing pressed: no force, exactly, for the cost
-    // of the gaps.
-    if (!touching && n_loaded == 0)
-      return true;
+    return touching;
+  }
 
+
+
+  bool
+  PatchContact::solve_contact(const ContactPatch &patch,
+                              Slot               &s,
+                              const unsigned int  n_loaded) noexcept
+  {
+    const unsigned int n = patch.size();
     // The gaps linear in the new forces about the current ones: q = g - W
     // lambda, so that the contact problem is W lambda' + q >= 0 (by rows
     // of W, which is symmetric: contiguous, vectorised).
@@ -297,6 +291,17 @@ namespace palpate
           s.factored = false;
       }
 
+    return settled;
+  }
+
+
+
+  void
+  PatchContact::apply_forces(const ContactPatch &patch,
+                             Slot               &s,
+                             Utilities::Point3  &force) noexcept
+  {
+    const unsigned int n = patch.size();
     for (unsigned int i = 0; i < n; ++i)
       if (s.active[i] || s.lambda[i] > 0)
         for (unsigned int a = 0; a < 3; ++a)
@@ -323,24 +328,63 @@ namespace palpate
                        M);
           }
       }
+  }
+
+
+
+  void
+  PatchContact::add_stiffness(const Slot            &s,
+                              std::array<double, 9> &stiffness) noexcept
+  {
+    const unsigned int m = s.n_active;
+    for (unsigned int b = 0; b < 3; ++b)
+      {
+        double *col = rhs.data() + std::size_t(b) * m;
+        for (unsigned int a = 0; a < m; ++a)
+          col[a] = u[s.index[a]][b];
+        solve_active(s, col);
+      }
+    for (unsigned int a = 0; a < m; ++a)
+      for (unsigned int r = 0; r < 3; ++r)
+        for (unsigned int b = 0; b < 3; ++b)
+          stiffness[3 * r + b] +=
+            u[s.index[a]][r] * rhs[std::size_t(b) * m + a];
+  }
+
+
+
+  bool
+  PatchContact::force(const ContactPatch      &patch,
+                      const Utilities::Point3 &x,
+                      Utilities::Point3       &force,
+                      std::array<double, 9>   *stiffness) noexcept
+  {
+    force = {{0, 0, 0}};
+    if (stiffness)
+      stiffness->fill(0.0);
+    const unsigned int n = patch.size();
+    if (n == 0)
+      return true;
+    if (n > max_nodes)
+      return false;
+    Slot &s = slot_of(patch);
+
+    // The gaps at the nodes' current positions, for the sphere's centre at
+    // this HIP, and the directions nu_i of their forces.
+    unsigned int n_loaded = 0;
+    const bool   touching = measure_gaps(patch, x, s, n_loaded);
+    // Off the surface and nothing pressed: no force, exactly, for the cost
+    // of the gaps.
+    if (!touching && n_loaded == 0)
+      return true;
+
+    const bool settled = solve_contact(patch, s, n_loaded);
+
+    apply_forces(patch, s, force);
 
     // The normal forces' growth as the gaps close, U_A^T W_AA^-1 U_A.
     if (stiffness && settled && s.factored)
-      {
-        const unsigned int m = s.n_active;
-        for (unsigned int b = 0; b < 3; ++b)
-          {
-            double *col = rhs.data() + std::size_t(b) * m;
-            for (unsigned int a = 0; a < m; ++a)
-              col[a] = u[s.index[a]][b];
-            solve_active(s, col);
-          }
-        for (unsigned int a = 0; a < m; ++a)
-          for (unsigned int r = 0; r < 3; ++r)
-            for (unsigned int b = 0; b < 3; ++b)
-              (*stiffness)[3 * r + b] +=
-                u[s.index[a]][r] * rhs[std::size_t(b) * m + a];
-      }
+      add_stiffness(s, *stiffness);
     return settled;
   }
 

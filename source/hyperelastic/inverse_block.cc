@@ -72,31 +72,12 @@ namespace palpate
 
 
 
-  bool
-  InverseBlock::compute(const std::vector<double>       &values,
-                        const std::vector<unsigned int> &unknowns,
-                        std::vector<double>             &inverse)
+  // compute(), a step: MUMPS's order of the unknowns, the METIS order of
+  // the others first and the block's @p unknowns last, in their order.
+  void
+  InverseBlock::order_block_last(const std::vector<unsigned int> &unknowns)
   {
     const unsigned int n = pattern.n_rows, k = unknowns.size();
-    factored = false; // whatever happens, not the old factors
-    inverse.assign(std::size_t(k) * k, 0.0);
-    if (k == 0)
-      return true;
-    if (k >= n)
-      {
-        message_ = "the block is the whole matrix";
-        return false;
-      }
-    for (std::size_t e = 0; e < upper.size(); ++e)
-      entries[e] = static_cast<float>(values[upper[e]]);
-    for (const float v : entries)
-      if (!std::isfinite(v))
-        {
-          message_ = "the matrix has NaN, infinite or (in single precision) "
-                     "too large entries";
-          return false;
-        }
-
     // The METIS order of the other unknowns, then S in its given order
     // (MUMPS wants PERM_IN(LISTVAR_SCHUR(i)) = n - k + i).
     schur_list.resize(k);
@@ -116,9 +97,17 @@ namespace palpate
         permutation[i] = next++;
     for (unsigned int i = 0; i < k; ++i)
       permutation[unknowns[i]] = n - k + 1 + i;
+  }
 
-    terminate(); // the Schur unknowns are fixed at the analysis
-    const auto lock = library.lock();
+
+
+  // compute(), a step: MUMPS's analysis and factorisation with the Schur
+  // complement S_A of the last @p k unknowns (the library's lock held by
+  // the caller); false, with the message, if either fails.
+  bool
+  InverseBlock::factorize_with_schur(const unsigned int k)
+  {
+    const unsigned int n = pattern.n_rows;
     if (!library.initialize(id))
       {
         message_ = "MUMPS could not be initialised, INFOG(1) = " +
@@ -161,7 +150,16 @@ namespace palpate
                        std::to_string(id.infog[0]);
         return false;
       }
+    return true;
+  }
 
+
+
+  // compute(), a step: @p inverse = S_A^-1 (k x k, full) from the Schur
+  // complement; false, with the message, if S_A is not positive definite.
+  bool
+  InverseBlock::invert_schur(const unsigned int k, std::vector<double> &inverse)
+  {
     // (A^-1)_SS = S_A^-1 by LAPACK's Cholesky (S_A is symmetric positive
     // definite for a stable state's compliance) and its inverse: blocked
     // kernels for the k^3 flops, in double.
@@ -185,6 +183,45 @@ namespace palpate
       for (unsigned int r = 0; r <= c; ++r)
         inverse[std::size_t(r) * k + c] = inverse[std::size_t(c) * k + r] =
           schur_inverse[std::size_t(c) * k + r];
+    return true;
+  }
+
+
+
+  bool
+  InverseBlock::compute(const std::vector<double>       &values,
+                        const std::vector<unsigned int> &unknowns,
+                        std::vector<double>             &inverse)
+  {
+    const unsigned int n = pattern.n_rows, k = unknowns.size();
+    factored = false; // whatever happens, not the old factors
+    inverse.assign(std::size_t(k) * k, 0.0);
+    if (k == 0)
+      return true;
+    if (k >= n)
+      {
+        message_ = "the block is the whole matrix";
+        return false;
+      }
+    for (std::size_t e = 0; e < upper.size(); ++e)
+      entries[e] = static_cast<float>(values[upper[e]]);
+    for (const float v : entries)
+      if (!std::isfinite(v))
+        {
+          message_ = "the matrix has NaN, infinite or (in single precision) "
+                     "too large entries";
+          return false;
+        }
+
+    order_block_last(unknowns);
+
+    terminate(); // the Schur unknowns are fixed at the analysis
+    const auto lock = library.lock();
+    if (!factorize_with_schur(k))
+      return false;
+
+    if (!invert_schur(k, inverse))
+      return false;
     block_inverse = inverse;
     factored      = true;
     return true;

@@ -66,6 +66,19 @@ namespace palpate
       return s;
     }
 
+    /** solve()'s path from @p a to @p target at parameter @p t: its end is
+     * the target itself, bit for bit, for the last increment is told apart
+     * by it (patch_factors_due()). */
+    Utilities::Point3
+    path_point(const Utilities::Point3 &a,
+               const Utilities::Point3 &target,
+               const double             t)
+    {
+      return t == 1 ? target :
+                      Utilities::Point3{{a[0] + t * (target[0] - a[0]),
+                                         a[1] + t * (target[1] - a[1]),
+                                         a[2] + t * (target[2] - a[2])}};
+    }
   } // namespace
 
 
@@ -437,6 +450,127 @@ namespace palpate
 
 
 
+  // newton(), a step before the first iteration: factors count as the
+  // state's only if made in its last increment (this Newton solve), those
+  // of an increment before are of another target; nor does Anderson's
+  // history carry over.
+  void
+  StateSolver::Impl::forget_earlier_increments()
+  {
+    factors_of_state    = false;
+    patch_of_state      = false;
+    patch_factors_tried = false;
+    anderson.reset();
+  }
+
+
+
+  // newton(), a step: the outcome of an iteration whose every trial step
+  // inverts an element, with @p record closed as a step of length 0.
+  StateSolver::Impl::Outcome
+  StateSolver::Impl::inverted_step(NewtonIteration   &record,
+                                   State             &state,
+                                   const unsigned int iteration) const
+  {
+    Outcome outcome;
+    record.step_length      = 0;
+    record.correction       = 0;
+    record.residual_after   = record.residual_before;
+    record.constraint_after = system->constraint_violation(residual);
+    state.history.push_back(record);
+    outcome.status     = SolveStatus::inverted_element;
+    outcome.iterations = iteration + 1;
+    outcome.message    = settings.line_search ?
+                           "every step the line search tried inverts an element" :
+                           "the Newton step inverts an element";
+    return outcome;
+  }
+
+
+
+  // newton(), a step: the line search's best trial taken as the iterate,
+  // @p record completed (at force scale @p scale), the multipliers kept
+  // forces; returns the full step's length for converged()'s round-off
+  // test, or -1 if it says nothing.
+  double
+  StateSolver::Impl::accept_step(std::vector<double> &x,
+                                 NewtonIteration     &record,
+                                 State               &state,
+                                 const double         best_alpha,
+                                 const double         scale,
+                                 const bool           condensed_path)
+  {
+    x.swap(best_x);
+    residual.swap(best_residual);
+    record.residual_after   = system->force_residual_norm(residual) / scale;
+    record.constraint_after = system->constraint_violation(residual);
+    record.step_length      = best_alpha;
+    record.correction       = best_alpha * system->max_displacement(step);
+    state.history.push_back(record);
+    // The round-off test of converged() looks at the full Newton step:
+    // a short line-search step says nothing about being close. Nor
+    // does a quasi-Newton step on older factors: it is short while the
+    // residual is still well above the tolerance.
+    const double last_correction = !condensed_path || record.factorized ?
+                                     system->max_displacement(step) :
+                                     -1;
+    // A multiplier the line search left between two forces is still a
+    // force: never negative.
+    if (condensed_path)
+      for (const auto &r : rows)
+        x[r.multiplier_eq] = std::max(0.0, x[r.multiplier_eq]);
+    return last_correction;
+  }
+
+
+
+  // newton(), a step on the condensed path: whether the next iteration
+  // makes new factors, after @p record, and the rate and count of steps on
+  // the kept factors that decide it.
+  void
+  StateSolver::Impl::plan_next_condensed(const NewtonIteration   &record,
+                                         const Utilities::Point3 &target,
+                                         const State             &state,
+                                         bool                    &refactorize,
+                                         double                  &previous_rate,
+                                         unsigned int &steps_on_factors) const
+  {
+    steps_on_factors = record.factorized ? 0 : steps_on_factors + 1;
+    refactorize =
+      worth_refactorizing(record, previous_rate, steps_on_factors) ||
+      patch_factors_due(record.residual_after, target, state);
+    previous_rate =
+      record.factorized ? 0 : record.residual_after / record.residual_before;
+  }
+
+
+
+  // newton(), a step: the residual and tangent at the accepted iterate
+  // @p x for the next iteration; false, with @p outcome saying so, if they
+  // are not finite.
+  bool
+  StateSolver::Impl::reassemble(const std::vector<double> &x,
+                                const Utilities::Point3   &target,
+                                const unsigned int         iteration,
+                                double                    &scale,
+                                double                    &assembly_time,
+                                Outcome                   &outcome)
+  {
+    const auto start   = Clock::now();
+    factorized_current = false;
+    if (!system->assemble(x, target, residual, &matrix, &scale))
+      {
+        outcome.status     = SolveStatus::not_finite;
+        outcome.iterations = iteration + 1;
+        outcome.message = "the tangent cannot be assembled at an accepted step";
+        return false;
+      }
+    assembly_time = seconds_since(start);
+    return true;
+  }
+
+
+
   StateSolver::Impl::Outcome
   StateSolver::Impl::newton(std::vector<double>     &x,
                             const Utilities::Point3 &target,
@@ -471,13 +605,7 @@ namespace palpate
     double       previous_rate    = 0;
     unsigned int steps_on_factors = 0;
     bool         refactorize      = condensed_path && !contact_free_factors;
-    // Factors count as the state's only if made in its last increment
-    // (this Newton solve): those of an increment before are of another
-    // target.
-    factors_of_state    = false;
-    patch_of_state      = false;
-    patch_factors_tried = false;
-    anderson.reset();
+    forget_earlier_increments();
 
     for (unsigned int iteration = 0;; ++iteration)
       {
@@ -509,40 +637,10 @@ namespace palpate
         const auto [best_alpha, best_scale] =
           step_length(x, target, record, condensed_path, iteration);
         if (best_alpha < 0)
-          {
-            record.step_length      = 0;
-            record.correction       = 0;
-            record.residual_after   = record.residual_before;
-            record.constraint_after = system->constraint_violation(residual);
-            state.history.push_back(record);
-            outcome.status     = SolveStatus::inverted_element;
-            outcome.iterations = iteration + 1;
-            outcome.message =
-              settings.line_search ?
-                "every step the line search tried inverts an element" :
-                "the Newton step inverts an element";
-            return outcome;
-          }
-        x.swap(best_x);
-        residual.swap(best_residual);
-        scale                   = best_scale;
-        record.residual_after   = system->force_residual_norm(residual) / scale;
-        record.constraint_after = system->constraint_violation(residual);
-        record.step_length      = best_alpha;
-        record.correction       = best_alpha * system->max_displacement(step);
-        state.history.push_back(record);
-        // The round-off test of converged() looks at the full Newton step:
-        // a short line-search step says nothing about being close. Nor
-        // does a quasi-Newton step on older factors: it is short while the
-        // residual is still well above the tolerance.
-        last_correction = !condensed_path || record.factorized ?
-                            system->max_displacement(step) :
-                            -1;
-        // A multiplier the line search left between two forces is still a
-        // force: never negative.
-        if (condensed_path)
-          for (const auto &r : rows)
-            x[r.multiplier_eq] = std::max(0.0, x[r.multiplier_eq]);
+          return inverted_step(record, state, iteration);
+        scale = best_scale;
+        last_correction =
+          accept_step(x, record, state, best_alpha, scale, condensed_path);
 
         // Stagnation (a start outside the basin, or a line search that
         // gets nowhere): give up this Newton solve early.
@@ -563,27 +661,17 @@ namespace palpate
           }
         if (condensed_path)
           {
-            steps_on_factors = record.factorized ? 0 : steps_on_factors + 1;
-            refactorize =
-              worth_refactorizing(record, previous_rate, steps_on_factors) ||
-              patch_factors_due(record.residual_after, target, state);
-            previous_rate = record.factorized ?
-                              0 :
-                              record.residual_after / record.residual_before;
+            plan_next_condensed(record,
+                                target,
+                                state,
+                                refactorize,
+                                previous_rate,
+                                steps_on_factors);
             assembly_time = 0;
             continue;
           }
-        start              = Clock::now();
-        factorized_current = false;
-        if (!system->assemble(x, target, residual, &matrix, &scale))
-          {
-            outcome.status     = SolveStatus::not_finite;
-            outcome.iterations = iteration + 1;
-            outcome.message =
-              "the tangent cannot be assembled at an accepted step";
-            return outcome;
-          }
-        assembly_time = seconds_since(start);
+        if (!reassemble(x, target, iteration, scale, assembly_time, outcome))
+          return outcome;
       }
   }
 
@@ -725,14 +813,7 @@ namespace palpate
     if (needed > 1000)
       return impl->too_far(x, length, state);
     const unsigned int n = static_cast<unsigned int>(needed);
-    // The path's end is the target itself, bit for bit: the last
-    // increment is told apart by it (patch_factors_due()).
-    const auto point = [&](const double t) {
-      return t == 1 ? target :
-                      Utilities::Point3{{a[0] + t * (target[0] - a[0]),
-                                         a[1] + t * (target[1] - a[1]),
-                                         a[2] + t * (target[2] - a[2])}};
-    };
+    const auto point = [&](const double t) { return path_point(a, target, t); };
 
     // One increment from parameter t0 to t1 of the path, halved up to
     // max_cutbacks times if it fails. After the first increment, Newton
@@ -752,21 +833,13 @@ namespace palpate
     const unsigned int                                work_limit = 2000 + 8 * n;
     std::function<bool(double, double, unsigned int)> increment =
       [&](const double t0, const double t1, const unsigned int depth) {
-        const std::vector<double> saved     = x;
-        bool                      predicted = false;
-        if (!previous.empty() && t0 == current_t && current_t > previous_t)
-          {
-            const double        r     = (t1 - t0) / (current_t - previous_t);
-            std::vector<double> guess = x;
-            for (unsigned int i = 0; i < x.size(); ++i)
-              guess[i] += r * (x[i] - previous[i]);
-            if (impl->system->assemble(
-                  guess, point(t1), impl->residual, nullptr))
-              {
-                x.swap(guess);
-                predicted = true;
-              }
-          }
+        const std::vector<double> saved = x;
+        const bool                predicted =
+          !previous.empty() && t0 == current_t && current_t > previous_t &&
+          impl->secant_predictor(x,
+                                 previous,
+                                 (t1 - t0) / (current_t - previous_t),
+                                 point(t1));
         // All the Newton iterations one solve may take, its increments,
         // cutbacks and retries together: each limit alone is bounded, but
         // 1000 increments, 1000 iterations each and 30 cutbacks together
@@ -780,32 +853,13 @@ namespace palpate
           }
         ++state.increments;
         const bool    may_cut_back = depth < s.max_cutbacks;
-        Impl::Outcome o = impl->newton(x, point(t1), state, may_cut_back);
-        state.newton_iterations += o.iterations;
-        if (o.status != SolveStatus::converged &&
-            o.status != SolveStatus::stopped && predicted)
-          {
-            // The extrapolation can overshoot into an unstable region:
-            // start again from the last equilibrium.
-            x = saved;
-            const Impl::Outcome retry =
-              impl->newton(x, point(t1), state, may_cut_back);
-            state.newton_iterations += retry.iterations;
-            o.iterations += retry.iterations;
-            o.status  = retry.status;
-            o.message = retry.message;
-          }
+        Impl::Outcome o            = impl->solve_increment(
+          x, saved, point(t1), state, may_cut_back, predicted);
         state.max_increment_iterations =
           std::max(state.max_increment_iterations, o.iterations);
         if (o.status == SolveStatus::converged)
           {
-            if (impl->observer)
-              {
-                State at;
-                at.active_displacement = point(t1);
-                impl->system->to_state(x, at);
-                impl->observer(at, t1);
-              }
+            impl->notify_observer(x, point(t1), t1);
             previous   = saved;
             previous_t = t0;
             current_t  = t1;
@@ -830,23 +884,7 @@ namespace palpate
     for (unsigned int i = 1; i <= n && ok && !free; ++i)
       ok = increment(double(i - 1) / n, double(i) / n, 0);
 
-    impl->system->to_state(x, state);
-    if (ok)
-      ok = impl->acceptable_end(x, state, failure);
-    if (!ok)
-      {
-        // A failure point: keep the last equilibrium reached on the way,
-        // but never hand out its force as the target's.
-        state.converged = false;
-        state.status    = failure.status;
-        state.message   = failure.message;
-        state.force     = {{0, 0, 0}};
-      }
-    else
-      {
-        impl->derivatives(state, x);
-        impl->remember_if_free(state, x);
-      }
+    impl->finish(x, ok, failure, state);
     state.wall_time = seconds_since(start);
     return state;
   }

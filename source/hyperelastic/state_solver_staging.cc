@@ -2,8 +2,10 @@
 // Copyright (C) 2026 the palpate authors
 
 // The incremental staging's checks and predictors (StateSolver::Impl): how
-// many increments a path takes, whether a start and an end may be used, and
-// the predictor from the states behind.
+// many increments a path takes, whether a start and an end may be used, the
+// predictor from the states behind, and the steps of solve() around each
+// increment's Newton solve (the secant predictor, the retry from the last
+// equilibrium, the observer, the state at the end).
 
 #include <palpate/hyperelastic/state_solver_impl.h>
 
@@ -268,5 +270,105 @@ namespace palpate
     if (system->has_contact() && free_equilibrium.empty() && state.converged &&
         state.force[0] == 0 && state.force[1] == 0 && state.force[2] == 0)
       free_equilibrium = x;
+  }
+
+
+
+  // solve(), a step: the secant predictor, @p x moved by @p r times its
+  // change since @p previous, taken if the residual at @p end is finite
+  // there (true).
+  bool
+  StateSolver::Impl::secant_predictor(std::vector<double>       &x,
+                                      const std::vector<double> &previous,
+                                      const double               r,
+                                      const Utilities::Point3   &end)
+  {
+    std::vector<double> guess = x;
+    for (unsigned int i = 0; i < x.size(); ++i)
+      guess[i] += r * (x[i] - previous[i]);
+    if (system->assemble(guess, end, residual, nullptr))
+      {
+        x.swap(guess);
+        return true;
+      }
+    return false;
+  }
+
+
+
+  // solve(), a step: Newton's method for one increment's @p end from
+  // @p x, and from the last equilibrium @p saved again if it failed from a
+  // @p predicted start.
+  StateSolver::Impl::Outcome
+  StateSolver::Impl::solve_increment(std::vector<double>       &x,
+                                     const std::vector<double> &saved,
+                                     const Utilities::Point3   &end,
+                                     State                     &state,
+                                     const bool                 may_cut_back,
+                                     const bool                 predicted)
+  {
+    Outcome o = newton(x, end, state, may_cut_back);
+    state.newton_iterations += o.iterations;
+    if (o.status != SolveStatus::converged &&
+        o.status != SolveStatus::stopped && predicted)
+      {
+        // The extrapolation can overshoot into an unstable region:
+        // start again from the last equilibrium.
+        x                   = saved;
+        const Outcome retry = newton(x, end, state, may_cut_back);
+        state.newton_iterations += retry.iterations;
+        o.iterations += retry.iterations;
+        o.status  = retry.status;
+        o.message = retry.message;
+      }
+    return o;
+  }
+
+
+
+  // solve(), a step: the observer (if any) told of the converged
+  // increment's state at @p end, parameter @p t of the path.
+  void
+  StateSolver::Impl::notify_observer(const std::vector<double> &x,
+                                     const Utilities::Point3   &end,
+                                     const double               t) const
+  {
+    if (observer)
+      {
+        State at;
+        at.active_displacement = end;
+        system->to_state(x, at);
+        observer(at, t);
+      }
+  }
+
+
+
+  // solve(), a step: @p state from the unknowns @p x reached; a failure
+  // point (@p failure, or an end not to hand out) unless @p ok, else the
+  // converged state with its derivatives.
+  void
+  StateSolver::Impl::finish(const std::vector<double> &x,
+                            bool                       ok,
+                            Outcome                   &failure,
+                            State                     &state)
+  {
+    system->to_state(x, state);
+    if (ok)
+      ok = acceptable_end(x, state, failure);
+    if (!ok)
+      {
+        // A failure point: keep the last equilibrium reached on the way,
+        // but never hand out its force as the target's.
+        state.converged = false;
+        state.status    = failure.status;
+        state.message   = failure.message;
+        state.force     = {{0, 0, 0}};
+      }
+    else
+      {
+        derivatives(state, x);
+        remember_if_free(state, x);
+      }
   }
 } // namespace palpate

@@ -28,46 +28,14 @@ namespace palpate
             values.push_back(static_cast<T>(std::stol(piece)));
         return values;
       }
-    } // namespace
 
 
 
-    void
-    Mesh::declare_parameters(ParameterHandler &prm)
-    {
-      prm.enter_subsection("Mesh");
+      // Mesh / Beam: the generated beam's size and blocks, a step of
+      // Mesh::declare_parameters() so that each subsection reads alone.
+      void
+      declare_beam_entries(ParameterHandler &prm)
       {
-        prm.declare_entry("Source",
-                          "blob",
-                          Patterns::Selection("file|surface|beam|blob"),
-                          "Where the tetrahedral mesh of the body comes from: "
-                          "a mesh file; an organ's closed surface (File name: "
-                          ".stl, .obj, .ply, .vtk or .vtp), meshed by palpate "
-                          "(see subsection Surface) and kept for the next "
-                          "run; or one of the built-in generators (a "
-                          "rectangular beam, an organ-like blob), which need "
-                          "no external data.");
-        prm.declare_entry(
-          "File name",
-          "",
-          Patterns::FileName(),
-          "Mesh file read when Source = file: Gmsh .msh (format 2.2 or "
-          "v1, ASCII), legacy VTK .vtk (ASCII UNSTRUCTURED_GRID) or "
-          ".vtu (ASCII, or binary inline, appended, raw or zlib-compressed, "
-          "in either byte order). Only linear "
-          "tetrahedra form the body; triangles set boundary ids. With "
-          "Source = surface: the organ's closed surface (.stl, .obj, .ply, "
-          ".vtk POLYDATA, .vtp). A relative path is looked up against the "
-          "scene file's directory first (see 'Relative paths' at the top "
-          "of doc/parameters.md).");
-        prm.declare_entry("Scale factor",
-                          "1",
-                          Patterns::Double(0.),
-                          "Metres per length unit of the mesh file: every "
-                          "coordinate is multiplied by it (m/unit), from "
-                          "1e-9 to 1e6. The generators produce metres and "
-                          "ignore it.");
-
         prm.enter_subsection("Beam");
         {
           prm.declare_entry("Length",
@@ -91,7 +59,15 @@ namespace palpate
                             "block is split into tetrahedra (dimensionless).");
         }
         prm.leave_subsection();
+      }
 
+
+
+      // Mesh / Surface: how an organ's surface is meshed, a step of
+      // Mesh::declare_parameters() so that each subsection reads alone.
+      void
+      declare_surface_entries(ParameterHandler &prm)
+      {
         prm.enter_subsection("Surface");
         {
           prm.declare_entry("Target nodes",
@@ -138,7 +114,15 @@ namespace palpate
             "explores.");
         }
         prm.leave_subsection();
+      }
 
+
+
+      // Mesh / Blob: the generated organ-like body, a step of
+      // Mesh::declare_parameters() so that each subsection reads alone.
+      void
+      declare_blob_entries(ParameterHandler &prm)
+      {
         prm.enter_subsection("Blob");
         {
           prm.declare_entry("Semi-axes",
@@ -157,6 +141,50 @@ namespace palpate
             "(218 on the surface) and 1080 tetrahedra.");
         }
         prm.leave_subsection();
+      }
+    } // namespace
+
+
+
+    void
+    Mesh::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Mesh");
+      {
+        prm.declare_entry("Source",
+                          "blob",
+                          Patterns::Selection("file|surface|beam|blob"),
+                          "Where the tetrahedral mesh of the body comes from: "
+                          "a mesh file; an organ's closed surface (File name: "
+                          ".stl, .obj, .ply, .vtk or .vtp), meshed by palpate "
+                          "(see subsection Surface) and kept for the next "
+                          "run; or one of the built-in generators (a "
+                          "rectangular beam, an organ-like blob), which need "
+                          "no external data.");
+        prm.declare_entry(
+          "File name",
+          "",
+          Patterns::FileName(),
+          "Mesh file read when Source = file: Gmsh .msh (format 2.2 or "
+          "v1, ASCII), legacy VTK .vtk (ASCII UNSTRUCTURED_GRID) or "
+          ".vtu (ASCII, or binary inline, appended, raw or zlib-compressed, "
+          "in either byte order). Only linear "
+          "tetrahedra form the body; triangles set boundary ids. With "
+          "Source = surface: the organ's closed surface (.stl, .obj, .ply, "
+          ".vtk POLYDATA, .vtp). A relative path is looked up against the "
+          "scene file's directory first (see 'Relative paths' at the top "
+          "of doc/parameters.md).");
+        prm.declare_entry("Scale factor",
+                          "1",
+                          Patterns::Double(0.),
+                          "Metres per length unit of the mesh file: every "
+                          "coordinate is multiplied by it (m/unit), from "
+                          "1e-9 to 1e6. The generators produce metres and "
+                          "ignore it.");
+
+        declare_beam_entries(prm);
+        declare_surface_entries(prm);
+        declare_blob_entries(prm);
       }
       prm.leave_subsection();
     }

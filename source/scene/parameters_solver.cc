@@ -335,10 +335,13 @@ namespace palpate
 
 
 
-    void
-    NonlinearSolver::declare_parameters(ParameterHandler &prm)
+    namespace
     {
-      prm.enter_subsection("Nonlinear solver");
+      // Nonlinear solver: the staging of the path and the Newton iteration
+      // (tolerances, line search, cutbacks), a step of
+      // NonlinearSolver::declare_parameters() so that each group reads alone.
+      void
+      declare_newton_entries(ParameterHandler &prm)
       {
         prm.declare_entry("Number of increments",
                           "1",
@@ -401,6 +404,16 @@ namespace palpate
           "smaller steps almost never help there). 0 is the paper's fixed "
           "staging. On the shipped liver, 2 turns a third of the initial "
           "cloud's failure points into states (18 -> 13).");
+      }
+
+
+
+      // Nonlinear solver: how each Newton step's linear system is assembled
+      // and solved (threads, kept factors, the contact's place), a step of
+      // NonlinearSolver::declare_parameters() so that each group reads alone.
+      void
+      declare_linear_step_entries(ParameterHandler &prm)
+      {
         prm.declare_entry("Assembly threads",
                           "1",
                           Patterns::Integer(1),
@@ -460,6 +473,18 @@ namespace palpate
           "that does not reduce the residual is replaced by the plain one. "
           "The states are the same (Residual tolerance); on the shipped liver a "
           "state costs 0.7x (doc/benchmarks/organ-speed.md).");
+      }
+    } // namespace
+
+
+
+    void
+    NonlinearSolver::declare_parameters(ParameterHandler &prm)
+    {
+      prm.enter_subsection("Nonlinear solver");
+      {
+        declare_newton_entries(prm);
+        declare_linear_step_entries(prm);
       }
       prm.leave_subsection();
     }

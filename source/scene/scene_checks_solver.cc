@@ -91,6 +91,99 @@ namespace palpate
 
 
 
+  namespace
+  {
+    // Scene::check_state_space(), a step: the scheduler's cloud, rate and
+    // look-ahead, the entries that decide which states are planned when.
+    void
+    check_scheduler(const Scene &scene)
+    {
+      using namespace Limits;
+      const auto &p = scene.parameters;
+      if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
+        throw scene.error(
+          "Scheduler/Cloud radius",
+          "the cloud cannot hold all 8 corners of the cell the HIP "
+          "is in: it must reach at least sqrt(3) h = " +
+            Utilities::to_string(std::sqrt(3.) * p.state_space.grid_spacing,
+                                 4) +
+            " m",
+          "increase Cloud radius or decrease State space / Grid "
+          "spacing.",
+          {"State space/Grid spacing"});
+      if (!(p.scheduler.rate >= min_scheduler_rate))
+        throw scene.error(
+          "Scheduler/Rate",
+          "at least " + Utilities::to_string(min_scheduler_rate, 3) +
+            " Hz: the scheduler re-plans the cloud around the moving "
+            "HIP on each cycle; slower, the states the hand needs are "
+            "planned seconds late and the force fades",
+          "use 100 Hz (the paper's rate).");
+      if (p.scheduler.cloud_radius > p.state_space.extent)
+        throw scene.error(
+          "Scheduler/Cloud radius",
+          "the cloud reaches beyond the state space (State space / "
+          "Extent = " +
+            Utilities::to_string(p.state_space.extent, 4) +
+            " m): the initial cloud alone would be most of the "
+            "grid's points, and the motion would wait for them",
+          "keep the cloud local: a radius of 4-6 grid spacings (the "
+          "default 0.025 m with 0.005 m spacing); at most Extent.",
+          {"State space/Extent"});
+      // Unbounded, a look-ahead of 1e9 s would centre the cloud where the
+      // HIP would be in 30 years, and the hand would meet missing data.
+      if (p.scheduler.look_ahead_time > 2)
+        throw scene.error(
+          "Scheduler/Look-ahead time",
+          "at most 2 s: the cloud is centred where the HIP would be "
+          "after this time at its current velocity, and a hand keeps "
+          "its velocity for a fraction of a second; farther ahead "
+          "the cloud leaves the HIP and the force fades",
+          "use 0.2 s (the default), or 0 for the paper's cloud "
+          "around the HIP.");
+      if (p.scheduler.rate > max_scheduler_rate)
+        throw scene.error(
+          "Scheduler/Rate",
+          "at most " + Utilities::to_string(max_scheduler_rate, 4) +
+            " Hz: the scheduler re-plans the cloud on each cycle, and "
+            "faster cycles only take time from the solvers",
+          "use 100 Hz (the paper's rate).");
+    }
+
+
+
+    // Scene::check_state_space(), a step: the threads a run asks for against
+    // this machine's cores, the one check that depends on the machine.
+    void
+    check_cores(const Scene &scene)
+    {
+      const auto        &p = scene.parameters;
+      const unsigned int cores =
+        std::max(2u, std::thread::hardware_concurrency());
+      if (p.engine.type == "threads" && p.engine.workers > cores)
+        throw scene.error(
+          "Engine/Workers",
+          "at most " + std::to_string(cores) +
+            " on this machine, its number of cores: each worker is "
+            "a solver thread that needs a core, and more workers "
+            "than cores only take time from the haptic loop",
+          "set Workers to " + std::to_string(cores) +
+            " or less (for more solvers, use several machines: "
+            "Engine / Type = mpi).");
+      if (p.nonlinear_solver.assembly_threads > cores)
+        throw scene.error(
+          "Nonlinear solver/Assembly threads",
+          "at most " + std::to_string(cores) +
+            " on this machine, its number of cores: more threads "
+            "than cores do not assemble faster",
+          "set Assembly threads to 1 (the workers already use the "
+          "cores) or at most " +
+            std::to_string(cores) + ".");
+    }
+  } // namespace
+
+
+
   void
   Scene::check_state_space() const
   {
@@ -136,70 +229,8 @@ namespace palpate
                       "= tricubic Hermite.",
                       {"Boundary conditions/Active node/Tip"});
       }
-    if (p.scheduler.cloud_radius < std::sqrt(3.) * p.state_space.grid_spacing)
-      throw error(
-        "Scheduler/Cloud radius",
-        "the cloud cannot hold all 8 corners of the cell the HIP "
-        "is in: it must reach at least sqrt(3) h = " +
-          Utilities::to_string(std::sqrt(3.) * p.state_space.grid_spacing, 4) +
-          " m",
-        "increase Cloud radius or decrease State space / Grid "
-        "spacing.",
-        {"State space/Grid spacing"});
-    if (!(p.scheduler.rate >= min_scheduler_rate))
-      throw error("Scheduler/Rate",
-                  "at least " + Utilities::to_string(min_scheduler_rate, 3) +
-                    " Hz: the scheduler re-plans the cloud around the moving "
-                    "HIP on each cycle; slower, the states the hand needs are "
-                    "planned seconds late and the force fades",
-                  "use 100 Hz (the paper's rate).");
-    if (p.scheduler.cloud_radius > p.state_space.extent)
-      throw error("Scheduler/Cloud radius",
-                  "the cloud reaches beyond the state space (State space / "
-                  "Extent = " +
-                    Utilities::to_string(p.state_space.extent, 4) +
-                    " m): the initial cloud alone would be most of the "
-                    "grid's points, and the motion would wait for them",
-                  "keep the cloud local: a radius of 4-6 grid spacings (the "
-                  "default 0.025 m with 0.005 m spacing); at most Extent.",
-                  {"State space/Extent"});
-    // Unbounded, a look-ahead of 1e9 s would centre the cloud where the
-    // HIP would be in 30 years, and the hand would meet missing data.
-    if (p.scheduler.look_ahead_time > 2)
-      throw error("Scheduler/Look-ahead time",
-                  "at most 2 s: the cloud is centred where the HIP would be "
-                  "after this time at its current velocity, and a hand keeps "
-                  "its velocity for a fraction of a second; farther ahead "
-                  "the cloud leaves the HIP and the force fades",
-                  "use 0.2 s (the default), or 0 for the paper's cloud "
-                  "around the HIP.");
-    if (p.scheduler.rate > max_scheduler_rate)
-      throw error("Scheduler/Rate",
-                  "at most " + Utilities::to_string(max_scheduler_rate, 4) +
-                    " Hz: the scheduler re-plans the cloud on each cycle, and "
-                    "faster cycles only take time from the solvers",
-                  "use 100 Hz (the paper's rate).");
-    {
-      const unsigned int cores =
-        std::max(2u, std::thread::hardware_concurrency());
-      if (p.engine.type == "threads" && p.engine.workers > cores)
-        throw error("Engine/Workers",
-                    "at most " + std::to_string(cores) +
-                      " on this machine, its number of cores: each worker is "
-                      "a solver thread that needs a core, and more workers "
-                      "than cores only take time from the haptic loop",
-                    "set Workers to " + std::to_string(cores) +
-                      " or less (for more solvers, use several machines: "
-                      "Engine / Type = mpi).");
-      if (p.nonlinear_solver.assembly_threads > cores)
-        throw error("Nonlinear solver/Assembly threads",
-                    "at most " + std::to_string(cores) +
-                      " on this machine, its number of cores: more threads "
-                      "than cores do not assemble faster",
-                    "set Assembly threads to 1 (the workers already use the "
-                    "cores) or at most " +
-                      std::to_string(cores) + ".");
-    }
+    check_scheduler(*this);
+    check_cores(*this);
   }
 
 

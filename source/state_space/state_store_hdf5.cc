@@ -209,80 +209,82 @@ namespace palpate
 
 
 
+  // open(), a step: the mark "open for writing" that a killed writer left
+  // cleared, and the file opened again with @p fapl and @p flags.
   void
-  StateStore::Impl::open()
+  StateStore::Impl::reopen_after_dead_writer(const hid_t        fapl,
+                                             const unsigned int flags)
   {
-    const bool  writing = access == Access::write;
-    const hid_t fapl    = file_access();
-    // A damaged file is damaged on every read: a writer does not retry
-    // (SWMR retries metadata reads 100 times with growing pauses,
-    // minutes). A reader may catch a piece of metadata while the writer
-    // rewrites it, and has its checksum fail: it tries again, a few times.
-    H5Pset_metadata_read_attempts(fapl, writing ? 1 : 12);
-    const unsigned int flags = writing ? H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE :
-                                         H5F_ACC_RDONLY | H5F_ACC_SWMR_READ;
-    h5                       = H5Fopen(file.c_str(), flags, fapl);
-    std::string why          = h5 < 0 ? hdf5_error() : "";
-    std::string system       = h5 < 0 ? hdf5_system_error() : "";
-    if (h5 < 0 && writing && lock)
+    // A writer that was killed leaves the superblock marked "open for
+    // writing", and HDF5 refuses to open it again. We hold the
+    // writer's lock, so no live writer has it open: the mark is a dead
+    // one's. The file itself is consistent (SWMR flushes in order):
+    // clear the mark, as HDF5's h5clear tool does, and open it again.
+    hbool_t     clear = true;
+    const hid_t fix   = H5Pcopy(fapl);
+    if (H5Pset(fix, "clear_status_flags", &clear) >= 0)
       {
-        // A writer that was killed leaves the superblock marked "open for
-        // writing", and HDF5 refuses to open it again. We hold the
-        // writer's lock, so no live writer has it open: the mark is a dead
-        // one's. The file itself is consistent (SWMR flushes in order):
-        // clear the mark, as HDF5's h5clear tool does, and open it again.
-        hbool_t     clear = true;
-        const hid_t fix   = H5Pcopy(fapl);
-        if (H5Pset(fix, "clear_status_flags", &clear) >= 0)
+        const hid_t cleared = H5Fopen(file.c_str(), H5F_ACC_RDWR, fix);
+        if (cleared >= 0)
           {
-            const hid_t cleared = H5Fopen(file.c_str(), H5F_ACC_RDWR, fix);
-            if (cleared >= 0)
-              {
-                // The killed writer's last chunks may lie beyond the end
-                // of allocation its superblock last recorded: HDF5 would
-                // then allocate new space over them, and its writes fail
-                // ("addr overflow"). Move the end of allocation to the
-                // file's end, as `h5clear --increment` does.
-                H5Fincrement_filesize(cleared, 0);
-                H5Fclose(cleared);
-                recovered = true;
-                h5        = H5Fopen(file.c_str(), flags, fapl);
-              }
+            // The killed writer's last chunks may lie beyond the end
+            // of allocation its superblock last recorded: HDF5 would
+            // then allocate new space over them, and its writes fail
+            // ("addr overflow"). Move the end of allocation to the
+            // file's end, as `h5clear --increment` does.
+            H5Fincrement_filesize(cleared, 0);
+            H5Fclose(cleared);
+            recovered = true;
+            h5        = H5Fopen(file.c_str(), flags, fapl);
           }
-        H5Pclose(fix);
       }
-    H5Pclose(fapl);
+    H5Pclose(fix);
+  }
+
+
+
+  // open(), a step: why HDF5 could not open the store, said as a system
+  // error, a file of another program, or damage (HDF5's @p why).
+  void
+  StateStore::Impl::refuse_unopened(const std::string &why,
+                                    const std::string &system) const
+  {
     // A system call that failed (HDF5 found the file checked above and
     // could not read it) is not damage.
-    if (h5 < 0 && !system.empty())
+    if (!system.empty())
       fail("HDF5 cannot open the store: " + system +
              ". The file itself may be fine",
            "check what else has it open and its permissions, then run "
            "again; do not delete it for this.");
-    if (h5 < 0)
+    // HDF5 opens for SWMR only files of the latest format: a file of
+    // another program (older format) fails here, but is not damaged.
+    // Opened plainly, it shows what it is.
+    const hid_t plain = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_file_locking(plain, false, true);
+    const hid_t probe = H5Fopen(file.c_str(), H5F_ACC_RDONLY, plain);
+    H5Pclose(plain);
+    if (probe >= 0)
       {
-        // HDF5 opens for SWMR only files of the latest format: a file of
-        // another program (older format) fails here, but is not damaged.
-        // Opened plainly, it shows what it is.
-        const hid_t plain = H5Pcreate(H5P_FILE_ACCESS);
-        H5Pset_file_locking(plain, false, true);
-        const hid_t probe = H5Fopen(file.c_str(), H5F_ACC_RDONLY, plain);
-        H5Pclose(plain);
-        if (probe >= 0)
-          {
-            const int found = store_datasets(probe);
-            H5Fclose(probe);
-            if (found == 0)
-              not_a_store();
-          }
+        const int found = store_datasets(probe);
+        H5Fclose(probe);
+        if (found == 0)
+          not_a_store();
       }
-    if (h5 < 0)
-      fail("the store is damaged: it is an HDF5 file, but HDF5 cannot "
-           "read its structure (" +
-             (why.empty() ? std::string("no detail") : why) +
-             "); it was truncated or overwritten",
-           "move it away or delete it: palpate then starts a new store "
-           "(the states in it are lost).");
+    fail("the store is damaged: it is an HDF5 file, but HDF5 cannot "
+         "read its structure (" +
+           (why.empty() ? std::string("no detail") : why) +
+           "); it was truncated or overwritten",
+         "move it away or delete it: palpate then starts a new store "
+         "(the states in it are lost).");
+  }
+
+
+
+  // open(), a step: the opened file's datasets checked and opened, with the
+  // record sizes and the rows every dataset holds.
+  void
+  StateStore::Impl::open_datasets()
+  {
     if (store_datasets(h5) == 0)
       not_a_store();
     // A store of the first format (before contact patches were kept) has
@@ -326,6 +328,31 @@ namespace palpate
         rows = std::min(rows, dims[0]);
       }
     first_row = rows;
+  }
+
+
+
+  void
+  StateStore::Impl::open()
+  {
+    const bool  writing = access == Access::write;
+    const hid_t fapl    = file_access();
+    // A damaged file is damaged on every read: a writer does not retry
+    // (SWMR retries metadata reads 100 times with growing pauses,
+    // minutes). A reader may catch a piece of metadata while the writer
+    // rewrites it, and has its checksum fail: it tries again, a few times.
+    H5Pset_metadata_read_attempts(fapl, writing ? 1 : 12);
+    const unsigned int flags = writing ? H5F_ACC_RDWR | H5F_ACC_SWMR_WRITE :
+                                         H5F_ACC_RDONLY | H5F_ACC_SWMR_READ;
+    h5                       = H5Fopen(file.c_str(), flags, fapl);
+    std::string why          = h5 < 0 ? hdf5_error() : "";
+    std::string system       = h5 < 0 ? hdf5_system_error() : "";
+    if (h5 < 0 && writing && lock)
+      reopen_after_dead_writer(fapl, flags);
+    H5Pclose(fapl);
+    if (h5 < 0)
+      refuse_unopened(why, system);
+    open_datasets();
   }
 
 

@@ -28,6 +28,7 @@ namespace palpate
 {
   using internal::acquire_lock;
   using internal::check_store_file;
+  using internal::store_error;
 
 
   // Why a lock file of our own, with flock: HDF5 1.10 locks the file it
@@ -118,14 +119,12 @@ namespace palpate
       return "";
     }
 
-  } // namespace
 
 
-
-  namespace internal
-  {
-    std::shared_ptr<StoreLock::Held>
-    acquire_lock(const std::string &store)
+    // acquire_lock(), a step: the path the lock is taken for, the same for
+    // every name of the store, and the refusal of a store with hard links.
+    std::filesystem::path
+    lock_target(const std::string &store)
     {
       // One lock per store file, whatever name it is given: the lock file
       // sits beside the file symbolic links lead to.
@@ -136,7 +135,6 @@ namespace palpate
       const auto canonical = std::filesystem::weakly_canonical(where, error);
       if (!error)
         where = canonical;
-      const std::string lock_file = where.string() + ".lock";
       // Symbolic links lead to one lock; hard links do not (each name has
       // its own lock file), so two writers through two names would append
       // to the same rows. A store with more than one name is refused.
@@ -151,6 +149,119 @@ namespace palpate
                     "'find / -samefile " +
                       where.string() +
                       "'), or copy the store to a file of its own.");
+      return where;
+    }
+
+
+
+    // acquire_lock(), a step: the lock file opened (made if needed), or the
+    // store refused with what keeps palpate from making it.
+    int
+    open_lock_file(const std::string &store, const std::string &lock_file)
+    {
+      const int fd =
+        open(lock_file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+      if (fd < 0)
+        {
+          const int         e = errno;
+          const std::string dir =
+            std::filesystem::path(lock_file).parent_path().string();
+          if (e == EACCES || e == EPERM || e == EROFS)
+            store_error(store,
+                        "palpate cannot make the lock file '" + lock_file +
+                          "' beside the store (" + std::strerror(e) +
+                          "): a writer takes it so that no other "
+                          "process writes the store at the same time",
+                        "make the directory '" + dir +
+                          "' writable for this user, or name a store in "
+                          "a directory you can write (State space / "
+                          "Store).");
+          store_error(store,
+                      "palpate cannot make the lock file '" + lock_file +
+                        "' beside the store: " + std::strerror(e),
+                      "name a store in a directory that exists and "
+                      "that you can write (State space / Store).");
+        }
+      return fd;
+    }
+
+
+
+    // acquire_lock(), a step: the refusal when the lock file @p fd cannot be
+    // locked (errno @p e): its holder named, or the file system blamed.
+    [[noreturn]] void
+    refuse_lock(const std::string &store,
+                const std::string &lock_file,
+                const int          fd,
+                const int          e)
+    {
+      if (e != EWOULDBLOCK)
+        {
+          close(fd);
+          store_error(store,
+                      "the file system does not lock the file '" + lock_file +
+                        "' (" + std::strerror(e) +
+                        "), and without a lock two processes could "
+                        "write the store at once",
+                      "name a store on a local file system (State "
+                      "space / Store).");
+        }
+      // Somebody holds it: say who, from what it wrote there.
+      std::string text(4096, '\0');
+      const auto  n = pread(fd, text.data(), text.size(), 0);
+      close(fd);
+      text.resize(n > 0 ? n : 0);
+      const std::string pid     = lock_entry(text, "pid");
+      const std::string command = lock_entry(text, "command");
+      const std::string since   = lock_entry(text, "since");
+      const std::string who =
+        pid.empty() ?
+          "another process (its lock file '" + lock_file +
+            "' does not say which yet)" :
+          "process " + pid +
+            (command.empty() ? std::string() : " ('" + command + "')") +
+            (since.empty() ? std::string() : ", since " + since) +
+            ", by its lock file '" + lock_file + "'";
+      store_error(store,
+                  "another process is writing this store: " + who +
+                    ". Two writers would append to the same rows and damage "
+                    "each other's records, so this one does not start",
+                  "wait until it ends, or stop it" +
+                    (pid.empty() ? std::string() : " (kill " + pid + ")") +
+                    ": palpate stops cleanly and keeps every state it "
+                    "stored; or give this run a store of its own (State "
+                    "space / Store = another file).");
+    }
+
+
+
+    // acquire_lock(), a step: the holder's pid, command and start written
+    // into the locked file @p fd, for a process that is refused.
+    void
+    write_holder(const int fd, const std::filesystem::path &where)
+    {
+      // Ours. Say who we are, for a process that is refused (it is
+      // only information: the lock is the flock, not the text).
+      const std::string text = "pid " + std::to_string(getpid()) +
+                               "\ncommand " + command_line() + "\nstore " +
+                               where.string() + "\nsince " + utc_now() + "\n";
+      if (ftruncate(fd, 0) == 0)
+        {
+          const auto written = pwrite(fd, text.data(), text.size(), 0);
+          (void)written;
+        }
+    }
+  } // namespace
+
+
+
+  namespace internal
+  {
+    std::shared_ptr<StoreLock::Held>
+    acquire_lock(const std::string &store)
+    {
+      const std::filesystem::path where     = lock_target(store);
+      const std::string           lock_file = where.string() + ".lock";
 
       std::lock_guard<std::mutex> registry_lock(lock_registry_mutex());
       auto                       &entry = lock_registry()[lock_file];
@@ -161,70 +272,9 @@ namespace palpate
       // it (see ~Held); then the file at the path is a new one.
       for (unsigned int round = 0; round < 20; ++round)
         {
-          const int fd =
-            open(lock_file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-          if (fd < 0)
-            {
-              const int         e = errno;
-              const std::string dir =
-                std::filesystem::path(lock_file).parent_path().string();
-              if (e == EACCES || e == EPERM || e == EROFS)
-                store_error(store,
-                            "palpate cannot make the lock file '" + lock_file +
-                              "' beside the store (" + std::strerror(e) +
-                              "): a writer takes it so that no other "
-                              "process writes the store at the same time",
-                            "make the directory '" + dir +
-                              "' writable for this user, or name a store in "
-                              "a directory you can write (State space / "
-                              "Store).");
-              store_error(store,
-                          "palpate cannot make the lock file '" + lock_file +
-                            "' beside the store: " + std::strerror(e),
-                          "name a store in a directory that exists and "
-                          "that you can write (State space / Store).");
-            }
+          const int fd = open_lock_file(store, lock_file);
           if (flock(fd, LOCK_EX | LOCK_NB) != 0)
-            {
-              const int e = errno;
-              if (e != EWOULDBLOCK)
-                {
-                  close(fd);
-                  store_error(store,
-                              "the file system does not lock the file '" +
-                                lock_file + "' (" + std::strerror(e) +
-                                "), and without a lock two processes could "
-                                "write the store at once",
-                              "name a store on a local file system (State "
-                              "space / Store).");
-                }
-              // Somebody holds it: say who, from what it wrote there.
-              std::string text(4096, '\0');
-              const auto  n = pread(fd, text.data(), text.size(), 0);
-              close(fd);
-              text.resize(n > 0 ? n : 0);
-              const std::string pid     = lock_entry(text, "pid");
-              const std::string command = lock_entry(text, "command");
-              const std::string since   = lock_entry(text, "since");
-              const std::string who =
-                pid.empty() ?
-                  "another process (its lock file '" + lock_file +
-                    "' does not say which yet)" :
-                  "process " + pid +
-                    (command.empty() ? std::string() : " ('" + command + "')") +
-                    (since.empty() ? std::string() : ", since " + since) +
-                    ", by its lock file '" + lock_file + "'";
-              store_error(
-                store,
-                "another process is writing this store: " + who +
-                  ". Two writers would append to the same rows and damage "
-                  "each other's records, so this one does not start",
-                "wait until it ends, or stop it" +
-                  (pid.empty() ? std::string() : " (kill " + pid + ")") +
-                  ": palpate stops cleanly and keeps every state it "
-                  "stored; or give this run a store of its own (State "
-                  "space / Store = another file).");
-            }
+            refuse_lock(store, lock_file, fd, errno);
           struct stat locked, at_path;
           if (fstat(fd, &locked) != 0 ||
               stat(lock_file.c_str(), &at_path) != 0 ||
@@ -234,16 +284,7 @@ namespace palpate
               close(fd);
               continue;
             }
-          // Ours. Say who we are, for a process that is refused (it is
-          // only information: the lock is the flock, not the text).
-          const std::string text =
-            "pid " + std::to_string(getpid()) + "\ncommand " + command_line() +
-            "\nstore " + where.string() + "\nsince " + utc_now() + "\n";
-          if (ftruncate(fd, 0) == 0)
-            {
-              const auto written = pwrite(fd, text.data(), text.size(), 0);
-              (void)written;
-            }
+          write_holder(fd, where);
           auto held       = std::make_shared<StoreLock::Held>();
           held->store     = store;
           held->lock_file = lock_file;

@@ -253,6 +253,41 @@ namespace palpate
 
 
 
+  // append(), a step: the datasets made again with the record sizes the
+  // first converged state fixes, the fingerprint kept.
+  void
+  StateStore::Impl::make_record_datasets(const hsize_t n_sol,
+                                         const hsize_t n_mult)
+  {
+    // The first state fixes the record sizes: make the datasets again
+    // with them (no row is in the file yet).
+    StoreFingerprint keep;
+    for (const char *const field : {"mesh",
+                                    "material",
+                                    "fixed nodes",
+                                    "active node",
+                                    "element",
+                                    "grid",
+                                    "tolerances",
+                                    "load effects",
+                                    "contact patches",
+                                    "palpate version"})
+      keep.fields.emplace_back(field, attribute(field));
+    close_file();
+    try
+      {
+        create(keep, n_sol, n_mult);
+      }
+    catch (const WriteFailure &f)
+      {
+        first_row_before_stop = 0;
+        stop(f.reason);
+      }
+    first_row_before_stop = first_row;
+  }
+
+
+
   void
   StateStore::append(const unsigned int point, const State &state)
   {
@@ -295,33 +330,7 @@ namespace palpate
       }
     s.first_row_before_stop = s.first_row;
     if (s.rows == 0 && s.n_solution == 0 && state.converged)
-      {
-        // The first state fixes the record sizes: make the datasets again
-        // with them (no row is in the file yet).
-        StoreFingerprint keep;
-        for (const char *const field : {"mesh",
-                                        "material",
-                                        "fixed nodes",
-                                        "active node",
-                                        "element",
-                                        "grid",
-                                        "tolerances",
-                                        "load effects",
-                                        "contact patches",
-                                        "palpate version"})
-          keep.fields.emplace_back(field, s.attribute(field));
-        s.close_file();
-        try
-          {
-            s.create(keep, state.solution.size(), state.multipliers.size());
-          }
-        catch (const WriteFailure &f)
-          {
-            s.first_row_before_stop = 0;
-            s.stop(f.reason);
-          }
-        s.first_row_before_stop = s.first_row;
-      }
+      s.make_record_datasets(state.solution.size(), state.multipliers.size());
     r.solution.resize(s.n_solution, 0.0);
     r.multipliers.resize(s.n_multipliers, 0.0);
     if (state.converged && patch != nullptr)

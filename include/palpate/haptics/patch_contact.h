@@ -144,6 +144,37 @@ namespace palpate
     bool
     factorize_active(const ContactPatch &patch, Slot &s) noexcept;
 
+    /** force(), a step: the gaps q of @p patch's nodes (their positions in
+     * @p s) to the sphere at the HIP @p x, the directions u to them (not
+     * yet normalised) and the @p n_loaded nodes that carry a force; true
+     * if any gap is closed. */
+    bool
+    measure_gaps(const ContactPatch      &patch,
+                 const Utilities::Point3 &x,
+                 const Slot              &s,
+                 unsigned int            &n_loaded) noexcept;
+
+    /** force(), a step: the contact problem W lambda + q >= 0 solved by
+     * the primal-dual active set, warm-started from @p s; true if the set
+     * settled within max_iterations. */
+    bool
+    solve_contact(const ContactPatch &patch,
+                  Slot               &s,
+                  const unsigned int  n_loaded) noexcept;
+
+    /** force(), a step: the nodes' forces summed into @p force, and the
+     * nodes of @p s moved by them for the next tick (y = x_free + H f). */
+    void
+    apply_forces(const ContactPatch &patch,
+                 Slot               &s,
+                 Utilities::Point3  &force) noexcept;
+
+    /** force(), a step: the normal forces' growth as the gaps close,
+     * U_A^T W_AA^-1 U_A on the settled active set of @p s, added to
+     * @p stiffness. */
+    void
+    add_stiffness(const Slot &s, std::array<double, 9> &stiffness) noexcept;
+
     unsigned int                       max_nodes, max_active;
     std::vector<Slot>                  slots;
     std::uint64_t                      clock = 0;

@@ -74,6 +74,22 @@ namespace palpate
     void
     terminate();
 
+    /** compute(): MUMPS's order of the unknowns, in permutation and
+     * schur_list: the METIS order of the others, then @p unknowns. */
+    void
+    order_block_last(const std::vector<unsigned int> &unknowns);
+
+    /** compute(): MUMPS's analysis and factorisation with the Schur
+     * complement of the last @p k unknowns, with the library's lock held;
+     * false (message() says why) if either fails. */
+    bool
+    factorize_with_schur(const unsigned int k);
+
+    /** compute(): the k x k @p inverse of the Schur complement, by
+     * LAPACK's Cholesky; false (message() says why) if it has none. */
+    bool
+    invert_schur(const unsigned int k, std::vector<double> &inverse);
+
     const SparsityCSR       &pattern;
     MumpsLibrary::Lease      library;
     SMUMPS_STRUC_C           id          = {};

@@ -6,7 +6,8 @@
 
 // Not an interface: StateSolver's implementation, shared by its source
 // files (state_solver.cc: Newton's method and the staging's driver;
-// state_solver_staging.cc: the staging's checks and predictors;
+// state_solver_staging.cc: the staging's checks and predictors, and
+// solve()'s steps around each increment;
 // state_solver_condensed.cc: the condensed contact's Newton steps).
 
 #include <palpate/hyperelastic/anderson_acceleration.h>
@@ -126,6 +127,91 @@ namespace palpate
            const Utilities::Point3 &target,
            State                   &state,
            const bool               may_cut_back = false);
+
+    // newton()'s steps.
+    /** Before the first iteration: the factors and the contact patch of
+     * an earlier increment (another target) no longer count as the
+     * state's, and Anderson's history restarts. */
+    void
+    forget_earlier_increments();
+
+    /** The outcome of Newton iteration @p iteration whose every trial
+     * step inverts an element; @p record closed and added to @p state. */
+    Outcome
+    inverted_step(NewtonIteration   &record,
+                  State             &state,
+                  const unsigned int iteration) const;
+
+    /** Take the line search's best trial (step length @p best_alpha) as
+     * the iterate @p x, complete @p record at force scale @p scale and add
+     * it to @p state; returns the full step's length for converged(), or
+     * -1 if it says nothing of being close. */
+    double
+    accept_step(std::vector<double> &x,
+                NewtonIteration     &record,
+                State               &state,
+                const double         best_alpha,
+                const double         scale,
+                const bool           condensed_path);
+
+    /** On the condensed path after @p record: whether the next iteration
+     * is to @p refactorize, with @p previous_rate and @p steps_on_factors
+     * brought up to date. */
+    void
+    plan_next_condensed(const NewtonIteration   &record,
+                        const Utilities::Point3 &target,
+                        const State             &state,
+                        bool                    &refactorize,
+                        double                  &previous_rate,
+                        unsigned int            &steps_on_factors) const;
+
+    /** Assemble the residual and tangent at the accepted iterate @p x
+     * (its force scale into @p scale, the time into @p assembly_time);
+     * false, @p outcome saying so, if they are not finite. */
+    bool
+    reassemble(const std::vector<double> &x,
+               const Utilities::Point3   &target,
+               const unsigned int         iteration,
+               double                    &scale,
+               double                    &assembly_time,
+               Outcome                   &outcome);
+
+    // solve()'s steps.
+    /** The secant predictor: @p x plus @p r times its change since
+     * @p previous, if the residual there (at the increment's @p end) is
+     * finite; whether @p x was moved. */
+    bool
+    secant_predictor(std::vector<double>       &x,
+                     const std::vector<double> &previous,
+                     const double               r,
+                     const Utilities::Point3   &end);
+
+    /** Newton's method for an increment's @p end from @p x, retried from
+     * the last equilibrium @p saved if a @p predicted start failed; its
+     * iterations are counted in @p state. */
+    Outcome
+    solve_increment(std::vector<double>       &x,
+                    const std::vector<double> &saved,
+                    const Utilities::Point3   &end,
+                    State                     &state,
+                    const bool                 may_cut_back,
+                    const bool                 predicted);
+
+    /** Tell the increment observer, if any, of the converged state @p x
+     * at @p end, parameter @p t of the path. */
+    void
+    notify_observer(const std::vector<double> &x,
+                    const Utilities::Point3   &end,
+                    const double               t) const;
+
+    /** @p state from the unknowns @p x a solve reached: a failure point
+     * (@p failure says why) unless @p ok and the end is acceptable, else
+     * converged, with its derivatives. */
+    void
+    finish(const std::vector<double> &x,
+           bool                       ok,
+           Outcome                   &failure,
+           State                     &state);
 
     /**
      * The Newton step of Contact solver = condensed into `step` (from

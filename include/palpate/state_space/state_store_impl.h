@@ -304,6 +304,23 @@ namespace palpate
     void
     open();
 
+    /** open(): clear the mark "open for writing" that a killed writer left,
+     * and open the file again with @p fapl and @p flags (h5 >= 0 if that
+     * worked). */
+    void
+    reopen_after_dead_writer(const hid_t fapl, const unsigned int flags);
+
+    /** open(): refuse the store HDF5 could not open: InputError saying a
+     * system call failed (@p system), the file is not a store, or it is
+     * damaged (HDF5's words: @p why). */
+    [[noreturn]] void
+    refuse_unopened(const std::string &why, const std::string &system) const;
+
+    /** open(): open the datasets of the opened file, and read the record
+     * sizes and the rows every dataset holds. */
+    void
+    open_datasets();
+
     /** The fingerprint's field @p name as the store recorded it, or "(not
      * recorded)"; InputError if HDF5 cannot read it. */
     std::string
@@ -362,6 +379,12 @@ namespace palpate
      */
     [[noreturn]] void
     stop(std::string reason);
+
+    /** append(): the first converged state fixes the record sizes: close
+     * the file and make the datasets again with @p n_sol and @p n_mult,
+     * keeping the fingerprint (no row is in the file yet). */
+    void
+    make_record_datasets(const hsize_t n_sol, const hsize_t n_mult);
 
     // The first row of this object's records when the write failed (open()
     // in stop() moves first_row to the end).
