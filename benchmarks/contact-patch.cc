@@ -76,6 +76,9 @@ namespace
     bool                     quick = false, verbose = false;
     std::vector<std::string> bodies   = {"liver", "blob"};
     std::vector<double>      spacings = {0.005, 0.01, 0.02};
+    /** The grid states' Nonlinear solver / patch_factor_residual
+     * (--patch-residual R; 0: the scene's). */
+    double patch_residual = 0;
   };
 
   Point3
@@ -310,6 +313,8 @@ namespace
         auto p                               = scene.parameters;
         p.state_space.grid_spacing           = h;
         p.nonlinear_solver.compute_stiffness = true;
+        if (o.patch_residual > 0)
+          p.nonlinear_solver.patch_factor_residual = o.patch_residual;
         StateSolver     solver(mesh, nodes, p);
         const StateGrid grid(h, std::max(p.state_space.extent, 0.03));
         StateCache      cache(grid, std::size_t(1) << 36);
@@ -576,6 +581,8 @@ namespace
             o.bodies = b == "all" ? std::vector<std::string>{"liver", "blob"} :
                                     std::vector<std::string>{b};
           }
+        else if (a == "--patch-residual" && i + 1 < argc)
+          o.patch_residual = std::stod(argv[++i]);
         else if (a == "--spacing" && i + 1 < argc)
           {
             o.spacings.clear();
@@ -585,7 +592,8 @@ namespace
         else
           {
             std::cerr << "usage: benchmarks/run contact-patch [--quick] "
-                         "[--body liver|blob|all] [--spacing 5,10,20]\n";
+                         "[--body liver|blob|all] [--spacing 5,10,20] "
+                         "[--patch-residual R]\n";
             return 2;
           }
       }

@@ -97,6 +97,9 @@ namespace
     /** The longest increment after the levers, in part 1 (--increment MM;
      * 0: as the levers leave it). */
     double increment = 0;
+    /** Nonlinear solver / patch_factor_residual after the levers
+     * (--patch-residual R; 0: as the levers leave it). */
+    double patch_residual = 0;
   };
 
   /** A solver configuration: the scene's settings with some levers. */
@@ -561,6 +564,8 @@ run_benchmark(int argc, char **argv)
         o.csv = argv[++i];
       else if (a == "--step" && i + 1 < argc)
         o.step = 1e-3 * std::stod(argv[++i]);
+      else if (a == "--patch-residual" && i + 1 < argc)
+        o.patch_residual = std::stod(argv[++i]);
       else if (a == "--increment" && i + 1 < argc)
         o.increment = stroke_grid.increment = 1e-3 * std::stod(argv[++i]);
       else if (a == "--engine" && i + 1 < argc)
@@ -586,7 +591,7 @@ run_benchmark(int argc, char **argv)
             << "usage: benchmarks/run organ-speed [--quick] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
-               "[--cores K] [--interpolation NAME] [--step MM] [--increment MM] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
+               "[--cores K] [--interpolation NAME] [--step MM] [--increment MM] [--patch-residual R] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
                "[--stroke-contact condensed|matrix]\n";
           return 2;
         }
@@ -690,6 +695,8 @@ run_benchmark(int argc, char **argv)
         levers[i].apply(p);
       if (o.increment > 0)
         p.nonlinear_solver.max_increment_length = o.increment;
+      if (o.patch_residual > 0)
+        p.nonlinear_solver.patch_factor_residual = o.patch_residual;
     };
     for (unsigned int i = 0; i <= l; ++i)
       c.extrapolate = c.extrapolate || levers[i].extrapolate;
