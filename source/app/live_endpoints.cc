@@ -469,7 +469,7 @@ namespace palpate
             Utilities::Point3           x;
             for (unsigned int k = 0; k < 3; ++k)
               x[k] = 1000 * m.vertices()[v][k];
-            res.set_content("node " + std::to_string(m.node_id(v)) + " at (" +
+            res.set_content(m.node_name(v) + " at (" +
                               Utilities::to_string(x, 4) +
                               ") mm; the cached states were dropped and are "
                               "computed again",

@@ -337,7 +337,7 @@ namespace palpate
     const auto  v    = interaction.nodes().active_vertex;
     if (v == NodeSelection::no_active_node)
       return "none";
-    return "node " + std::to_string(mesh.node_id(v)) + " at (" +
+    return mesh.node_name(v) + " at (" +
            Utilities::to_string(Utilities::scaled(mesh.vertices()[v], 1000),
                                 4) +
            ") mm";

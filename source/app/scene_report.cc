@@ -164,8 +164,8 @@ namespace palpate
       s << "Boundary conditions\n"
         << "  fixed nodes:   " << nodes.fixed_vertices.size() << " ("
         << nodes.fixed_description << "), by " << f.treatment << "\n"
-        << "  active node:   node " << mesh.node_id(nodes.active_vertex)
-        << " at (" << Utilities::to_string(xa, 4) << ") m";
+        << "  active node:   " << mesh.node_name(nodes.active_vertex) << " at ("
+        << Utilities::to_string(xa, 4) << ") m";
       if (a.selection == "nearest surface node")
         s << ", the surface node nearest to ("
           << Utilities::to_string(a.point, 4) << ") m, "

@@ -630,6 +630,14 @@ namespace palpate
 
 
 
+  std::string
+  Mesh::node_name(const unsigned int v) const
+  {
+    return "node " + std::to_string(node_id(v));
+  }
+
+
+
   std::optional<unsigned int>
   Mesh::vertex_of_node_id(const long id) const
   {

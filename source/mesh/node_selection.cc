@@ -289,8 +289,8 @@ namespace palpate
           if (!(best <= 0.25 * mesh.diameter()))
             throw scene.error(
               "Boundary conditions/Active node/Point",
-              "the nearest surface node (node " +
-                std::to_string(mesh.node_id(selection.active_vertex)) + " at " +
+              "the nearest surface node (" +
+                mesh.node_name(selection.active_vertex) + " at " +
                 Utilities::to_string(x[selection.active_vertex], 4) +
                 " m) is " + Utilities::to_string(best, 3) +
                 " m from Point, more than a quarter of the body's size (" +
@@ -322,9 +322,8 @@ namespace palpate
         throw scene.error(
           a.selection == "node id" ? "Boundary conditions/Active node/Node id" :
                                      "Boundary conditions/Active node/Point",
-          "the active node (node " +
-            std::to_string(mesh.node_id(selection.active_vertex)) + " at " +
-            Utilities::to_string(x[selection.active_vertex], 4) +
+          "the active node (" + mesh.node_name(selection.active_vertex) +
+            " at " + Utilities::to_string(x[selection.active_vertex], 4) +
             " m) is also a fixed node, so it cannot move",
           "choose an active node outside the fixed region, or "
           "shrink the region.");

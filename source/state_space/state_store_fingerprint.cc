@@ -72,7 +72,7 @@ namespace palpate
                               ", hash " + h.hex());
     }
     {
-      std::string a = "node " + std::to_string(nodes.active_vertex);
+      std::string a = mesh.node_name(nodes.active_vertex);
       if (!nodes.tip_vertices.empty())
         a += ", tip of " + std::to_string(nodes.tip_vertices.size() + 1) +
              " nodes";

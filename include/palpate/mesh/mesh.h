@@ -103,6 +103,12 @@ namespace palpate
     long
     node_id(const unsigned int v) const;
 
+    /** Vertex @p v as every message names it: "node " and the number the
+     * mesh file gives it (node_id()), the number a user finds in the file
+     * and in ParaView's node_id field, never the internal index. */
+    std::string
+    node_name(const unsigned int v) const;
+
     /** The vertex the file numbers @p id, if there is one. */
     std::optional<unsigned int>
     vertex_of_node_id(const long id) const;
