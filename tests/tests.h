@@ -182,6 +182,26 @@ touch_beam_with_sphere(palpate::Scene &scene, const double radius)
   p.boundary_conditions.active_node.tip_radius = radius;
 }
 
+/**
+ * The contact-patch tests' beam: @p scene (touched by a sphere) meshed with
+ * 2.5 mm elements, so that a 1 cm sphere touches several nodes and its force
+ * is the tissue's rather than one node's; Neo-Hookean, because
+ * St.Venant-Kirchhoff softens under the compression a sphere makes and
+ * inverts these elements 2.5 mm deep; State space / Interpolation = contact
+ * patch with the condensed contact solver.
+ */
+inline void
+beam_with_contact_patches(palpate::Scene &scene)
+{
+  auto &p                              = scene.parameters;
+  p.mesh.beam_subdivisions_length      = 40;
+  p.mesh.beam_subdivisions_width       = 8;
+  p.mesh.beam_subdivisions_height      = 8;
+  p.material_model.model_name          = "Neo-Hookean";
+  p.state_space.interpolation          = "contact patch";
+  p.nonlinear_solver.condensed_contact = true;
+}
+
 /** Every linear solver registered (LinearSolverRegistry, in name order)
  * with the METIS ordering, and MUMPS with AMD too, for the solver tests. */
 inline std::vector<std::pair<std::string, std::string>>

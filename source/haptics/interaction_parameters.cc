@@ -2,8 +2,8 @@
 // Copyright (C) 2026 the palpate authors
 
 // Interaction::change_parameters() and check_parameters(): what may change
-// while a session runs (the material, the boundary conditions, the effects,
-// the solver settings; not what the grid, cache, engine and filter are
+// while the interaction runs (the material, the boundary conditions, the
+// effects, the solver settings; not what the grid, cache, engine and filter are
 // built for), checked before anything changes.
 
 #include <palpate/haptics/interaction_impl.h>

@@ -3,7 +3,7 @@
 
 // What an Interaction says of itself while and after it runs: the states
 // stored and the store's trouble, the events of missing data for the log,
-// the engine's load and the session's summary.
+// the engine's load and the run's summary.
 
 #include <palpate/haptics/interaction_impl.h>
 

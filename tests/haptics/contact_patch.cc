@@ -155,20 +155,11 @@ main(int argc, char **argv)
 
   palpate::Scene scene = shipped_scene("beam.prm");
   touch_beam_with_sphere(scene, 0.01);
+  beam_with_contact_patches(scene);
   auto &p = scene.parameters;
-  // 2.5 mm elements: a 1 cm sphere then touches several nodes, and its
-  // force is the tissue's rather than one node's.
-  p.mesh.beam_subdivisions_length = 40;
-  p.mesh.beam_subdivisions_width  = 8;
-  p.mesh.beam_subdivisions_height = 8;
-  // Neo-Hookean: St.Venant-Kirchhoff softens under the compression a
-  // sphere makes, and inverts these elements 2.5 mm deep.
-  p.material_model.model_name = "Neo-Hookean";
   p.material_model.set("Neo-Hookean", "Young's modulus", 1e5);
   p.material_model.set("Neo-Hookean", "Poisson's ratio", 0.3);
-  p.state_space.interpolation           = "contact patch";
   p.state_space.grid_spacing            = 0.005;
-  p.nonlinear_solver.condensed_contact  = true;
   p.nonlinear_solver.residual_tolerance = 1e-10;
   Patches patches(scene);
   deallog << "states with a patch: " << patches.states.size() << " of 27"

@@ -53,13 +53,8 @@ main(int argc, char **argv)
 
   palpate::Scene scene = small_beam_scene();
   touch_beam_with_sphere(scene, 0.01);
-  auto &p                              = scene.parameters;
-  p.mesh.beam_subdivisions_length      = 40;
-  p.mesh.beam_subdivisions_width       = 8;
-  p.mesh.beam_subdivisions_height      = 8;
-  p.material_model.model_name          = "Neo-Hookean";
-  p.state_space.interpolation          = "contact patch";
-  p.nonlinear_solver.condensed_contact = true;
+  beam_with_contact_patches(scene);
+  auto &p = scene.parameters;
 
   const double         depth = -0.0011, edge = 0.006, beyond = 0.0075;
   palpate::Interaction interaction(scene);

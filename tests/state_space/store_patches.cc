@@ -76,14 +76,9 @@ main(int argc, char **argv)
 
   palpate::Scene scene = shipped_scene("beam.prm");
   touch_beam_with_sphere(scene, 0.01);
+  beam_with_contact_patches(scene);
   auto &p                               = scene.parameters;
-  p.mesh.beam_subdivisions_length       = 40;
-  p.mesh.beam_subdivisions_width        = 8;
-  p.mesh.beam_subdivisions_height       = 8;
-  p.material_model.model_name           = "Neo-Hookean";
-  p.state_space.interpolation           = "contact patch";
   p.state_space.grid_spacing            = 0.005;
-  p.nonlinear_solver.condensed_contact  = true;
   p.nonlinear_solver.residual_tolerance = 1e-10;
   const Body body(scene);
   const auto fingerprint =

@@ -9,8 +9,8 @@
 //   interaction.cc             attaching and detaching, the force at each
 //                              tick (the real-time path) and what the
 //                              haptic side asks of the data
-//   interaction_parameters.cc  the parameters changed during a session
-//   interaction_report.cc      what the session says of itself: the store,
+//   interaction_parameters.cc  the parameters changed while it runs
+//   interaction_report.cc      what the interaction says of itself: the store,
 //                              the events of missing data, the summary
 // Users of the interaction include interaction.h, never this header.
 
