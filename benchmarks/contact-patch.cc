@@ -19,9 +19,12 @@
 // stiffness and patch on), for every corner of a cell a sweep visits and
 // those corners' neighbours (the cross derivatives of Hermite need them).
 // A sample whose cell has a failure point for a corner is left out and
-// counted (`uncovered`). patch_plain: the corners' patch forces blended by
-// the trilinear weights alone, without PatchContact::blend()'s confidence,
-// in the same run.
+// counted (`uncovered`). contact_patch blends the patches of the 4 corners
+// of the HIP's tetrahedron in its cell, as palpate renders
+// (PatchContact::weights()); patch_8_corners the cell's 8 by trilinear
+// weights with the same confidence; patch_plain those by the trilinear
+// weights alone, without PatchContact::blend()'s confidence; all in the
+// same run, each replay by a solver of its own.
 //
 // tick_us_p999: the contact patch's time per tick, replaying the sweeps at
 // 20 ticks between neighbouring samples (the sphere moving about 0.05 mm a
@@ -239,6 +242,75 @@ namespace
     unsigned int samples = 0, uncovered = 0;
   };
 
+  /** How a replay blends the corners' patches: as palpate renders (the
+   * HIP's tetrahedron, PatchContact::weights()), the cell's 8 corners by
+   * trilinear weights with the same confidence, or those alone. */
+  enum class Blend
+  {
+    rendered,
+    cell,
+    plain
+  };
+
+  /** A replay of the sweeps through a PatchContact: the force at each
+   * sample (covered: its cell's corners all have patches), each tick's
+   * force, time and work, and as many ticks again held in place. */
+  struct Replay
+  {
+    std::vector<Point3>             force;
+    std::vector<char>               covered;
+    std::vector<Point3>             tick_force;
+    std::vector<double>             tick_us, cpu_us, held_us;
+    std::vector<PatchContact::Work> works;
+    unsigned int                    unsettled = 0;
+  };
+
+  /** The slowest ticks (the p99.9 tail and a few more) with the work they
+   * did: what the tail is made of. */
+  void
+  print_slowest_ticks(const std::vector<double>             &tick_us,
+                      const std::vector<PatchContact::Work> &works)
+  {
+    std::vector<std::size_t> order(tick_us.size());
+    for (std::size_t t = 0; t < order.size(); ++t)
+      order[t] = t;
+    std::sort(order.begin(), order.end(), [&](auto a, auto b) {
+      return tick_us[a] > tick_us[b];
+    });
+    const std::size_t shown = std::min<std::size_t>(order.size(), 8);
+    std::cout << "  the slowest ticks: us (corners, new corners, active-set "
+                 "iterations, factorisations, largest active set, largest "
+                 "patch)\n";
+    for (std::size_t k = 0; k < shown; ++k)
+      {
+        const auto &w = works[order[k]];
+        std::cout << "    " << tick_us[order[k]] << " (" << w.corners << ", "
+                  << w.new_corners << ", " << w.iterations << ", "
+                  << w.factorizations << ", " << w.largest_active << ", "
+                  << w.largest_patch << ")\n";
+      }
+  }
+
+  /** The work of a replay's ticks, summed (it does not drift with the
+   * machine as their times do), and their times. */
+  void
+  print_work(const Replay &r, const std::string &what)
+  {
+    std::size_t iterations = 0, factorizations = 0, new_corners = 0;
+    for (const auto &w : r.works)
+      {
+        iterations += w.iterations;
+        factorizations += w.factorizations;
+        new_corners += w.new_corners;
+      }
+    std::cout << "  " << what << ": " << r.works.size() << " ticks, "
+              << new_corners << " corners met, " << iterations
+              << " active-set iterations, " << factorizations
+              << " factorisations; p50 " << percentile(r.tick_us, 0.5)
+              << " us, p99 " << percentile(r.tick_us, 0.99) << " us, p999 "
+              << percentile(r.tick_us, 0.999) << " us\n";
+  }
+
   /** The CPU time this thread has used (s): a tick's work without the
    * time the VM or the scheduler took the core away. */
   double
@@ -247,6 +319,116 @@ namespace
     timespec t{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return t.tv_sec + 1e-9 * t.tv_nsec;
+  }
+
+  /** The hand's move per tick between sweeps (m): 25 mm/s. */
+  constexpr double transit_step = 2.5e-5;
+
+
+  /**
+   * The sweeps @p lines replayed as a hand moves them: 20 ticks from one
+   * sample to the next (about 0.05 mm a tick), after 20 ticks at rest on
+   * the first, and from one sweep's end to the next one's start at 25 mm/s
+   * (those ticks timed too); the force at a sample is what the tick there
+   * renders. With
+   * @p blend the corners are blended as palpate renders, or as the
+   * comparisons do (Blend). Then as
+   * many ticks again with the same work each (the HIP held where the last
+   * sweep ended, the contact settled): what this VM's jitter alone makes of
+   * a tick's time, in the same run.
+   */
+  Replay
+  replay(const StateGrid                        &grid,
+         const StateCache                       &cache,
+         const std::vector<std::vector<Point3>> &lines,
+         PatchContact                           &solver,
+         const Blend                             blend)
+  {
+    Replay r;
+    auto   tick = [&](const Point3 &x, Point3 &f) {
+      GridIndex             lower;
+      std::array<double, 3> local;
+      if (!grid.locate(x, lower, local))
+        return false;
+      const auto                          corners = grid.corners(lower);
+      std::array<const ContactPatch *, 8> patches;
+      for (unsigned int c = 0; c < 8; ++c)
+        {
+          const auto s = cache.state(corners[c]);
+          if (!s || !s->contact_patch)
+            return false;
+          patches[c] = s->contact_patch.get();
+        }
+      std::array<double, 9> K;
+      const auto   w = blend == Blend::rendered ? PatchContact::weights(local) :
+                                                    trilinear_weights(local);
+      const double cpu   = thread_cpu_seconds();
+      const auto   start = std::chrono::steady_clock::now();
+      bool         settled;
+      if (blend != Blend::plain)
+        settled = solver.blend(patches, w, x, f, &K);
+      else
+        {
+          settled = true;
+          f       = {{0, 0, 0}};
+          for (unsigned int c = 0; c < 8; ++c)
+            if (w[c] != 0)
+              {
+                Point3 fc;
+                settled = solver.force(*patches[c], x, fc) && settled;
+                f       = add(f, fc, w[c]);
+              }
+        }
+      r.tick_us.push_back(1e6 * Utilities::seconds_since(start));
+      r.cpu_us.push_back(1e6 * (thread_cpu_seconds() - cpu));
+      r.works.push_back(solver.last_work());
+      r.tick_force.push_back(f);
+      r.unsettled += settled ? 0 : 1;
+      return true;
+    };
+    const Point3 *last = nullptr;
+    for (const auto &line : lines)
+      for (std::size_t i = 0; i < line.size(); ++i)
+        {
+          Point3 f;
+          bool   covered = true;
+          // From the end of the last sweep to the start of this one as the
+          // hand moves (0.025 mm a tick): no tick jumps, as no hand does.
+          if (i == 0 && last)
+            {
+              const unsigned int steps =
+                std::ceil(Utilities::distance(*last, line[0]) / transit_step);
+              for (unsigned int t = 1; t < steps; ++t)
+                tick(add(*last, add(line[0], *last, -1), double(t) / steps), f);
+            }
+          last = &line[i];
+          if (i == 0)
+            for (unsigned int t = 0; t < 20; ++t)
+              covered = tick(line[i], f);
+          else
+            for (unsigned int t = 1; t <= 20; ++t)
+              covered =
+                tick(add(line[i - 1], add(line[i], line[i - 1], -1), t / 20.0),
+                     f);
+          r.force.push_back(f);
+          r.covered.push_back(covered);
+        }
+    if (!lines.empty() && !lines.back().empty())
+      {
+        Point3            f;
+        const std::size_t n_ticks = r.tick_us.size();
+        for (unsigned int t = 0; t < 20; ++t)
+          tick(lines.back().back(), f);
+        const std::size_t settled = r.tick_us.size();
+        for (std::size_t t = 0; t < n_ticks; ++t)
+          tick(lines.back().back(), f);
+        r.held_us.assign(r.tick_us.begin() + settled, r.tick_us.end());
+        r.tick_us.resize(n_ticks);
+        r.cpu_us.resize(n_ticks);
+        r.works.resize(n_ticks);
+        r.tick_force.resize(n_ticks);
+      }
+    return r;
   }
 
   /** Everything measured on one body. */
@@ -439,127 +621,81 @@ namespace
           }
 
         // The contact patch keeps a warm start from tick to tick: the
-        // sweeps are replayed as a hand moves, 20 ticks from one sample to
-        // the next (about 0.05 mm a tick), after 20 ticks at rest on the
-        // first; the force at a sample is what the tick there renders.
+        // sweeps are replayed as a hand moves, each pass by a solver of its
+        // own (one pass does not warm the caches for another).
         Row row;
         row.body          = body;
         row.interpolation = "contact_patch";
         row.spacing_mm    = 1e3 * h;
         row.states_per_cm = path_corners.size() / path_cm;
-        std::vector<double> err, tick_us, err_plain, cpu_us;
-        PatchContact        plain_contact(contact.size(), 256);
-        Point3              f_plain;
-        unsigned int        unsettled = 0;
-        std::size_t         sample    = 0;
-        auto                tick      = [&](const Point3 &x, Point3 &f) {
-          GridIndex             lower;
-          std::array<double, 3> local;
-          if (!grid.locate(x, lower, local))
-            return false;
-          const auto                          corners = grid.corners(lower);
-          std::array<const ContactPatch *, 8> patches;
-          for (unsigned int c = 0; c < 8; ++c)
-            {
-              const auto s = cache.state(corners[c]);
-              if (!s || !s->contact_patch)
-                return false;
-              patches[c] = s->contact_patch.get();
-            }
-          std::array<double, 9> K;
-          const auto            w   = trilinear_weights(local);
-          const double          cpu = thread_cpu_seconds();
-          const auto            start = std::chrono::steady_clock::now();
-          if (!patch_contact.blend(patches, w, x, f, &K))
-            ++unsettled;
-          tick_us.push_back(1e6 * Utilities::seconds_since(start));
-          cpu_us.push_back(1e6 * (thread_cpu_seconds() - cpu));
-          // The corners' forces blended by the trilinear weights alone,
-          // without the confidence (a solver of its own: the same warm
-          // starts), for comparison.
-          f_plain = {{0, 0, 0}};
-          for (unsigned int c = 0; c < 8; ++c)
-            if (w[c] != 0)
-              {
-                Point3 fc;
-                plain_contact.force(*patches[c], x, fc);
-                f_plain = add(f_plain, fc, w[c]);
-              }
-          return true;
-        };
-        for (const auto &line : direct_lines)
-          for (std::size_t i = 0; i < line.size(); ++i, ++sample)
-            {
-              Point3 f;
-              bool   covered = true;
-              if (i == 0)
-                for (unsigned int t = 0; t < 20; ++t)
-                  covered = tick(samples[sample], f);
-              else
-                for (unsigned int t = 1; t <= 20; ++t)
-                  covered =
-                    tick(add(samples[sample - 1],
-                             add(samples[sample], samples[sample - 1], -1),
-                             t / 20.0),
-                         f);
-              if (!covered)
-                {
-                  ++row.uncovered;
-                  continue;
-                }
-              err.push_back(error_pct(f, f_direct[sample]));
-              err_plain.push_back(error_pct(f_plain, f_direct[sample]));
-              if (o.verbose)
-                print_sample(row.interpolation,
-                             samples[sample],
-                             f_direct[sample],
-                             f);
-            }
-        // As many ticks again with the same work each (the HIP held where
-        // the last sweep ended, the contact settled): what this VM's jitter
-        // alone makes of a tick's time, in the same run.
-        std::vector<double> held_us;
-        if (!direct_lines.empty() && !direct_lines.back().empty())
+        PatchContact rendered(contact.size(), 256);
+        PatchContact cell_contact(contact.size(), 256);
+        PatchContact plain_contact(contact.size(), 256);
+        const Replay ticks =
+          replay(grid, cache, direct_lines, rendered, Blend::rendered);
+        const Replay cell =
+          replay(grid, cache, direct_lines, cell_contact, Blend::cell);
+        const Replay plain =
+          replay(grid, cache, direct_lines, plain_contact, Blend::plain);
+
+        std::vector<double> err, err_cell, err_plain;
+        for (std::size_t i = 0; i < samples.size(); ++i)
           {
-            Point3            f;
-            const std::size_t n_ticks = tick_us.size();
-            for (unsigned int t = 0; t < 20; ++t)
-              tick(direct_lines.back().back(), f);
-            const std::size_t settled = tick_us.size();
-            for (std::size_t t = 0; t < n_ticks; ++t)
-              tick(direct_lines.back().back(), f);
-            held_us.assign(tick_us.begin() + settled, tick_us.end());
-            tick_us.resize(n_ticks);
+            if (!ticks.covered[i])
+              {
+                ++row.uncovered;
+                continue;
+              }
+            err.push_back(error_pct(ticks.force[i], f_direct[i]));
+            err_cell.push_back(error_pct(cell.force[i], f_direct[i]));
+            err_plain.push_back(error_pct(plain.force[i], f_direct[i]));
+            if (o.verbose)
+              print_sample(row.interpolation,
+                           samples[i],
+                           f_direct[i],
+                           ticks.force[i]);
           }
-        cpu_us.resize(tick_us.size());
-        row.samples   = err.size();
-        row.p95       = percentile(err, 0.95);
-        row.max       = percentile(err, 1.0);
-        row.tick_p999 = percentile(tick_us, 0.999);
-        row.held_p50  = percentile(held_us, 0.5);
-        row.held_p999 = percentile(held_us, 0.999);
-        row.cpu_p999  = percentile(cpu_us, 0.999);
-        rows.push_back(row);
-        Row plain           = row;
-        plain.interpolation = "patch_plain";
-        plain.p95           = percentile(err_plain, 0.95);
-        plain.max           = percentile(err_plain, 1.0);
-        plain.tick_p999 = plain.held_p999 = 0;
-        rows.push_back(plain);
-        std::cout << "  contact_patch: p95 " << row.p95 << " %, max " << row.max
-                  << " %; the corners' forces blended trilinearly alone: p95 "
-                  << plain.p95 << " %, max " << plain.max << " %" << std::endl;
-        std::cout << "  contact patch: " << tick_us.size() << " ticks ("
-                  << unsettled << " not settled), p50 "
-                  << percentile(tick_us, 0.5) << " us, p99 "
-                  << percentile(tick_us, 0.99) << " us, p999 "
-                  << percentile(tick_us, 0.999) << " us; held in place: p50 "
-                  << row.held_p50 << " us, p999 " << row.held_p999 << " us"
+        print_work(ticks, "contact patch (the HIP's tetrahedron, 4 corners)");
+        print_work(cell, "the cell's 8 corners, trilinear weights");
+        print_slowest_ticks(ticks.tick_us, ticks.works);
+        auto timed = [&](Row r, const Replay &replayed) {
+          r.tick_p999 = percentile(replayed.tick_us, 0.999);
+          r.held_p50  = percentile(replayed.held_us, 0.5);
+          r.held_p999 = percentile(replayed.held_us, 0.999);
+          r.cpu_p999  = percentile(replayed.cpu_us, 0.999);
+          return r;
+        };
+        row.samples = err.size();
+        row.p95     = percentile(err, 0.95);
+        row.max     = percentile(err, 1.0);
+        rows.push_back(timed(row, ticks));
+        Row cell_row           = timed(row, cell);
+        cell_row.interpolation = "patch_8_corners";
+        cell_row.p95           = percentile(err_cell, 0.95);
+        cell_row.max           = percentile(err_cell, 1.0);
+        rows.push_back(cell_row);
+        Row plain_row           = row;
+        plain_row.interpolation = "patch_plain";
+        plain_row.p95           = percentile(err_plain, 0.95);
+        plain_row.max           = percentile(err_plain, 1.0);
+        rows.push_back(plain_row);
+        const Row &r = rows[rows.size() - 3];
+        std::cout << "  contact_patch: p95 " << r.p95 << " %, max " << r.max
+                  << " %; the cell's 8 corners: p95 " << cell_row.p95
+                  << " %, max " << cell_row.max
+                  << " %; those by the trilinear weights alone: p95 "
+                  << plain_row.p95 << " %, max " << plain_row.max << " %"
                   << std::endl;
+        std::cout << "  contact patch: " << ticks.tick_us.size() << " ticks ("
+                  << ticks.unsettled << " not settled), p50 "
+                  << percentile(ticks.tick_us, 0.5) << " us, p99 "
+                  << percentile(ticks.tick_us, 0.99) << " us, p999 "
+                  << r.tick_p999 << " us; held in place: p50 " << r.held_p50
+                  << " us, p999 " << r.held_p999 << " us" << std::endl;
         std::cout << "  the same ticks' thread CPU time: p50 "
-                  << percentile(cpu_us, 0.5) << " us, p99 "
-                  << percentile(cpu_us, 0.99) << " us, p999 " << row.cpu_p999
-                  << " us" << std::endl;
+                  << percentile(ticks.cpu_us, 0.5) << " us, p99 "
+                  << percentile(ticks.cpu_us, 0.99) << " us, p999 "
+                  << r.cpu_p999 << " us" << std::endl;
       }
   }
 

@@ -281,7 +281,7 @@ namespace palpate
               return false;
             patches[c] = i->second->contact_patch.get();
           }
-        const auto w = trilinear_weights(sample.local);
+        const auto w = PatchContact::weights(sample.local);
         Point3     previous{{NAN, NAN, NAN}};
         for (unsigned int tick = 0; tick < 200; ++tick)
           {

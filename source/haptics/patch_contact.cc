@@ -4,6 +4,7 @@
 #include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/contact_lcp.h>
 #include <palpate/hyperelastic/contact_patch.h>
+#include <palpate/state_space/state_grid.h>
 
 #include <algorithm>
 #include <cmath>
@@ -145,6 +146,7 @@ namespace palpate
       }
     // A patch seen for the first time starts from its state: the solution
     // there, and the nearest guess near it.
+    ++work.new_corners;
     Slot &s    = *oldest;
     s.patch    = &patch;
     s.id       = patch.id;
@@ -175,6 +177,7 @@ namespace palpate
       for (unsigned int b = 0; b < m; ++b)
         s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
     s.n_active = m;
+    ++work.factorizations;
     // W is a compliance, symmetric positive definite at a stable state:
     // Cholesky, half the work of LU. LU where round-off (or an unstable
     // state's tangent) makes the block indefinite.
@@ -260,6 +263,7 @@ namespace palpate
     while (!settled && iterations < max_iterations)
       {
         ++iterations;
+        ++work.iterations;
         if (!s.factored && !factorize_active(patch, s))
           break;
         const unsigned int m = s.n_active;
@@ -359,6 +363,18 @@ namespace palpate
                       Utilities::Point3       &force,
                       std::array<double, 9>   *stiffness) noexcept
   {
+    work = Work();
+    return corner_force(patch, x, force, stiffness);
+  }
+
+
+
+  bool
+  PatchContact::corner_force(const ContactPatch      &patch,
+                             const Utilities::Point3 &x,
+                             Utilities::Point3       &force,
+                             std::array<double, 9>   *stiffness) noexcept
+  {
     force = {{0, 0, 0}};
     if (stiffness)
       stiffness->fill(0.0);
@@ -368,6 +384,8 @@ namespace palpate
     if (n > max_nodes)
       return false;
     Slot &s = slot_of(patch);
+    ++work.corners;
+    work.largest_patch = std::max(work.largest_patch, n);
 
     // The gaps at the nodes' current positions, for the sphere's centre at
     // this HIP, and the directions nu_i of their forces.
@@ -378,7 +396,8 @@ namespace palpate
     if (!touching && n_loaded == 0)
       return true;
 
-    const bool settled = solve_contact(patch, s, n_loaded);
+    const bool settled  = solve_contact(patch, s, n_loaded);
+    work.largest_active = std::max(work.largest_active, s.n_active);
 
     apply_forces(patch, s, force);
 
@@ -390,6 +409,14 @@ namespace palpate
 
 
 
+  std::array<double, 8>
+  PatchContact::weights(const std::array<double, 3> &local) noexcept
+  {
+    return simplex_weights(local);
+  }
+
+
+
   bool
   PatchContact::blend(const std::array<const ContactPatch *, 8> &corners,
                       const std::array<double, 8>               &weights,
@@ -397,6 +424,7 @@ namespace palpate
                       Utilities::Point3                         &force,
                       std::array<double, 9> *stiffness) noexcept
   {
+    work  = Work();
     force = {{0, 0, 0}};
     if (stiffness)
       stiffness->fill(0.0);
@@ -409,7 +437,7 @@ namespace palpate
         if (weights[c] == 0)
           continue;
         settled =
-          this->force(*corners[c], x, f, stiffness ? &k : nullptr) && settled;
+          corner_force(*corners[c], x, f, stiffness ? &k : nullptr) && settled;
         // A corner pressing harder than the contact at x does is trusted
         // less (see blend() in the header).
         const double own = Utilities::norm(corners[c]->force);

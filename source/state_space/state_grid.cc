@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace palpate
 {
@@ -126,6 +127,33 @@ namespace palpate
                       lower[1] + int((k >> 1) & 1),
                       lower[2] + int((k >> 2) & 1)}});
     return c;
+  }
+
+
+
+  std::array<double, 8>
+  simplex_weights(const std::array<double, 3> &s) noexcept
+  {
+    // The axes by decreasing coordinate: the tetrahedron from corner 0
+    // through one more upper bit per axis in that order to corner 7.
+    std::array<unsigned int, 3> axis = {{0, 1, 2}};
+    if (s[axis[0]] < s[axis[1]])
+      std::swap(axis[0], axis[1]);
+    if (s[axis[1]] < s[axis[2]])
+      std::swap(axis[1], axis[2]);
+    if (s[axis[0]] < s[axis[1]])
+      std::swap(axis[0], axis[1]);
+    std::array<double, 8> w{};
+    unsigned int          corner = 0;
+    double                above  = 1;
+    for (unsigned int e = 0; e < 3; ++e)
+      {
+        w[corner] += above - s[axis[e]];
+        above = s[axis[e]];
+        corner |= 1u << axis[e];
+      }
+    w[corner] += above;
+    return w;
   }
 
 

@@ -74,15 +74,13 @@ namespace
     for (unsigned int c = 0; c < 8; ++c)
       {
         corners[c] = cache.read_patch(points[c], cache.generation());
-        weights[c] = (c & 1 ? t[0] : 1 - t[0]) *
-                     ((c >> 1) & 1 ? t[1] : 1 - t[1]) *
-                     ((c >> 2) & 1 ? t[2] : 1 - t[2]);
         if (corners[c] == nullptr)
           {
             cache.end_patch_reads();
             return {{0, 0, 0}};
           }
       }
+    weights = palpate::PatchContact::weights(t);
     Point3 f;
     // Twenty ticks where the hand rests: the fixed-point iteration settles.
     for (unsigned int tick = 0; tick < 20; ++tick)

@@ -121,7 +121,7 @@ namespace
         all = all &&
               (patches[c] = cache.read_patch(corners[c], cache.generation()));
       if (all)
-        contact.blend(patches, palpate::trilinear_weights(local), x, f);
+        contact.blend(patches, palpate::PatchContact::weights(local), x, f);
       cache.end_patch_reads();
       counting = false;
       return all;

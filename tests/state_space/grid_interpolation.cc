@@ -177,4 +177,54 @@ main(int argc, char **argv)
           << (held_patches.second <= 10 * per_state ? "yes" : "NO") << "), "
           << readable << " patches readable, all of held states ("
           << (readable == readable_held ? "yes" : "NO") << ")" << std::endl;
+
+  // The tetrahedron's weights (simplex_weights()): at most 4 corners, a
+  // partition of unity that reproduces linear functions (barycentric), 1 at
+  // their own corner, and continuous across the tetrahedra's faces (a
+  // point on the face x = y seen from both sides).
+  {
+    std::mt19937                           random(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    bool   partition = true, linear = true, at_most_4 = true, corner = true;
+    double jump = 0;
+    for (unsigned int k = 0; k < 8; ++k)
+      {
+        const auto w = palpate::simplex_weights(
+          {{double(k & 1), double((k >> 1) & 1), double((k >> 2) & 1)}});
+        corner = corner && w[k] == 1;
+      }
+    for (unsigned int t = 0; t < 1000; ++t)
+      {
+        const std::array<double, 3> s    = {{u(random), u(random), u(random)}};
+        const auto                  w    = palpate::simplex_weights(s);
+        double                      sum  = 0;
+        std::array<double, 3>       x    = {{0, 0, 0}};
+        unsigned int                used = 0;
+        for (unsigned int k = 0; k < 8; ++k)
+          {
+            sum += w[k];
+            used += w[k] != 0;
+            partition = partition && w[k] >= 0;
+            for (unsigned int d = 0; d < 3; ++d)
+              x[d] += w[k] * ((k >> d) & 1);
+          }
+        partition = partition && std::abs(sum - 1) < 1e-14;
+        at_most_4 = at_most_4 && used <= 4;
+        for (unsigned int d = 0; d < 3; ++d)
+          linear = linear && std::abs(x[d] - s[d]) < 1e-14;
+        const std::array<double, 3> below = {{s[0], s[0] - 1e-12, s[2]}},
+                                    above = {{s[0], s[0] + 1e-12, s[2]}};
+        const auto wb                     = palpate::simplex_weights(below),
+                   wa                     = palpate::simplex_weights(above);
+        for (unsigned int k = 0; k < 8; ++k)
+          jump = std::max(jump, std::abs(wb[k] - wa[k]));
+      }
+    deallog << "tetrahedron weights: non-negative, sum 1 ("
+            << (partition ? "yes" : "NO") << "), at most 4 corners ("
+            << (at_most_4 ? "yes" : "NO") << "), linear functions exact ("
+            << (linear ? "yes" : "NO") << "), 1 at their corner ("
+            << (corner ? "yes" : "NO")
+            << "), continuous across faces, jump < 1e-11: "
+            << (jump < 1e-11 ? "yes" : "NO") << std::endl;
+  }
 }

@@ -244,7 +244,7 @@ namespace palpate
       if (all)
         {
           patch_contact->blend(patches,
-                               trilinear_weights(sample.local),
+                               PatchContact::weights(sample.local),
                                position,
                                sample.force,
                                &sample.stiffness);
@@ -279,8 +279,11 @@ namespace palpate
       for (unsigned int d = 0; d < 3; ++d)
         local[d] =
           std::clamp((position[d] - last_origin[d]) / grid.spacing(), 0.0, 1.0);
-      patch_contact->blend(
-        last_patches, trilinear_weights(local), position, force, &stiffness);
+      patch_contact->blend(last_patches,
+                           PatchContact::weights(local),
+                           position,
+                           force,
+                           &stiffness);
       return true;
     }
 

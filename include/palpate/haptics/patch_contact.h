@@ -27,7 +27,8 @@ namespace palpate
    * tissue's compliance say from the moment it touches, and is the state's
    * own force at the corner. The rendered force is their blend (blend()):
    * the state's force at every grid point, continuous everywhere, zero
-   * where no corner's surface is touched.
+   * where no corner's surface is touched. The corners blended are the 4
+   * of the HIP's tetrahedron in its cell (weights()).
    *
    * The model is non-linear in the directions of the forces (they follow
    * the sphere's normals at the moved nodes), so each tick takes one step
@@ -77,7 +78,8 @@ namespace palpate
      * so its model touches early at a shallow HIP; a corner pressed
      * less, or not at all, has a free surface near the rest surface and
      * the contact's geometry exact. The blend therefore weights each corner
-     * by @p weights w_k (trilinear) times a confidence
+     * by @p weights w_k (weights(); a corner of weight 0 is not solved)
+     * times a confidence
      * c_k = 1 / (1 + (d_k / tau)^2), d_k = max(0, |F_k| - |F_k(x)|) /
      * (|F_k| + force_floor), with F_k the state's force, and normalises:
      *
@@ -93,6 +95,32 @@ namespace palpate
           const Utilities::Point3                   &x,
           Utilities::Point3                         &force,
           std::array<double, 9> *stiffness = nullptr) noexcept;
+
+    /** What the last blend() (or force()) did: the tick's work, for the
+     * benchmark to tell which ticks are slow and why. */
+    struct Work
+    {
+      unsigned int corners = 0, new_corners = 0, iterations = 0;
+      unsigned int factorizations = 0, largest_active = 0, largest_patch = 0;
+    };
+
+    /** The work of the last blend() or force() call. */
+    const Work &
+    last_work() const noexcept
+    {
+      return work;
+    }
+
+    /**
+     * The corners' weights blend() is given for the HIP at local
+     * coordinates @p local in its cell: those of the tetrahedron of the
+     * cell's Kuhn triangulation that holds it (simplex_weights()), so that
+     * a tick solves the contact of 4 corners, not 8. Measured against the
+     * trilinear weights of all 8 (doc/benchmarks/contact-patch.md): the
+     * same accuracy against direct solves, half the work.
+     */
+    static std::array<double, 8>
+    weights(const std::array<double, 3> &local) noexcept;
 
     /** The most active-set iterations one call may take. */
     static constexpr unsigned int max_iterations = 12;
@@ -129,6 +157,14 @@ namespace palpate
       // Whether LU holds a Cholesky factor (else LU with pivot).
       bool cholesky = false;
     };
+
+    /** force() without resetting the work counted (blend() sums its
+     * corners'). */
+    bool
+    corner_force(const ContactPatch      &patch,
+                 const Utilities::Point3 &x,
+                 Utilities::Point3       &force,
+                 std::array<double, 9>   *stiffness) noexcept;
 
     /** The slot of @p patch (its warm start), or the least recently used
      * one, reset. */
@@ -178,6 +214,7 @@ namespace palpate
     unsigned int                       max_nodes, max_active;
     std::vector<Slot>                  slots;
     std::uint64_t                      clock = 0;
+    Work                               work;
     std::vector<double>                q, w, rhs, rho;
     std::vector<std::array<double, 3>> u;
     std::vector<unsigned int>          loaded;

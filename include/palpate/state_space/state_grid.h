@@ -124,6 +124,16 @@ namespace palpate
    */
   std::array<double, 8>
   trilinear_weights(const std::array<double, 3> &local) noexcept;
+
+  /**
+   * The weights of the 8 corners (ordered as StateGrid::corners()) that
+   * interpolate linearly on the tetrahedron of the cell's Kuhn
+   * triangulation (6 tetrahedra along its main diagonal) holding
+   * @p local: at most 4 are not zero, they sum to 1, are continuous
+   * across cells and tetrahedra, and are 1 at their own corner.
+   */
+  std::array<double, 8>
+  simplex_weights(const std::array<double, 3> &local) noexcept;
 } // namespace palpate
 
 #endif
