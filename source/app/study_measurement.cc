@@ -273,16 +273,19 @@ namespace palpate
                   PatchContact     &contact,
                   ForceSample      &sample)
       {
-        std::array<const ContactPatch *, 8> patches;
+        // The patches of the HIP's tetrahedron, as the haptic loop reads.
+        const auto w = PatchContact::weights(sample.local);
+        std::array<const ContactPatch *, 8> patches{};
         for (unsigned int c = 0; c < 8; ++c)
           {
+            if (w[c] == 0)
+              continue;
             const auto i = g.states.find(sample.corners[c]);
             if (i == g.states.end() || !i->second->contact_patch)
               return false;
             patches[c] = i->second->contact_patch.get();
           }
-        const auto w = PatchContact::weights(sample.local);
-        Point3     previous{{NAN, NAN, NAN}};
+        Point3 previous{{NAN, NAN, NAN}};
         for (unsigned int tick = 0; tick < 200; ++tick)
           {
             contact.blend(patches, w, x, sample.force, &sample.stiffness);

@@ -90,6 +90,50 @@ namespace palpate
 
 
 
+  ForceSample
+  interpolate_on_tetrahedron(const StateGrid         &grid,
+                             const StateCache        &cache,
+                             const Utilities::Point3 &x) noexcept
+  {
+    ForceSample sample;
+    if (!locate(grid, x, sample))
+      return sample;
+    // Only the corners of the tetrahedron holding x are read: the cell's
+    // others may still be on their way.
+    const auto          path       = simplex_corners(sample.local);
+    const std::uint64_t generation = cache.generation();
+    for (const unsigned int k : path)
+      if (cache.read_force(sample.corners[k],
+                           generation,
+                           sample.corner_forces[k]))
+        ++sample.hits;
+      else
+        sample.failed += cache.status(sample.corners[k]) == PointStatus::failed;
+    sample.complete = sample.hits == 4;
+    if (!sample.complete)
+      return sample;
+    sample.failed = 0;
+    // The force linear on the tetrahedron; along its path each step of one
+    // axis changes it by the difference of the two corners.
+    const auto w = simplex_weights(sample.local);
+    sample.force = {{0, 0, 0}};
+    for (const unsigned int k : path)
+      for (unsigned int i = 0; i < 3; ++i)
+        sample.force[i] += w[k] * sample.corner_forces[k][i];
+    sample.stiffness = {};
+    for (unsigned int k = 0; k < 3; ++k)
+      {
+        const unsigned int j = __builtin_ctz(path[k + 1] ^ path[k]);
+        for (unsigned int i = 0; i < 3; ++i)
+          sample.stiffness[3 * i + j] = -(sample.corner_forces[path[k + 1]][i] -
+                                          sample.corner_forces[path[k]][i]) /
+                                        grid.spacing();
+      }
+    return sample;
+  }
+
+
+
   Interpolation
   interpolation_from_name(const std::string &name)
   {
@@ -132,6 +176,8 @@ namespace palpate
                     const Utilities::Point3 &x,
                     const Interpolation      scheme) noexcept
   {
+    if (scheme == Interpolation::contact_patch)
+      return interpolate_on_tetrahedron(grid, cache, x);
     if (scheme != Interpolation::hermite)
       return interpolate_force(grid, cache, x);
     ForceSample sample;

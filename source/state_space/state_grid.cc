@@ -131,8 +131,8 @@ namespace palpate
 
 
 
-  std::array<double, 8>
-  simplex_weights(const std::array<double, 3> &s) noexcept
+  std::array<unsigned int, 4>
+  simplex_corners(const std::array<double, 3> &s) noexcept
   {
     // The axes by decreasing coordinate: the tetrahedron from corner 0
     // through one more upper bit per axis in that order to corner 7.
@@ -143,16 +143,29 @@ namespace palpate
       std::swap(axis[1], axis[2]);
     if (s[axis[0]] < s[axis[1]])
       std::swap(axis[0], axis[1]);
+    std::array<unsigned int, 4> path = {{0, 0, 0, 7}};
+    path[1]                          = 1u << axis[0];
+    path[2]                          = path[1] | (1u << axis[1]);
+    return path;
+  }
+
+
+
+  std::array<double, 8>
+  simplex_weights(const std::array<double, 3> &s) noexcept
+  {
+    // Along the path, corner k has the weight s of the axis it steps from
+    // less the s of the axis the next corner steps along.
+    const auto            path = simplex_corners(s);
     std::array<double, 8> w{};
-    unsigned int          corner = 0;
-    double                above  = 1;
-    for (unsigned int e = 0; e < 3; ++e)
+    double                above = 1;
+    for (unsigned int k = 0; k < 3; ++k)
       {
-        w[corner] += above - s[axis[e]];
-        above = s[axis[e]];
-        corner |= 1u << axis[e];
+        const unsigned int axis = __builtin_ctz(path[k + 1] ^ path[k]);
+        w[path[k]] += above - s[axis];
+        above = s[axis];
       }
-    w[corner] += above;
+    w[7] += above;
     return w;
   }
 

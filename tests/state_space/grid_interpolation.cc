@@ -227,4 +227,51 @@ main(int argc, char **argv)
             << "), continuous across faces, jump < 1e-11: "
             << (jump < 1e-11 ? "yes" : "NO") << std::endl;
   }
+
+  // The force on the HIP's tetrahedron (interpolate_on_tetrahedron()):
+  // exact for a linear field, with its gradient; complete with its 4
+  // corners alone.
+  {
+    auto linear_field = [](const Point3 &x) {
+      return Point3{{3 * x[0] - 2 * x[1] + 0.1, x[1] + 5 * x[2], -4 * x[0]}};
+    };
+    const Point3          x = {{0.0012, -0.0031, 0.0071}};
+    palpate::GridIndex    cell;
+    std::array<double, 3> at;
+    grid.locate(x, cell, at);
+    const auto          corners = grid.corners(cell);
+    const auto          path    = palpate::simplex_corners(at);
+    palpate::StateCache only(grid, 1 << 20);
+    for (const unsigned int k : path)
+      {
+        auto s   = std::make_shared<palpate::State>();
+        s->force = linear_field(grid.position(corners[k]));
+        only.publish(corners[k], s, only.generation());
+      }
+    const auto   t       = palpate::interpolate_on_tetrahedron(grid, only, x);
+    const Point3 f       = linear_field(x);
+    const double K[9]    = {-3, 2, 0, 0, -1, -5, 4, 0, 0};
+    double       k_error = 0;
+    for (unsigned int e = 0; e < 9; ++e)
+      k_error = std::max(k_error, std::abs(t.stiffness[e] - K[e]));
+    const auto full = palpate::interpolate_force(grid, only, x);
+    // Without one of the 4: not complete, not computed.
+    palpate::StateCache three(grid, 1 << 20);
+    for (unsigned int k = 1; k < 4; ++k)
+      three.publish(corners[path[k]],
+                    only.state(corners[path[k]]),
+                    three.generation());
+    const auto missing = palpate::interpolate_on_tetrahedron(grid, three, x);
+    deallog << "on the tetrahedron, 4 corners of 8 computed: complete ("
+            << (t.complete ? "yes" : "NO")
+            << "; trilinear needs all 8: " << (full.complete ? "NO" : "yes")
+            << "), a linear field exact to 1e-12 ("
+            << (palpate::Utilities::distance(t.force, f) < 1e-12 ? "yes" : "NO")
+            << "), its stiffness too (" << (k_error < 1e-9 ? "yes" : "NO")
+            << "); one of the 4 missing: complete "
+            << (missing.complete ? "yes" : "no") << ", not computed ("
+            << (missing.cause() == palpate::MissingCause::not_computed ? "yes" :
+                                                                         "NO")
+            << ")" << std::endl;
+  }
 }

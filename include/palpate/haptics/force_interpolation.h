@@ -39,8 +39,9 @@ namespace palpate
     /** Tricubic Hermite (C1): the 8 corners' forces, their active-node
      * stiffnesses and cross derivatives from the neighbours' stiffnesses. */
     hermite,
-    /** The sphere's contact solved against the 8 corners' contact
-     * patches for the actual HIP, blended trilinearly (PatchContact). */
+    /** The sphere's contact solved against the contact patches of the 4
+     * corners of the HIP's tetrahedron in its cell, for the actual HIP
+     * (PatchContact); complete once those 4 are computed. */
     contact_patch
   };
 
@@ -108,12 +109,26 @@ namespace palpate
    * any force field of total degree 3 exactly. A cell with a corner that
    * has no stiffness is interpolated trilinearly (sample.hermite false).
    * Real-time safe: 16 lock-free reads, about 300 flops, no allocation.
+   * Interpolation::contact_patch: interpolate_on_tetrahedron().
    */
   ForceSample
   interpolate_force(const StateGrid         &grid,
                     const StateCache        &cache,
                     const Utilities::Point3 &x,
                     const Interpolation      scheme) noexcept;
+
+  /**
+   * The force at @p x linear on the tetrahedron of its cell's Kuhn
+   * triangulation that holds it (simplex_weights()), from the forces of
+   * its 4 corners: complete once those are computed, whatever the cell's
+   * other corners. What Interpolation::contact_patch starts from (its
+   * patches then give the force, PatchContact) and falls back to where a
+   * corner's patch was dropped. Real-time safe: 4 lock-free reads.
+   */
+  ForceSample
+  interpolate_on_tetrahedron(const StateGrid         &grid,
+                             const StateCache        &cache,
+                             const Utilities::Point3 &x) noexcept;
 
   /**
    * The stiffness n . K n = -n . (df/dx) n (N/m) of the interpolated force

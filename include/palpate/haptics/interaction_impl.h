@@ -237,9 +237,14 @@ namespace palpate
         cache.end_patch_reads();
       cache.begin_patch_reads();
       patch_section_open = true;
-      bool all           = true;
-      for (unsigned int c = 0; c < 8 && all; ++c)
-        all = (patches[c] = cache.read_patch(sample.corners[c], generation));
+      // The cell's patches that are there (those of the other tetrahedra
+      // keep answering for missing data beyond this one's face); those of
+      // the HIP's tetrahedron are needed.
+      for (unsigned int c = 0; c < 8; ++c)
+        patches[c] = cache.read_patch(sample.corners[c], generation);
+      bool all = true;
+      for (const unsigned int c : simplex_corners(sample.local))
+        all = all && patches[c];
       last_patches_valid = all;
       if (all)
         {
@@ -279,11 +284,17 @@ namespace palpate
       for (unsigned int d = 0; d < 3; ++d)
         local[d] =
           std::clamp((position[d] - last_origin[d]) / grid.spacing(), 0.0, 1.0);
-      patch_contact->blend(last_patches,
-                           PatchContact::weights(local),
-                           position,
-                           force,
-                           &stiffness);
+      // The tetrahedron of the clamped position, less a corner whose patch
+      // was not there (the last cell was complete for another tetrahedron).
+      auto   weights = PatchContact::weights(local);
+      double total   = 0;
+      for (unsigned int c = 0; c < 8; ++c)
+        total += last_patches[c] ? weights[c] : (weights[c] = 0);
+      if (!(total > 0))
+        return false;
+      for (double &w : weights)
+        w /= total;
+      patch_contact->blend(last_patches, weights, position, force, &stiffness);
       return true;
     }
 
@@ -353,10 +364,14 @@ namespace palpate
         render_contact_patch(position, sample);
       if (sample.hits > 0 || sample.complete)
         {
-          corner_reads.fetch_add(8, std::memory_order_relaxed);
+          corner_reads.fetch_add(patch_contact ? 4 : 8,
+                                 std::memory_order_relaxed);
           corner_hits.fetch_add(sample.hits, std::memory_order_relaxed);
         }
-      if (sample.complete)
+      if (sample.complete && patch_contact)
+        for (const unsigned int c : simplex_corners(sample.local))
+          used[sample.corners[c]].store(1, std::memory_order_relaxed);
+      else if (sample.complete)
         for (const unsigned int c : sample.corners)
           used[c].store(1, std::memory_order_relaxed);
       return sample;

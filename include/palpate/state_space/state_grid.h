@@ -134,6 +134,14 @@ namespace palpate
    */
   std::array<double, 8>
   simplex_weights(const std::array<double, 3> &local) noexcept;
+
+  /**
+   * The 4 corners (ordered as StateGrid::corners()) of that tetrahedron,
+   * from corner 0 to corner 7, each the one before with one more upper
+   * axis: along the axes by decreasing coordinate of @p local.
+   */
+  std::array<unsigned int, 4>
+  simplex_corners(const std::array<double, 3> &local) noexcept;
 } // namespace palpate
 
 #endif
