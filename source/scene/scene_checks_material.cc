@@ -210,6 +210,7 @@ namespace palpate
           throw error(section + "/" + name + "/" + e.entry, e.problem, e.fix);
         }
     };
+    check("mesh source", "Mesh", p.mesh.source, p.mesh.own);
     check("device", "Haptics", p.haptics.device, p.haptics.own);
     check("trajectory",
           "Haptics/Trajectory",

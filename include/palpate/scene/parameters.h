@@ -32,8 +32,13 @@ namespace palpate
     /** `subsection Mesh`: where the body's tetrahedral mesh comes from. */
     struct Mesh
     {
-      /** "file", "surface", "beam" or "blob". */
+      /** The mesh source plug-in's name (MeshSourceRegistry,
+       * mesh/mesh_source.h), e.g. "file". */
       std::string source;
+      /** Each mesh source plug-in's own entries (plug-in name -> its
+       * subsection's values); the built-in sources have none: they read
+       * the entries below. */
+      std::map<std::string, Plugins::Entries> own;
       /** Mesh file (.msh Gmsh 2.2 or v1, .vtk, .vtu) as written in the scene.
        */
       std::string file_name;
