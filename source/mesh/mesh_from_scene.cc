@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/base/exceptions.h>
+#include <palpate/mesh/fixed_region.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/mesh_source.h>
 #include <palpate/scene/scene.h>
@@ -40,12 +41,12 @@ namespace palpate
       const double size   = mesh.diameter();
       const auto  &x      = mesh.vertices();
       const auto  &bc     = scene.parameters.boundary_conditions;
-      const auto  &fixed  = bc.fixed_nodes;
+      const auto   region = FixedRegion::create(scene);
       // Whether 0 < k < n vertices at scale s lie in the fixed region.
-      const auto splits = [&](const double s, const auto &in_region) {
+      const auto splits = [&](const double s) {
         std::size_t k = 0;
         for (const auto &v : x)
-          k += in_region(Utilities::scaled(v, s));
+          k += region->contains(Utilities::scaled(v, s));
         return k > 0 && k < x.size();
       };
       const auto fits = [&](const double f) {
@@ -60,27 +61,12 @@ namespace palpate
                                                      bc.active_node.point));
             n += nearest <= 0.05 * size * s;
           }
-        if (fixed.selection == "box")
-          n += splits(s, [&](const Utilities::Point3 &v) {
-            for (unsigned int d = 0; d < 3; ++d)
-              if (v[d] < fixed.box_lower_corner[d] ||
-                  v[d] > fixed.box_upper_corner[d])
-                return false;
-            return true;
-          });
-        if (fixed.selection == "half-space")
-          n += splits(s, [&](const Utilities::Point3 &v) {
-            double dot = 0;
-            for (unsigned int d = 0; d < 3; ++d)
-              dot +=
-                (v[d] - fixed.half_space_point[d]) * fixed.half_space_normal[d];
-            return dot >= 0;
-          });
+        if (region->is_place())
+          n += splits(s);
         return n;
       };
       ScaleSuggestion best;
-      best.of = (bc.active_node.selection != "node id") +
-                (fixed.selection == "box" || fixed.selection == "half-space");
+      best.of = (bc.active_node.selection != "node id") + region->is_place();
       const auto consider = [&](const double f) {
         const double scaled = size * f / factor;
         if (!(scaled >= Limits::min_body_size &&

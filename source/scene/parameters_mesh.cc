@@ -267,14 +267,17 @@ namespace palpate
     {
       prm.enter_subsection("Fixed nodes");
       {
-        prm.declare_entry(
+        // The regions are plug-ins (mesh/fixed_region.h): the choice comes
+        // from their declarations; the entries below are the built-in
+        // regions'.
+        internal::declare_plugin_choice(
+          prm,
+          "fixed region",
           "Selection",
           "half-space",
-          Patterns::Selection("boundary id|box|half-space|node list"),
           "How the nodes held at zero displacement (homogeneous Dirichlet) "
-          "are chosen: all nodes on boundary faces with given ids, the nodes "
-          "inside an axis-aligned box, the nodes in a half-space, or an "
-          "explicit list of node numbers.");
+          "are chosen:",
+          "");
         prm.declare_entry("Boundary ids",
                           "1",
                           Patterns::List(Patterns::Integer(0), 1),
@@ -338,6 +341,7 @@ namespace palpate
       prm.enter_subsection("Fixed nodes");
       {
         selection          = prm.get("Selection");
+        own                = internal::own_entries(prm, "fixed region");
         boundary_ids       = get_list<unsigned int>(prm, "Boundary ids");
         box_lower_corner   = internal::get_point(prm, "Box lower corner");
         box_upper_corner   = internal::get_point(prm, "Box upper corner");

@@ -3,8 +3,8 @@
 
 // The checks of a scene's body and its boundary conditions
 // (Scene::validate()): the probe's tip and its radius, the mesh's scale, and
-// through its plug-in the mesh source's entries (its file, the generated
-// beam's or blob's size), and the fixed-node region.
+// through their plug-ins the mesh source's entries (its file, the generated
+// beam's or blob's size) and the fixed-node region's.
 
 #include <palpate/scene/scene_impl.h>
 
@@ -85,31 +85,10 @@ namespace palpate
   void
   Scene::check_fixed_nodes() const
   {
-    using namespace Limits;
-    const auto &p = parameters;
-
-    // Fixed nodes: the region must be well-defined.
-    const auto &f = p.boundary_conditions.fixed_nodes;
-    if (f.selection == "box")
-      for (unsigned int d = 0; d < 3; ++d)
-        if (!(f.box_lower_corner[d] < f.box_upper_corner[d]))
-          throw error("Boundary conditions/Fixed nodes/Box upper corner",
-                      "the box is empty: its upper corner is not above its "
-                      "lower corner in every coordinate",
-                      "make each coordinate of Box upper corner larger than "
-                      "that of Box lower corner.");
-    if (f.selection == "half-space" &&
-        std::max({std::abs(f.half_space_normal[0]),
-                  std::abs(f.half_space_normal[1]),
-                  std::abs(f.half_space_normal[2])}) == 0)
-      throw error("Boundary conditions/Fixed nodes/Half-space normal",
-                  "the normal is the zero vector",
-                  "give the direction pointing into the fixed half-space, "
-                  "e.g. 0, 0, -1.");
-    if (f.selection == "node list" && f.node_ids.empty())
-      throw error("Boundary conditions/Fixed nodes/Node ids",
-                  "Selection = node list, but the list is empty",
-                  "list the node numbers to fix, separated by commas.");
+    // The fixed region checks the entries that define it
+    // (mesh/fixed_regions/): the region must be well-defined.
+    const auto &f = parameters.boundary_conditions.fixed_nodes;
+    Plugins::check_scene("fixed region", f.selection, *this);
   }
 
 } // namespace palpate

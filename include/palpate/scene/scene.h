@@ -166,8 +166,8 @@ namespace palpate
     /** validate(): each enabled effect plug-in's entries. */
     void
     check_effects() const;
-    /** The own entries of the chosen mesh source, device, trajectory and
-     * linear solver plug-ins (Plugins::check_entries). */
+    /** The own entries of the chosen mesh source, fixed region, device,
+     * trajectory and linear solver plug-ins (Plugins::check_entries). */
     void
     check_plugin_entries() const;
 
@@ -180,7 +180,8 @@ namespace palpate
     void
     check_mesh() const;
 
-    /** validate(): the fixed-node region. */
+    /** validate(): the fixed-node region's entries
+     * (Plugins::check_scene()). */
     void
     check_fixed_nodes() const;
 
