@@ -6,6 +6,7 @@
 #include <palpate/hyperelastic/material.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/mesh_quality.h>
+#include <palpate/mesh/mesh_source.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
@@ -75,17 +76,16 @@ namespace palpate
 
     /** The mesh: its source, counts, size and quality, and warnings. */
     void
-    report_mesh(std::ostream                    &s,
-                const Parameters::AllParameters &p,
-                const Mesh                      &mesh,
-                const NodeSelection             &nodes)
+    report_mesh(std::ostream        &s,
+                const Scene         &scene,
+                const Mesh          &mesh,
+                const NodeSelection &nodes)
     {
-      const auto box = mesh.bounding_box();
+      const auto &p      = scene.parameters;
+      const auto  source = MeshSource::create(scene);
+      const auto  box    = mesh.bounding_box();
       s << "Mesh\n"
-        << "  source:        " << mesh.description();
-      if (p.mesh.source == "file")
-        s << ", scaled by " << std::setprecision(6) << p.mesh.scale_factor
-          << std::setprecision(4) << " m/unit";
+        << "  source:        " << source->description(mesh, scene);
       s << "\n  nodes:         " << mesh.n_vertices() << " ("
         << mesh.n_surface_vertices() << " on the surface)";
       if (mesh.n_merged_nodes() > 0)
@@ -108,11 +108,8 @@ namespace palpate
       // (2 mm and 2 m are refused outright).
       if (const std::string advice =
             unit_advice(mesh.diameter(),
-                        p.mesh.source == "file" || p.mesh.source == "surface" ?
-                          p.mesh.scale_factor :
-                          1.0);
-          !advice.empty() &&
-          (p.mesh.source == "file" || p.mesh.source == "surface"))
+                        source->from_file() ? p.mesh.scale_factor : 1.0);
+          !advice.empty() && source->from_file())
         s << "  warning:       the body is " << mesh.diameter()
           << " m across: is Mesh / Scale factor right? " << advice << ".\n";
     }
@@ -248,7 +245,7 @@ namespace palpate
     std::ostringstream s;
     s << std::setprecision(4);
     report_command_line(s, scene);
-    report_mesh(s, scene.parameters, mesh, nodes);
+    report_mesh(s, scene, mesh, nodes);
     report_boundary_conditions(s, scene.parameters, mesh, nodes);
     report_material(s, scene.parameters);
     report_effects(s, scene.parameters, mesh, nodes);

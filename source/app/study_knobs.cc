@@ -10,6 +10,7 @@
 #include <palpate/app/study_impl.h>
 #include <palpate/base/exceptions.h>
 #include <palpate/hyperelastic/material.h>
+#include <palpate/mesh/mesh_source.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -111,52 +112,13 @@ namespace palpate
                   "the mesh's error.");
               }
           }
-        else if (m.source == "file")
+        else if (const auto names =
+                   MeshSource::create(scene)->make_finer(m, scene))
           {
-            std::filesystem::path file(m.file_name);
-            if (file.is_relative() && !scene.file().empty())
-              file = std::filesystem::path(scene.file()).parent_path() / file;
-            const auto sibling = file.parent_path() / "liver2k.msh";
-            if (file.filename() == "liver501.msh" &&
-                std::filesystem::exists(sibling))
-              {
-                m.file_name = std::filesystem::absolute(sibling).string();
-                finer_name  = "liver2k";
-                coarse_name = "liver501";
-                finer       = f;
-              }
-          }
-        else if (m.source == "surface")
-          {
-            // The same surface, finer: the refinement around the probe
-            // halved (the indenter's region), or twice the nodes.
-            if (m.surface_fine_size > 0)
-              {
-                coarse_name = "refinement " + mm(m.surface_fine_size);
-                m.surface_fine_size /= 2;
-                finer_name = "refinement " + mm(m.surface_fine_size);
-              }
-            else
-              {
-                coarse_name = std::to_string(m.surface_target_nodes) + " nodes";
-                m.surface_target_nodes *= 2;
-                finer_name = std::to_string(m.surface_target_nodes) + " nodes";
-              }
-            finer = f;
-          }
-        else if (m.source == "blob")
-          {
-            ++m.blob_refinements;
-            finer_name =
-              "blob, " + std::to_string(m.blob_refinements) + " refinements";
-            finer = f;
-          }
-        else if (m.source == "beam")
-          {
-            m.beam_subdivisions_length *= 2;
-            m.beam_subdivisions_width *= 2;
-            m.beam_subdivisions_height *= 2;
-            finer_name = "beam, twice the subdivisions";
+            // The scene's mesh source knows a finer mesh of the body.
+            if (!names->coarse_name.empty())
+              coarse_name = names->coarse_name;
+            finer_name = names->finer_name;
             finer      = f;
           }
       }

@@ -95,6 +95,18 @@ namespace palpate
 
 
 
+    void
+    check_scene(const std::string &kind,
+                const std::string &name,
+                const Scene       &scene)
+    {
+      for (const auto &d : declarations(kind))
+        if (d.name == name && d.check_scene != nullptr)
+          d.check_scene(scene);
+    }
+
+
+
     std::string
     selection(const std::string &kind)
     {

@@ -2,197 +2,18 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/base/exceptions.h>
-#include <palpate/mesh/generators.h>
+#include <palpate/mesh/fixed_region.h>
 #include <palpate/mesh/mesh.h>
-#include <palpate/mesh/mesh_file.h>
-#include <palpate/mesh/surface.h>
-#include <palpate/mesh/volume_mesher.h>
+#include <palpate/mesh/mesh_source.h>
 #include <palpate/scene/scene.h>
 
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <limits>
-#include <memory>
-#include <sstream>
 
 namespace palpate
 {
-  namespace
-  {
-    /**
-     * @p e with the scene that reads the file named in its fix, so that the
-     * user knows where to point it elsewhere.
-     */
-    InputError
-    read_by(const InputError &e, const Scene &scene, const std::string &what)
-    {
-      return InputError(e.file(),
-                        e.line(),
-                        e.entry(),
-                        e.problem(),
-                        e.fix() + " (The scene '" + scene.file() + "' reads " +
-                          what + " through Mesh / File name.)");
-    }
-
-    /**
-     * The bytes of the surface file Mesh / File name names (resolved to
-     * @p path), with errors that point at that entry.
-     */
-    std::string
-    surface_bytes(const Scene &scene, const std::string &path)
-    {
-      const auto &p = scene.parameters.mesh;
-      try
-        {
-          check_file_size(path,
-                          "surface file",
-                          max_mesh_file_bytes,
-                          "an organ's surface of 100,000 triangles has "
-                          "about 5 MiB");
-        }
-      catch (const InputError &e)
-        {
-          throw scene.error("Mesh/File name", e.problem(), e.fix());
-        }
-      std::ifstream in(path, std::ios::binary);
-      if (!in)
-        {
-          // A name the file system refuses (a loop of links, too long,
-          // no permission) is said as such, not as a missing file.
-          bool              missing = false;
-          const std::string why     = why_cannot_open(path, &missing);
-          if (!missing && !why.empty())
-            throw scene.error("Mesh/File name",
-                              "the surface file '" + path +
-                                "' cannot be read: " + why,
-                              "check the path, the links on the way and "
-                              "the permissions.");
-          throw scene.error(
-            "Mesh/File name",
-            "the surface file '" + p.file_name +
-              "' was not found: looked for " + scene.where_looked(p.file_name),
-            "a relative path is relative to the scene file's directory; "
-            "the example organs are in the project's meshes/ (its "
-            "README), e.g. '../meshes/liver-tetgen/liver2k-surface.obj' "
-            "from parameters/.");
-        }
-      std::ostringstream s;
-      s << in.rdbuf();
-      return s.str();
-    }
-
-
-
-    /**
-     * Where the volume mesh of the surface at @p path (its bytes @p bytes)
-     * is kept: in Mesh / Surface / Volume mesh directory, named by a hash
-     * of the bytes, the scale factor and the target, so a changed surface
-     * or setting is meshed again and an unchanged one never is.
-     */
-    std::filesystem::path
-    volume_mesh_file(const Scene       &scene,
-                     const std::string &path,
-                     const std::string &bytes)
-    {
-      namespace fs       = std::filesystem;
-      const auto   &p    = scene.parameters.mesh;
-      std::uint64_t hash = 1469598103934665603ull; // FNV-1a
-      for (const char c :
-           bytes + "|" + Utilities::to_string(p.scale_factor, 17) + "|" +
-             // -2: the mesher's node-count correction changed (within
-             // 10 %); meshes of older builds are made again.
-             std::to_string(p.surface_target_nodes) + "|palpate-mesh-2" +
-             (p.surface_fine_size > 0 ?
-                "|graded " + Utilities::to_string(p.surface_fine_size, 17) +
-                  " " + Utilities::to_string(p.surface_fine_radius, 17) + " " +
-                  Utilities::to_string(
-                    scene.parameters.boundary_conditions.active_node.point,
-                    17) :
-                std::string()))
-        hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
-      char hex[17];
-      std::snprintf(hex, sizeof(hex), "%016llx", (unsigned long long)hash);
-      const fs::path  directory(p.surface_mesh_directory);
-      std::error_code ec;
-      fs::create_directories(directory, ec);
-      if (ec || !fs::is_directory(directory))
-        throw scene.error("Mesh/Surface/Volume mesh directory",
-                          "the directory '" + directory.string() +
-                            "' cannot be created (" + ec.message() + ")",
-                          "name a directory palpate may write to.");
-      return directory / (fs::path(path).stem().string() + "-" +
-                          std::to_string(p.surface_target_nodes) + "-" +
-                          std::string(hex).substr(0, 8) + ".msh");
-    }
-
-
-
-    /**
-     * Mesh / Source = surface: the volume mesh palpate made of the surface
-     * before (volume_mesh_file()), or a new one.
-     */
-    Mesh
-    from_surface(const Scene &scene)
-    {
-      namespace fs        = std::filesystem;
-      const auto    &p    = scene.parameters.mesh;
-      const auto     path = scene.resolve_path(p.file_name);
-      const fs::path file =
-        volume_mesh_file(scene, path, surface_bytes(scene, path));
-      std::string how = "reused";
-      // A mesh whose node-count corrections the time limit stopped is
-      // used once and not kept: with more time the next run does better.
-      bool keep = true;
-      if (std::error_code exists_error; !fs::exists(file, exists_error))
-        try
-          {
-            MeshGrading grading;
-            grading.fine_size = p.surface_fine_size;
-            grading.radius    = p.surface_fine_radius;
-            grading.center =
-              scene.parameters.boundary_conditions.active_node.point;
-            const auto report = mesh_surface_file(path,
-                                                  p.scale_factor,
-                                                  "Mesh / Scale factor",
-                                                  p.surface_target_nodes,
-                                                  p.surface_time_limit,
-                                                  file.string(),
-                                                  grading);
-            how               = "meshed now in " +
-                  Utilities::to_string(report.meshing.seconds, 3) + " s";
-            const auto repairs = report.repairs.lines();
-            for (const auto &r : repairs)
-              how += "; " + r;
-            // The mesher's warnings (a node count it could not meet,
-            // slivers) reach the scene report too, not only palpate mesh.
-            for (const auto &line : report.lines())
-              if (line.rfind("warning:", 0) == 0)
-                how += "; " + Utilities::trim(line);
-            keep = !report.meshing.stopped_by_time_limit;
-          }
-        catch (const InputError &e)
-          {
-            throw read_by(e, scene, "this surface");
-          }
-      Mesh mesh(read_mesh_file(file.string()),
-                1.0,
-                p.file_name + ", meshed by palpate into " + file.string() +
-                  " (" + how + (keep ? "" : "; not kept") + ")");
-      if (!keep)
-        {
-          std::error_code error;
-          fs::remove(file, error);
-        }
-      return mesh;
-    }
-  } // namespace
-
-
-
   namespace
   {
     /** A scale factor to suggest for a mesh read in the wrong unit. */
@@ -220,12 +41,12 @@ namespace palpate
       const double size   = mesh.diameter();
       const auto  &x      = mesh.vertices();
       const auto  &bc     = scene.parameters.boundary_conditions;
-      const auto  &fixed  = bc.fixed_nodes;
+      const auto   region = FixedRegion::create(scene);
       // Whether 0 < k < n vertices at scale s lie in the fixed region.
-      const auto splits = [&](const double s, const auto &in_region) {
+      const auto splits = [&](const double s) {
         std::size_t k = 0;
         for (const auto &v : x)
-          k += in_region(Utilities::scaled(v, s));
+          k += region->contains(Utilities::scaled(v, s));
         return k > 0 && k < x.size();
       };
       const auto fits = [&](const double f) {
@@ -240,27 +61,12 @@ namespace palpate
                                                      bc.active_node.point));
             n += nearest <= 0.05 * size * s;
           }
-        if (fixed.selection == "box")
-          n += splits(s, [&](const Utilities::Point3 &v) {
-            for (unsigned int d = 0; d < 3; ++d)
-              if (v[d] < fixed.box_lower_corner[d] ||
-                  v[d] > fixed.box_upper_corner[d])
-                return false;
-            return true;
-          });
-        if (fixed.selection == "half-space")
-          n += splits(s, [&](const Utilities::Point3 &v) {
-            double dot = 0;
-            for (unsigned int d = 0; d < 3; ++d)
-              dot +=
-                (v[d] - fixed.half_space_point[d]) * fixed.half_space_normal[d];
-            return dot >= 0;
-          });
+        if (region->is_place())
+          n += splits(s);
         return n;
       };
       ScaleSuggestion best;
-      best.of = (bc.active_node.selection != "node id") +
-                (fixed.selection == "box" || fixed.selection == "half-space");
+      best.of = (bc.active_node.selection != "node id") + region->is_place();
       const auto consider = [&](const double f) {
         const double scaled = size * f / factor;
         if (!(scaled >= Limits::min_body_size &&
@@ -330,55 +136,11 @@ namespace palpate
             ", and " + Utilities::to_string(factor * 0.25 / size, 4) +
             " makes it 0.25 m (a liver).");
       };
-      const auto &p = scene.parameters.mesh;
-      if (p.source == "beam")
-        return Mesh(generate_beam(p), 1.0, "the beam generator");
-      if (p.source == "blob")
-        return Mesh(generate_blob(p), 1.0, "the blob generator");
-
-      if (p.source == "surface")
-        {
-          auto mesh = from_surface(scene);
-          check_size(scene, mesh);
-          return mesh;
-        }
-
-      // (.vtk holds either, and its reader tells them apart.)
-      if (is_surface_file_name(p.file_name) &&
-          std::filesystem::path(p.file_name).extension() != ".vtk")
-        throw scene.error("Mesh/Source",
-                          "Source = file reads a tetrahedral mesh, but '" +
-                            p.file_name + "' is a surface",
-                          "set Source = surface: palpate then meshes the "
-                          "surface (and keeps the mesh for the next run).");
-      const std::string path = scene.resolve_path(p.file_name);
-      // error_code: a name the file system refuses (too long, a loop of
-      // links) is reported below as a file that cannot be read.
-      std::error_code exists_error;
-      if (!std::filesystem::exists(path, exists_error) && !exists_error)
-        throw scene.error(
-          "Mesh/File name",
-          "the mesh file '" + p.file_name + "' was not found: looked for " +
-            scene.where_looked(p.file_name),
-          "a relative path is relative to the scene file's directory; the "
-          "example organs are in the project's meshes/ (its README), e.g. "
-          "'../meshes/liver-tetgen/liver501.msh' from parameters/. Or use "
-          "Source = blob, which needs no file.");
-      std::unique_ptr<Mesh> mesh;
-      try
-        {
-          // Errors about the file's content name the file as the scene
-          // writes it (and the report shows it that way too).
-          mesh = std::make_unique<Mesh>(read_mesh_file(path),
-                                        p.scale_factor,
-                                        p.file_name);
-        }
-      catch (const InputError &e)
-        {
-          throw read_by(e, scene, "this file");
-        }
-      check_size(scene, *mesh);
-      return std::move(*mesh);
+      const auto source = MeshSource::create(scene);
+      Mesh       mesh   = source->create_mesh(scene);
+      if (source->from_file())
+        check_size(scene, mesh);
+      return mesh;
     }
   } // namespace
 

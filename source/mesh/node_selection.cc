@@ -2,6 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 #include <palpate/hyperelastic/effect.h>
+#include <palpate/mesh/fixed_region.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/mesh/node_selection_impl.h>
@@ -11,7 +12,6 @@
 #include <cmath>
 #include <limits>
 #include <set>
-#include <sstream>
 
 namespace palpate
 {
@@ -20,7 +20,6 @@ namespace palpate
     using Utilities::Point3;
 
     using Utilities::cross;
-    using Utilities::dot;
     using Utilities::minus;
 
     /**
@@ -67,7 +66,7 @@ namespace palpate
   namespace
   {
     /** The fixed nodes a scene selects, and how it selects them. */
-    struct FixedRegion
+    struct FixedSelection
     {
       std::set<unsigned int> fixed;
       /** The scene entry that defines the region, for messages. */
@@ -79,90 +78,17 @@ namespace palpate
 
 
 
-    /** The fixed nodes the scene's Fixed nodes section selects. */
-    FixedRegion
+    /** The fixed nodes the scene's fixed region (Fixed nodes / Selection,
+     * mesh/fixed_regions/) selects. */
+    FixedSelection
     select_fixed(const Scene &scene, const Mesh &mesh)
     {
-      const auto &f       = scene.parameters.boundary_conditions.fixed_nodes;
-      const auto &x       = mesh.vertices();
-      const auto &surface = mesh.on_surface();
-
-      std::set<unsigned int> fixed;
-      std::string            region_entry;
-      unsigned int       in_region = 0; // nodes in the region, surface or not
-      std::ostringstream description;
-
-      if (f.selection == "boundary id")
-        {
-          region_entry = "Boundary conditions/Fixed nodes/Boundary ids";
-          const std::set<unsigned int> ids(f.boundary_ids.begin(),
-                                           f.boundary_ids.end());
-          for (const auto &face : mesh.surface_faces())
-            if (ids.count(face.boundary_id))
-              fixed.insert(face.vertices.begin(), face.vertices.end());
-          in_region = fixed.size();
-          description << "nodes on boundary faces with id";
-          for (const auto id : f.boundary_ids)
-            description << " " << id;
-        }
-      else if (f.selection == "box" || f.selection == "half-space")
-        {
-          const bool box = f.selection == "box";
-          region_entry   = box ?
-                             "Boundary conditions/Fixed nodes/Box lower corner" :
-                             "Boundary conditions/Fixed nodes/Half-space point";
-          for (unsigned int v = 0; v < x.size(); ++v)
-            {
-              bool inside = true;
-              if (box)
-                {
-                  for (unsigned int d = 0; d < 3; ++d)
-                    inside = inside && x[v][d] >= f.box_lower_corner[d] &&
-                             x[v][d] <= f.box_upper_corner[d];
-                }
-              else
-                inside = dot(minus(x[v], f.half_space_point),
-                             f.half_space_normal) >= 0;
-              if (inside)
-                {
-                  ++in_region;
-                  if (!f.surface_nodes_only || surface[v])
-                    fixed.insert(v);
-                }
-            }
-          if (box)
-            description << "nodes in the box ["
-                        << Utilities::to_string(f.box_lower_corner, 4)
-                        << "] - ["
-                        << Utilities::to_string(f.box_upper_corner, 4) << "] m";
-          else
-            description << "nodes x with (x - ("
-                        << Utilities::to_string(f.half_space_point, 4)
-                        << ")) . ("
-                        << Utilities::to_string(f.half_space_normal, 4)
-                        << ") >= 0";
-          if (f.surface_nodes_only)
-            description << ", surface only";
-        }
-      else // node list
-        {
-          region_entry = "Boundary conditions/Fixed nodes/Node ids";
-          for (const long id : f.node_ids)
-            {
-              const auto v = mesh.vertex_of_node_id(id);
-              if (!v)
-                throw scene.error(region_entry,
-                                  "the mesh has no node " + std::to_string(id),
-                                  "use node numbers as the mesh file numbers "
-                                  "them (Gmsh node tags, VTK point indices "
-                                  "from 0); the VTU output shows them as "
-                                  "'node id'.");
-              fixed.insert(*v);
-            }
-          in_region = fixed.size();
-          description << "node list (" << fixed.size() << " nodes)";
-        }
-      return {fixed, region_entry, in_region, description.str()};
+      const auto region   = FixedRegion::create(scene);
+      const auto selected = region->select(scene, mesh);
+      return {selected.fixed,
+              region->entry(),
+              selected.in_region,
+              region->description(selected)};
     }
 
 
@@ -172,7 +98,9 @@ namespace palpate
      * not all on one line.
      */
     void
-    check_fixed(const Scene &scene, const Mesh &mesh, const FixedRegion &region)
+    check_fixed(const Scene          &scene,
+                const Mesh           &mesh,
+                const FixedSelection &region)
     {
       const auto &x            = mesh.vertices();
       const auto &fixed        = region.fixed;
@@ -367,8 +295,8 @@ namespace palpate
   {
     const auto &a = scene.parameters.boundary_conditions.active_node;
 
-    NodeSelection     selection;
-    const FixedRegion region = select_fixed(scene, mesh);
+    NodeSelection        selection;
+    const FixedSelection region = select_fixed(scene, mesh);
     check_fixed(scene, mesh, region);
     selection.fixed_vertices.assign(region.fixed.begin(), region.fixed.end());
     selection.fixed_description = region.description;

@@ -151,16 +151,16 @@ namespace palpate
     {
       prm.enter_subsection("Mesh");
       {
-        prm.declare_entry("Source",
-                          "blob",
-                          Patterns::Selection("file|surface|beam|blob"),
-                          "Where the tetrahedral mesh of the body comes from: "
-                          "a mesh file; an organ's closed surface (File name: "
-                          ".stl, .obj, .ply, .vtk or .vtp), meshed by palpate "
-                          "(see subsection Surface) and kept for the next "
-                          "run; or one of the built-in generators (a "
-                          "rectangular beam, an organ-like blob), which need "
-                          "no external data.");
+        // The sources are plug-ins (mesh/mesh_source.h): the choice comes
+        // from their declarations; the entries below are the built-in
+        // sources', shared where two read one (File name, Scale factor).
+        internal::declare_plugin_choice(
+          prm,
+          "mesh source",
+          "Source",
+          "blob",
+          "Where the tetrahedral mesh of the body comes from:",
+          "");
         prm.declare_entry(
           "File name",
           "",
@@ -196,6 +196,7 @@ namespace palpate
     {
       const auto entries = [](const Mesh &m) {
         return std::tie(m.source,
+                        m.own,
                         m.file_name,
                         m.scale_factor,
                         m.beam_length,
@@ -223,6 +224,7 @@ namespace palpate
       prm.enter_subsection("Mesh");
       {
         source       = prm.get("Source");
+        own          = internal::own_entries(prm, "mesh source");
         file_name    = prm.get("File name");
         scale_factor = prm.get_double("Scale factor");
 
@@ -265,14 +267,17 @@ namespace palpate
     {
       prm.enter_subsection("Fixed nodes");
       {
-        prm.declare_entry(
+        // The regions are plug-ins (mesh/fixed_region.h): the choice comes
+        // from their declarations; the entries below are the built-in
+        // regions'.
+        internal::declare_plugin_choice(
+          prm,
+          "fixed region",
           "Selection",
           "half-space",
-          Patterns::Selection("boundary id|box|half-space|node list"),
           "How the nodes held at zero displacement (homogeneous Dirichlet) "
-          "are chosen: all nodes on boundary faces with given ids, the nodes "
-          "inside an axis-aligned box, the nodes in a half-space, or an "
-          "explicit list of node numbers.");
+          "are chosen:",
+          "");
         prm.declare_entry("Boundary ids",
                           "1",
                           Patterns::List(Patterns::Integer(0), 1),
@@ -336,6 +341,7 @@ namespace palpate
       prm.enter_subsection("Fixed nodes");
       {
         selection          = prm.get("Selection");
+        own                = internal::own_entries(prm, "fixed region");
         boundary_ids       = get_list<unsigned int>(prm, "Boundary ids");
         box_lower_corner   = internal::get_point(prm, "Box lower corner");
         box_upper_corner   = internal::get_point(prm, "Box upper corner");

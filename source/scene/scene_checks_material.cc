@@ -210,6 +210,11 @@ namespace palpate
           throw error(section + "/" + name + "/" + e.entry, e.problem, e.fix);
         }
     };
+    check("mesh source", "Mesh", p.mesh.source, p.mesh.own);
+    check("fixed region",
+          "Boundary conditions/Fixed nodes",
+          p.boundary_conditions.fixed_nodes.selection,
+          p.boundary_conditions.fixed_nodes.own);
     check("device", "Haptics", p.haptics.device, p.haptics.own);
     check("trajectory",
           "Haptics/Trajectory",

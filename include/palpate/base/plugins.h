@@ -17,6 +17,8 @@ namespace dealii
 
 namespace palpate
 {
+  class Scene;
+
   /**
    * Pieces of palpate chosen by name in a scene (materials, effects) are
    * plug-ins, registered the way ASPECT registers its material models: the
@@ -73,6 +75,19 @@ namespace palpate
       return false;
     }
 
+    template <typename Class>
+    constexpr auto
+    has_scene_check(int) -> decltype(&Class::check_scene, bool())
+    {
+      return true;
+    }
+    template <typename Class>
+    constexpr bool
+    has_scene_check(long)
+    {
+      return false;
+    }
+
     /**
      * What a scene needs of a plug-in to declare it: its name, description
      * and entries, without its interface. The scene declares the plug-ins
@@ -87,6 +102,11 @@ namespace palpate
       /** Checks the plug-in's own entries when the scene is read (throws
        * EntryError); nullptr if it has no check_parameters(). */
       void (*check_parameters)(const dealii::ParameterHandler &own) = nullptr;
+      /** Checks the entries of the scene the plug-in reads outside its own
+       * subsection (a mesh source: File name, Mesh / Beam) when the scene
+       * is read, throwing the scene's InputError (Scene::error()); nullptr
+       * if it has no check_scene(). */
+      void (*check_scene)(const Scene &scene) = nullptr;
     };
 
     /** A plug-in class's `static void check_parameters(const
@@ -102,12 +122,32 @@ namespace palpate
         return nullptr;
     }
 
+    /** A plug-in class's `static void check_scene(const Scene &scene)`, or
+     * nullptr if it has none: what the scene's shared entries must satisfy
+     * for it (a mesh source that reads a file needs File name), checked
+     * when the scene is read. */
+    template <typename Class>
+    constexpr void (*scene_check_function())(const Scene &)
+    {
+      if constexpr (has_scene_check<Class>(0))
+        return &Class::check_scene;
+      else
+        return nullptr;
+    }
+
     /** Check the own @p entries of the plug-in of @p kind called @p name
      * (their patterns, then its check_parameters()): throws EntryError. */
     void
     check_entries(const std::string &kind,
                   const std::string &name,
                   const Entries     &entries);
+
+    /** Run the check_scene() of the plug-in of @p kind called @p name on
+     * @p scene, if it has one: throws the scene's InputError. */
+    void
+    check_scene(const std::string &kind,
+                const std::string &name,
+                const Scene       &scene);
 
     /** Add @p declaration to those of @p kind (at static initialisation,
      * by a registration macro). */
@@ -227,24 +267,26 @@ namespace palpate
  * Context...>) under @p name, and its Declaration as one of @p kind, so that
  * the scene declares and checks its entries without including its interface
  * (devices, trajectories, linear solvers). The class also provides an
- * optional `static void check_parameters(const dealii::ParameterHandler &)`.
+ * optional `static void check_parameters(const dealii::ParameterHandler &)`
+ * and an optional `static void check_scene(const Scene &)`.
  */
-#define PALPATE_REGISTER_DECLARED_PLUGIN(                     \
-  Registry, kind, classname, name, description)               \
-  namespace                                                   \
-  {                                                           \
-    [[maybe_unused]] const bool                               \
-      palpate_declared_plugin_registered_##classname =        \
-        Registry::add({name,                                  \
-                       description,                           \
-                       &classname::declare_parameters,        \
-                       &classname::create}) &&                \
-        ::palpate::Plugins::add_declaration(                  \
-          kind,                                               \
-          {name,                                              \
-           description,                                       \
-           &classname::declare_parameters,                    \
-           ::palpate::Plugins::check_function<classname>()}); \
+#define PALPATE_REGISTER_DECLARED_PLUGIN(                           \
+  Registry, kind, classname, name, description)                     \
+  namespace                                                         \
+  {                                                                 \
+    [[maybe_unused]] const bool                                     \
+      palpate_declared_plugin_registered_##classname =              \
+        Registry::add({name,                                        \
+                       description,                                 \
+                       &classname::declare_parameters,              \
+                       &classname::create}) &&                      \
+        ::palpate::Plugins::add_declaration(                        \
+          kind,                                                     \
+          {name,                                                    \
+           description,                                             \
+           &classname::declare_parameters,                          \
+           ::palpate::Plugins::check_function<classname>(),         \
+           ::palpate::Plugins::scene_check_function<classname>()}); \
   }
 
 #endif

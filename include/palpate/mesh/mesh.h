@@ -60,8 +60,9 @@ namespace palpate
     ~Mesh();
 
     /**
-     * The mesh a scene describes (a file or a generator). Errors about the
-     * mesh file name that file; errors about finding it name the scene
+     * The mesh a scene describes, made by its mesh source (Mesh / Source,
+     * mesh/mesh_source.h: a file, a surface or a generator). Errors about
+     * the mesh file name that file; errors about finding it name the scene
      * entry.
      */
     static Mesh

@@ -32,8 +32,13 @@ namespace palpate
     /** `subsection Mesh`: where the body's tetrahedral mesh comes from. */
     struct Mesh
     {
-      /** "file", "surface", "beam" or "blob". */
+      /** The mesh source plug-in's name (MeshSourceRegistry,
+       * mesh/mesh_source.h), e.g. "file". */
       std::string source;
+      /** Each mesh source plug-in's own entries (plug-in name -> its
+       * subsection's values); the built-in sources have none: they read
+       * the entries below. */
+      std::map<std::string, Plugins::Entries> own;
       /** Mesh file (.msh Gmsh 2.2 or v1, .vtk, .vtu) as written in the scene.
        */
       std::string file_name;
@@ -79,8 +84,13 @@ namespace palpate
     /** `subsection Boundary conditions / subsection Fixed nodes`. */
     struct FixedNodes
     {
-      /** "boundary id", "box", "half-space" or "node list". */
+      /** The fixed region plug-in's name (FixedRegionRegistry,
+       * mesh/fixed_region.h), e.g. "box". */
       std::string selection;
+      /** Each fixed region plug-in's own entries (plug-in name -> its
+       * subsection's values); the built-in regions have none: they read
+       * the entries below. */
+      std::map<std::string, Plugins::Entries> own;
       /** Boundary ids whose faces' nodes are fixed. */
       std::vector<unsigned int> boundary_ids;
       /** Axis-aligned box, in metres (scaled mesh coordinates). */

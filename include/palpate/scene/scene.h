@@ -152,11 +152,12 @@ namespace palpate
     unsigned int
     displacement_degree() const;
 
-  private:
-    /** Whether the scene file or the command line (--set) sets @p entry. */
+    /** Whether the scene file or the command line (--set) sets @p entry
+     * ("Mesh/File name"), rather than leaving its default. */
     bool
     sets(const std::string &entry) const;
 
+  private:
     /** validate(): the material plug-in's constants, their bounds, and the
      * element pair's degree. */
     void
@@ -165,8 +166,8 @@ namespace palpate
     /** validate(): each enabled effect plug-in's entries. */
     void
     check_effects() const;
-    /** The own entries of the chosen device, trajectory and linear
-     * solver plug-ins (Plugins::check_entries). */
+    /** The own entries of the chosen mesh source, fixed region, device,
+     * trajectory and linear solver plug-ins (Plugins::check_entries). */
     void
     check_plugin_entries() const;
 
@@ -174,11 +175,13 @@ namespace palpate
     void
     check_probe() const;
 
-    /** validate(): the mesh's source, file, scale and size. */
+    /** validate(): the mesh source's entries (Plugins::check_scene()), and
+     * the scale. */
     void
     check_mesh() const;
 
-    /** validate(): the fixed-node region. */
+    /** validate(): the fixed-node region's entries
+     * (Plugins::check_scene()). */
     void
     check_fixed_nodes() const;
 
