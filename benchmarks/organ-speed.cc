@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run organ-speed [--quick] [--refinement 5,2.5] [--scaling]
+// benchmarks/run organ-speed [--quick|--smoke] [--refinement 5,2.5] [--scaling]
 //                            [--material nh,mr] [--lines L] [--no-stroke]
 //                            [--csv FILE]
 //
@@ -25,6 +25,11 @@
 // interactions as `palpate scene.prm` runs them, with the best
 // configuration, 2 solver threads and 2 MPI servers; speed doubled until a
 // missing-data event, then bisected.
+//
+// --smoke (the test suite's): every part on the liver meshed at 8 mm
+// near the probe, Mooney-Rivlin: part 1 with the unchanged solver and all
+// the levers, one state per line; part 3 with the initial cloud within
+// two grid steps; part 2 with one trial of the thread engine.
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
@@ -65,6 +70,7 @@ namespace
   struct Options
   {
     bool quick = false;
+    bool smoke = false;
     /** Refinement sizes near the probe (m): 2,012 nodes (the shipped
      * parameters/liver-indenter.prm) and 3,976 nodes. */
     std::vector<double>      sizes     = {0.004, 0.0025};
@@ -545,6 +551,8 @@ run_benchmark(int argc, char **argv)
       };
       if (a == "--quick")
         o.quick = true;
+      else if (a == "--smoke")
+        o.smoke = o.quick = true;
       else if (a == "--refinement" && i + 1 < argc)
         list(o.sizes, [](const std::string &s) { return 1e-3 * std::stod(s); });
       else if (a == "--material" && i + 1 < argc)
@@ -597,7 +605,7 @@ run_benchmark(int argc, char **argv)
       else
         {
           std::cerr
-            << "usage: benchmarks/run organ-speed [--quick] "
+            << "usage: benchmarks/run organ-speed [--quick|--smoke] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
                "[--cores K] [--interpolation NAME] [--step MM] [--increment MM] [--patch-residual R] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
@@ -608,9 +616,11 @@ run_benchmark(int argc, char **argv)
   if (o.quick)
     {
       o.lines     = 2;
-      o.sizes     = {0.004};
+      o.sizes     = {o.smoke ? 0.008 : 0.004};
       o.materials = {"mr"};
     }
+  if (o.smoke)
+    o.lines = 1;
 
   // Each lever changes one setting; configuration l applies levers 0..l.
   const std::vector<Lever> levers = {
@@ -696,6 +706,10 @@ run_benchmark(int argc, char **argv)
      false},
   };
   const unsigned int amg_lever = levers.size() - 1;
+  // The smoke: the unchanged solver and every lever but AMG, which
+  // replaces the factorisation.
+  if (o.smoke && o.levers.empty())
+    o.levers = {amg_lever - 1};
   // Configuration l: every lever up to l.
   const auto configuration = [&levers, &o](const unsigned int l) {
     Lever c = levers[l];
@@ -726,7 +740,10 @@ run_benchmark(int argc, char **argv)
       csv.open(o.csv);
       csv << "mesh,nodes,unknowns,material,lever,state_ms\n";
     }
-  std::cout << "Organ speed (" << (o.quick ? "quick" : "full")
+  std::cout << "Organ speed ("
+            << (o.smoke ? "smoke" :
+                o.quick ? "quick" :
+                          "full")
             << " run)\nmachine: " << machine() << "\n\n";
   for (const double size : o.sizes)
     for (const std::string &material : o.materials)
@@ -835,7 +852,7 @@ run_benchmark(int argc, char **argv)
         // half the states press into the liver, up to 15 mm deep.
         if (o.engine != "mpi")
           std::cout << "  thread engine, the initial cloud within "
-                    << 3e3 *
+                    << (o.smoke ? 2e3 : 3e3) *
                          (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
                     << " mm of rest:\n";
         for (const bool private_copies : {false, true})
@@ -847,9 +864,12 @@ run_benchmark(int argc, char **argv)
               {
                 const double h =
                   stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005;
-                const Throughput t = thread_throughput(
-                  size, material, workers, 3 * h, private_copies);
-                const double rate = t.seconds > 0 ? t.states / t.seconds : 0;
+                const Throughput t = thread_throughput(size,
+                                                       material,
+                                                       workers,
+                                                       (o.smoke ? 2 : 3) * h,
+                                                       private_copies);
+                const double rate  = t.seconds > 0 ? t.states / t.seconds : 0;
                 if (workers == 1)
                   one = rate;
                 std::cout << "    " << workers << " worker(s), MUMPS "
@@ -892,9 +912,14 @@ run_benchmark(int argc, char **argv)
               o.quick ? std::clamp(h / (4e-3 * state_ms), 0.0005, 0.028) :
               state_ms < 300 ? 0.028 :
                                0.004;
-            const auto [best, last] =
-              search(size, material, engine, start, o.quick ? 2 : 6);
-            const Trial &shown = best.passed ? best : last;
+            const auto [best, last] = search(size,
+                                             material,
+                                             engine,
+                                             start,
+                                             o.smoke ? 1 :
+                                             o.quick ? 2 :
+                                                       6);
+            const Trial &shown      = best.passed ? best : last;
             // The platform's own misses in as many ticks, with the
             // solvers' load beside it.
             const auto bare =
