@@ -33,6 +33,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "machine.h"
@@ -56,17 +57,28 @@ namespace
     std::size_t frame_bytes = 0;
   };
 
-  /** The cloud computed again after a material change (Young's modulus
-   * set to its own value: the cached states are dropped), in seconds. */
+  /** The cloud computed again after a material change, in seconds:
+   * Young's modulus changed by one part in a million, another value each
+   * call (the server keeps the cached states when the value in force is
+   * sent again). Throws if the server did not take the change: the time
+   * would then be that of no work at all. */
   double
   recompute(LiveServer &server, httplib::Client &client, const Scene &scene)
   {
-    const auto        &m = scene.parameters.material_model;
-    const double       E = m.get_double(m.model_name, "Young's modulus");
-    std::ostringstream body;
-    body << std::setprecision(17) << "Young's modulus=" << E;
+    static unsigned int changes = 0;
+    const auto         &m       = scene.parameters.material_model;
+    const double        E       = m.get_double(m.model_name, "Young's modulus");
+    std::ostringstream  body;
+    body << std::setprecision(17)
+         << "Young's modulus=" << E * (1 + 1e-6 * ++changes);
     const auto start = Clock::now();
-    client.Post("/material", body.str(), LiveServer::command_type);
+    const auto reply =
+      client.Post("/material", body.str(), LiveServer::command_type);
+    if (!reply || reply->status != 200 ||
+        reply->body.find("unchanged") != std::string::npos)
+      throw std::runtime_error(
+        "the live view did not take the material change '" + body.str() +
+        "': " + (reply ? reply->body : std::string("no reply")));
     while (!server.interaction().initial_cloud_complete())
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     return seconds_since(start);
