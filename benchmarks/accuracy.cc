@@ -68,6 +68,13 @@ run_benchmark(int argc, char **argv)
           return 2;
         }
     }
+  if (material != "stvk" && material != "mr" && material != "all" &&
+      material != "none")
+    {
+      std::cerr << "usage: benchmarks/run accuracy [--quick|--smoke] "
+                   "[--material stvk|mr|all|none]\n";
+      return 2;
+    }
   if ((quick || smoke) && material == "all")
     material = "stvk";
   // The smoke's scene: the beam, whose states take milliseconds.

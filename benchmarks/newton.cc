@@ -447,7 +447,11 @@ run_benchmark(int argc, char **argv)
         o.studies = false;
       else
         {
-          std::cerr << "benchmarks/run newton: unknown option " << a << "\n";
+          std::cerr << "benchmarks/run newton: unknown option " << a
+                    << "\nusage: benchmarks/run newton [--quick|--smoke] "
+                       "[--material stvk|nh|mr] [--element p1p1|taylor-hood] "
+                       "[--targets N] [--spacing H] [--radius R] [--seed S] "
+                       "[--no-studies] [--mesh liver501|liver2k] [--growth]\n";
           return 2;
         }
     }
