@@ -34,9 +34,9 @@
 //
 // --quick: the liver, 10 mm, a third of the samples (a few minutes).
 // --smoke (the test suite's): the liver meshed at 8 mm under the probe
-// (not 4 mm), 10 mm, one sweep through onset on the normal (2 mm above to
-// 4 mm deep, 1 mm steps), the grid states with one cutback: every
-// interpolation and the ticks.
+// (not 4 mm), 10 mm, one sweep in contact on the normal (1 to 4 mm deep,
+// 0.5 mm steps), the grid states with one cutback: every interpolation
+// and the ticks.
 
 #include <palpate/base/environment.h>
 #include <palpate/base/utilities.h>
@@ -180,7 +180,7 @@ namespace
       std::abs(normal[0]) < 0.9 ? Point3{{1, 0, 0}} : Point3{{0, 1, 0}};
     t1              = unit(add(t1, normal, -Utilities::dot(t1, normal)));
     const Point3 t2 = Utilities::cross(normal, t1);
-    const double mm = 1e-3, step = (smoke ? 1 : quick ? 1.5 : 0.5) * mm;
+    const double mm = 1e-3, step = (smoke ? 0.5 : quick ? 1.5 : 0.5) * mm;
     std::vector<std::vector<Point3>> all;
     auto line = [&](const Point3 &from, const Point3 &to) {
       const unsigned int  n = std::ceil(Utilities::distance(from, to) / step);
@@ -190,12 +190,14 @@ namespace
       all.push_back(s);
     };
     // Onset: 5 mm above to 8 mm deep, on the normal and 3 and 6 mm beside
-    // it (the offsets not on grid lines). The smoke: 2 mm above to 4 mm
-    // deep on the normal, the fewest cells that still cross onset.
+    // it (the offsets not on grid lines). The smoke: 1 to 4 mm deep on
+    // the normal, in contact throughout and on one side of the rest
+    // position, a grid point: a line through it needs the states around
+    // the cells on every side of it.
     const Point3 beside = unit(add(t1, t2, 0.6));
     if (smoke)
       {
-        line(Utilities::scaled(normal, 2 * mm),
+        line(Utilities::scaled(normal, -1 * mm),
              Utilities::scaled(normal, -4 * mm));
         return all;
       }
