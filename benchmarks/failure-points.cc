@@ -194,7 +194,7 @@ run_benchmark(int argc, char **argv)
       else if (a == "--smoke")
         smoke = true;
       else if (a == "--targets" && i + 1 < argc)
-        n = std::stoul(argv[++i]);
+        n = whole_number(a, argv[++i], 1);
       else if (a == "--tip" && i + 1 < argc)
         tip = std::stod(argv[++i]);
       else if (a == "--cutbacks" && i + 1 < argc)

@@ -336,7 +336,7 @@ run_benchmark(int argc, char **argv)
         {
           o.workers.clear();
           for (const auto &s : Utilities::split(next(), ','))
-            o.workers.push_back(std::stoul(s));
+            o.workers.push_back(whole_number(a, s, 1));
         }
       else if (a == "--engine")
         {

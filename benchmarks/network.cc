@@ -622,7 +622,11 @@ run_benchmark(int argc, char **argv)
       else if (a == "--length")
         o.length = 0.01 * list().at(0);
       else if (a == "--repeat")
-        o.repeat = static_cast<unsigned int>(list().at(0));
+        {
+          if (i + 1 >= argc)
+            throw std::invalid_argument(a + " needs a value");
+          o.repeat = whole_number(a, argv[++i], 1);
+        }
       else if (a == "--no-partition")
         o.partition = false;
       else if (a == "--drop")

@@ -432,7 +432,7 @@ run_benchmark(int argc, char **argv)
       else if (a == "--element" && i + 1 < argc)
         o.element = argv[++i];
       else if (a == "--targets" && i + 1 < argc)
-        o.targets = std::stoi(argv[++i]);
+        o.targets = whole_number(a, argv[++i], 1);
       else if (a == "--spacing" && i + 1 < argc)
         o.spacing = std::stod(argv[++i]);
       else if (a == "--radius" && i + 1 < argc)

@@ -558,17 +558,16 @@ run_benchmark(int argc, char **argv)
       else if (a == "--material" && i + 1 < argc)
         list(o.materials, [](const std::string &s) { return s; });
       else if (a == "--lines" && i + 1 < argc)
-        o.lines = std::stoul(argv[++i]);
+        o.lines = whole_number(a, argv[++i], 1);
       else if (a == "--no-stroke")
         o.stroke = false;
       else if (a == "--trace")
         o.trace = true;
       else if (a == "--krylov" && i + 1 < argc)
-        o.krylov = std::stoul(argv[++i]);
+        o.krylov = whole_number(a, argv[++i]);
       else if (a == "--levers" && i + 1 < argc)
-        list(o.levers, [](const std::string &s) {
-          return static_cast<unsigned int>(std::stoul(s));
-        });
+        list(o.levers,
+             [&a](const std::string &s) { return whole_number(a, s); });
       else if (a == "--scaling")
         {
           o.scaling   = true;
@@ -599,7 +598,7 @@ run_benchmark(int argc, char **argv)
         stroke_grid.condensed = std::string(argv[++i]) != "matrix";
       else if (a == "--cores" && i + 1 < argc)
         {
-          o.cores  = std::stoul(argv[++i]);
+          o.cores  = whole_number(a, argv[++i], 1);
           o.stroke = false; // part 1 only: the stroke's workers use a core
         }
       else

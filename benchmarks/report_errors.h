@@ -11,8 +11,39 @@
 
 #include <exception>
 #include <iostream>
+#include <limits>
 #include <stdexcept>
 #include <string>
+
+/**
+ * The value @p text of the command-line option @p option as a whole
+ * number from @p low to @p high. std::stoul takes "-1" and "3x" (as
+ * 2^64 - 1 and 3): a count of runs or targets read so would never end.
+ * This refuses them, naming the option (report_errors() reports it as an
+ * input error).
+ */
+inline unsigned int
+whole_number(const std::string &option,
+             const std::string &text,
+             const unsigned int low  = 0,
+             const unsigned int high = std::numeric_limits<unsigned int>::max())
+{
+  std::size_t end   = 0;
+  long long   value = -1;
+  try
+    {
+      value = std::stoll(text, &end);
+    }
+  catch (const std::logic_error &)
+    {
+      end = 0;
+    }
+  if (text.empty() || end != text.size() || value < low || value > high)
+    throw std::invalid_argument(option + " must be a whole number from " +
+                                std::to_string(low) + " to " +
+                                std::to_string(high) + ", not '" + text + "'");
+  return static_cast<unsigned int>(value);
+}
 
 /**
  * Runs the benchmark @p body with @p argc and @p argv and returns its exit

@@ -131,7 +131,7 @@ run_benchmark(int argc, char **argv)
              (args[i + 1] == "yes" || args[i + 1] == "no"))
       reuse = args[++i];
     else if (args[i] == "--repeat" && i + 1 < args.size())
-      repeat = std::stoul(args[++i]);
+      repeat = whole_number("--repeat", args[++i], 1);
     else
       {
         std::cerr << "usage: benchmarks/run scaling [--quick|--smoke] "
