@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run cluster [--quick] [--csv FILE] [--length CM]
+// benchmarks/run cluster [--quick|--smoke] [--csv FILE] [--length CM]
 //
 // The paper's Table 2 and Fig. 4 on a simulated cluster: palpate's
 // scheduler and N solver servers in virtual time (ClusterSimulation), with
@@ -31,6 +31,9 @@
 // Fig. 4: busy servers over 40 s, StVK, cloud 2.5 cm, the paper's state
 // time, the HIP moving from 15 s to 33 s at 5.25 mm/s; written as CSV for
 // doc/images/cluster_fig4.py.
+//
+// --smoke (the test suite's): as --quick, on a stroke of 1 cm, with the
+// 5 mm grid and the 2 cm cloud only (and Fig. 4).
 
 #include <palpate/base/environment.h>
 #include <palpate/engine/cluster_simulation.h>
@@ -61,6 +64,7 @@ namespace
   struct Options
   {
     bool        quick  = false;
+    bool        smoke  = false;
     std::string csv    = "cluster-fig4.csv";
     double      length = 0.08; // m, the stroke
   };
@@ -309,6 +313,8 @@ run_benchmark(int argc, char **argv)
       };
       if (a == "--quick")
         o.quick = true;
+      else if (a == "--smoke")
+        o.smoke = o.quick = true;
       else if (a == "--csv")
         o.csv = next();
       else if (a == "--length")
@@ -316,11 +322,13 @@ run_benchmark(int argc, char **argv)
       else
         {
           std::cerr << "cluster: unknown option " << a
-                    << "\nusage: benchmarks/run cluster [--quick] [--csv FILE] "
-                       "[--length CM]\n";
+                    << "\nusage: benchmarks/run cluster [--quick|--smoke] "
+                       "[--csv FILE] [--length CM]\n";
           return 2;
         }
     }
+  if (o.smoke)
+    o.length = 0.01;
   const auto wall0 = std::chrono::steady_clock::now();
 
   std::vector<Material> materials = {
@@ -333,7 +341,10 @@ run_benchmark(int argc, char **argv)
             << "  grid 5 mm, look-ahead 0.2 s, scheduler 100 Hz, network "
                "100 us + 1 Gbit/s, stroke "
             << 100 * o.length << " cm along -x after the initial cloud"
-            << (o.quick ? "  [--quick]" : "") << "\n\n";
+            << (o.smoke ? "  [--smoke]" :
+                o.quick ? "  [--quick]" :
+                          "")
+            << "\n\n";
 
   std::cout << "State times measured on liver501 (5 mm grid steps from rest "
                "along the stroke, one core):\n";
@@ -365,14 +376,19 @@ run_benchmark(int argc, char **argv)
   // grid spacing is not stated: 5 mm is the liver scenes'; 10 mm, with the
   // paper's state times only (palpate's were measured for 5 mm steps),
   // shows how much the answer depends on it.
-  std::vector<Row> rows;
-  for (const double h : {0.005, 0.010})
+  std::vector<Row>          rows;
+  const std::vector<double> spacings =
+    o.smoke ? std::vector<double>{0.005} : std::vector<double>{0.005, 0.010};
+  const std::vector<double> radii =
+    o.smoke ? std::vector<double>{0.020} :
+              std::vector<double>{0.020, 0.025, 0.030, 0.035};
+  for (const double h : spacings)
     {
       const StateGrid grid(h, o.length + 0.035 + 3 * h);
       for (const auto &m : materials)
         for (const bool paper : {false, true})
           for (const double speed : {0.028, m.paper_speed})
-            for (const double radius : {0.020, 0.025, 0.030, 0.035})
+            for (const double radius : radii)
               if (h == 0.005 || paper)
                 {
                   Row r;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run convergence [--quick] [--csv FILE]
+// benchmarks/run convergence [--quick|--smoke] [--csv FILE]
 //
 // Does the indenter's force belong to the tissue or to the mesh? For each
 // case and discretisation, the force of the same push on meshes of the
@@ -28,6 +28,10 @@
 // RESULT convergence case=hertz|liver discretization=NAME nodes=N
 //   force_N=F extrapolated_N=X err_pct=E state_ms=T
 // RESULT convergence case=liver recommended=yes ... err_pct=E state_ms=T
+//
+// --smoke (the test suite's): one level of each case, the coarsest (the
+// Hertz block unsplit, the liver at 8 mm, Mooney-Rivlin P1-P1): the
+// forces, no extrapolation.
 
 #include <palpate/base/environment.h>
 #include <palpate/hyperelastic/hertz.h>
@@ -184,26 +188,30 @@ static int
 run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
-  bool        quick = false;
+  bool        quick = false, smoke = false;
   std::string csv_name;
   for (int i = 1; i < argc; ++i)
     {
       const std::string a = argv[i];
       if (a == "--quick")
         quick = true;
+      else if (a == "--smoke")
+        smoke = true;
       else if (a == "--csv" && i + 1 < argc)
         csv_name = argv[++i];
       else
         {
-          std::cerr << "usage: benchmarks/run convergence [--quick] [--csv "
-                       "FILE]\n";
+          std::cerr << "usage: benchmarks/run convergence [--quick|--smoke] "
+                       "[--csv FILE]\n";
           return 2;
         }
     }
   const std::string source = PALPATE_SOURCE_DIR;
   std::cout << "Convergence of the indenter's force ("
-            << (quick ? "quick" : "full") << " run)\nmachine: " << machine()
-            << "\n\n";
+            << (smoke ? "smoke" :
+                quick ? "quick" :
+                        "full")
+            << " run)\nmachine: " << machine() << "\n\n";
   std::vector<Series> all;
 
   // --- Hertz.
@@ -226,6 +234,7 @@ run_benchmark(int argc, char **argv)
       std::vector<unsigned int> splits;
     };
     const std::vector<Discretisation> discretisations =
+      smoke ? std::vector<Discretisation>{{"P1", 1, {1}}} :
       quick ? std::vector<Discretisation>{{"P1", 1, {1, 2}}} :
               std::vector<Discretisation>{{"P1", 1, {1, 2, 3}}, {"P2", 2, {1}}};
     for (const auto &disc : discretisations)
@@ -277,6 +286,9 @@ run_benchmark(int argc, char **argv)
       std::vector<double> sizes; // Refinement size (m)
     };
     const std::vector<Discretisation> discretisations =
+      smoke ?
+        std::vector<Discretisation>{
+          {"MR-P1P1", "Mooney-Rivlin", "P1-P1", {0.008}}} :
       quick ?
         std::vector<Discretisation>{
           {"MR-P1P1", "Mooney-Rivlin", "P1-P1", {0.006, 0.004, 0.003}}} :

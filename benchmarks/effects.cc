@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run effects [--quick] [--repeats N]
+// benchmarks/run effects [--quick|--smoke] [--repeats N]
 //
 // What each effect costs (issue 13): the paper-stvk interaction
 // (liver501, 2 solver threads, the 1 kHz loop, the 2.86 s stroke at
@@ -23,6 +23,9 @@
 // others.
 //
 // --quick: none and shape output, once each (about 30 s).
+// --smoke (the test suite's): every effect once, on a cloud of radius 9 mm
+// (the least that holds a cell) and a stroke of 0.1 s (each run a second
+// or two).
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
@@ -53,11 +56,16 @@ namespace
   };
 
   Run
-  run(const std::string &effect)
+  run(const std::string &effect, const bool smoke = false)
   {
-    Scene scene        = Scene::read(std::string(PALPATE_SOURCE_DIR) +
+    Scene scene = Scene::read(std::string(PALPATE_SOURCE_DIR) +
                               "/parameters/paper-stvk.prm");
-    auto &p            = scene.parameters;
+    auto &p     = scene.parameters;
+    if (smoke)
+      {
+        p.scheduler.cloud_radius      = 0.009;
+        p.haptics.trajectory.duration = 0.1;
+      }
     p.output.directory = "effects-output";
     p.output.summary_formats.clear();
     p.output.print_timings = false;
@@ -130,7 +138,7 @@ static int
 run_benchmark(int argc, char **argv)
 {
   Environment  env(argc, argv);
-  bool         quick   = false;
+  bool         quick = false, smoke = false;
   unsigned int repeats = 2;
   std::string  baseline;
   for (int i = 1; i < argc; ++i)
@@ -138,6 +146,8 @@ run_benchmark(int argc, char **argv)
       const std::string a = argv[i];
       if (a == "--quick")
         quick = true;
+      else if (a == "--smoke")
+        smoke = true;
       else if (a == "--repeats" && i + 1 < argc)
         repeats = std::max(1, std::stoi(argv[++i]));
       else if (a == "--baseline" && i + 1 < argc)
@@ -152,26 +162,29 @@ run_benchmark(int argc, char **argv)
         }
       else
         {
-          std::cerr << "usage: benchmarks/run effects [--quick] [--repeats N] "
-                       "[--baseline BIN]\n";
+          std::cerr << "usage: benchmarks/run effects [--quick|--smoke] "
+                       "[--repeats N] [--baseline BIN]\n";
           return 2;
         }
     }
-  if (quick)
+  if (quick || smoke)
     repeats = 1;
   std::vector<std::string> effects =
-    quick ? std::vector<std::string>{"none", "shape-output"} :
-            std::vector<std::string>{"none",
-                                     "gravity",
-                                     "surface-traction",
-                                     "shape-output",
-                                     "force-log",
-                                     "vtu-export"};
+    quick && !smoke ? std::vector<std::string>{"none", "shape-output"} :
+                      std::vector<std::string>{"none",
+                                               "gravity",
+                                               "surface-traction",
+                                               "shape-output",
+                                               "force-log",
+                                               "vtu-export"};
   if (!baseline.empty())
     effects.push_back("no-effects-build");
   std::cout << "What each effect costs: paper-stvk interaction, " << machine()
             << ", " << repeats << " run(s) each, interleaved"
-            << (quick ? " [--quick]" : "") << "\n\n";
+            << (smoke ? " [--smoke]" :
+                quick ? " [--quick]" :
+                        "")
+            << "\n\n";
 
   // Interleaved rounds, so that a slow minute of the machine does not fall
   // on one effect only.
@@ -181,7 +194,7 @@ run_benchmark(int argc, char **argv)
       {
         runs[k].push_back(effects[k] == "no-effects-build" ?
                             run_baseline(baseline) :
-                            run(effects[k]));
+                            run(effects[k], smoke));
         std::cout << "  " << std::left << std::setw(17) << effects[k]
                   << " state " << std::fixed << std::setprecision(2)
                   << runs[k].back().state_ms << " ms, initial cloud "

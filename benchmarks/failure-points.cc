@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run failure-points [--quick] [--targets N] [--tip R_MM]
+// benchmarks/run failure-points [--quick|--smoke] [--targets N] [--tip R_MM]
 //                                [--cutbacks N]
 //
 // Where does the state space have no state, and why? On the shipped liver
@@ -28,6 +28,9 @@
 //          solver_failure_pct=... avg_iters=...
 // Configurations run two at a time, in separate processes (MUMPS cannot
 // factorise in two threads of one process).
+//
+// --smoke (the test suite's): St.Venant-Kirchhoff only (point and tip),
+// 3 targets: the same child processes and table in seconds.
 
 #include <palpate/base/environment.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -177,6 +180,7 @@ run_benchmark(int argc, char **argv)
 {
   Environment  env(argc, argv);
   bool         quick    = false;
+  bool         smoke    = false;
   unsigned int n        = 1000;
   double       tip      = 25;
   int          only     = -1; // --part K: run configuration K only
@@ -187,8 +191,10 @@ run_benchmark(int argc, char **argv)
       const std::string a = argv[i];
       if (a == "--quick")
         quick = true;
+      else if (a == "--smoke")
+        smoke = true;
       else if (a == "--targets" && i + 1 < argc)
-        n = std::stoul(argv[++i]);
+        n = whole_number(a, argv[++i], 1);
       else if (a == "--tip" && i + 1 < argc)
         tip = std::stod(argv[++i]);
       else if (a == "--cutbacks" && i + 1 < argc)
@@ -199,16 +205,22 @@ run_benchmark(int argc, char **argv)
         out = argv[++i];
       else
         {
-          std::cerr << "usage: benchmarks/run failure-points [--quick] "
+          std::cerr << "usage: benchmarks/run failure-points [--quick|--smoke] "
                        "[--targets N] [--tip R_MM] [--cutbacks N]\n";
           return 2;
         }
     }
   if (quick)
     n = 25;
+  if (smoke)
+    n = 3;
 
-  const std::vector<Configuration> configurations = {
+  std::vector<Configuration> configurations = {
     {"stvk", 0}, {"stvk", tip}, {"nh", 0}, {"nh", tip}, {"mr", 0}, {"mr", tip}};
+  // The first two, so that a part's number (--part K) names the same
+  // configuration in the child.
+  if (smoke && only < 0)
+    configurations.resize(2);
   const std::vector<Point3> t = targets(n);
   if (only >= 0)
     {

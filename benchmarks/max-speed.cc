@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run max-speed [--quick] [--material stvk|mr|all]
+// benchmarks/run max-speed [--quick|--smoke] [--material stvk|mr|all]
 //                          [--spacing 5,10] [--workers 1,2]
 //                          [--engine threads|mpi|all] [--mesh liver2k]
 //                          [--length CM] [--no-studies]
@@ -36,6 +36,12 @@
 // Study (unless --no-studies or --quick): what accuracy costs in speed, the
 // Newton residual tolerance 1e-4 / 1e-6 / 1e-8 (the default), StVK, 5 mm,
 // one worker.
+//
+// --smoke (the test suite's): one trial, StVK, h = 10 mm, 2 solver
+// threads, a cloud of radius 18 mm (the least that holds a cell), a
+// stroke of 5 mm and 1 s of timer noise: the whole interaction and the
+// table in seconds. The MPI engine's children are left to
+// benchmarks/run scaling --smoke.
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
@@ -72,6 +78,7 @@ namespace
   struct Options
   {
     bool                      quick     = false;
+    bool                      smoke     = false;
     std::vector<std::string>  materials = {"stvk", "mr"};
     std::vector<double>       spacings  = {5, 10};
     std::vector<unsigned int> workers   = {1, 2};
@@ -106,6 +113,8 @@ namespace
     std::string  engine        = "threads";
     std::string  mesh          = "liver501";
     std::string  interpolation = "trilinear";
+    /** Scheduler / Cloud radius (m); 0: the scene's (25 mm). */
+    double cloud_radius = 0;
   };
 
   const Point3 direction{{-1, 0, 0}};
@@ -134,6 +143,8 @@ namespace
     p.haptics.trajectory.start     = "after initial cloud";
     p.effects.shape_output         = false;
     p.effects.force_log            = false;
+    if (c.cloud_radius > 0)
+      p.scheduler.cloud_radius = c.cloud_radius;
     scene.validate();
     return scene;
   }
@@ -233,7 +244,7 @@ namespace
           }
         else
           high = v;
-        if (o.quick && trials >= 4)
+        if ((o.quick && trials >= 4) || o.smoke)
           break;
         if (high == 0) // no failure yet: double
           {
@@ -307,6 +318,8 @@ run_benchmark(int argc, char **argv)
       };
       if (a == "--quick")
         o.quick = true;
+      else if (a == "--smoke")
+        o.smoke = o.quick = true;
       else if (a == "--material")
         {
           const std::string m = next();
@@ -323,7 +336,7 @@ run_benchmark(int argc, char **argv)
         {
           o.workers.clear();
           for (const auto &s : Utilities::split(next(), ','))
-            o.workers.push_back(std::stoul(s));
+            o.workers.push_back(whole_number(a, s, 1));
         }
       else if (a == "--engine")
         {
@@ -356,7 +369,7 @@ run_benchmark(int argc, char **argv)
         {
           std::cerr
             << "max-speed: unknown option " << a
-            << "\nusage: benchmarks/run max-speed [--quick] [--material stvk|mr|all] "
+            << "\nusage: benchmarks/run max-speed [--quick|--smoke] [--material stvk|mr|all] "
                "[--spacing 5,10] [--workers 1,2] [--engine threads|mpi|all] "
                "[--length CM] [--no-studies] [--interpolation "
                "trilinear|hermite] [--tolerance 1e-8]\n";
@@ -377,16 +390,25 @@ run_benchmark(int argc, char **argv)
       o.length    = 0.06;
       o.studies   = false;
     }
+  if (o.smoke)
+    {
+      o.engines = {"threads"};
+      o.length  = 0.005;
+    }
 
   std::cout
     << "Maximum HIP speed along a straight line (after the initial cloud)\n"
     << "  machine: " << machine() << "\n"
-    << "  " << o.mesh << " (25 cm), cloud radius 25 mm, look-ahead "
+    << "  " << o.mesh << " (25 cm), cloud radius " << (o.smoke ? 18 : 25)
+    << " mm, look-ahead "
     << scene_for({"stvk", 5, 1, 1e-8}).parameters.scheduler.look_ahead_time
     << " s, path " << 100 * o.length
     << " cm along -x from rest, 1 kHz haptic loop"
-    << (o.quick ? "  [--quick]" : "") << "\n";
-  const double noise_seconds     = o.quick ? 5 : 60;
+    << (o.smoke ? "  [--smoke]" :
+        o.quick ? "  [--quick]" :
+                  "")
+    << "\n";
+  const double noise_seconds     = o.smoke ? 1 : o.quick ? 5 : 60;
   const auto [noise, noise_late] = bare_loop(noise_seconds, 1000);
   std::cout
     << "  platform timer noise: a bare SCHED_FIFO 1 kHz loop, nothing else "
@@ -407,8 +429,14 @@ run_benchmark(int argc, char **argv)
         for (const unsigned int w :
              e == "mpi" ? std::vector<unsigned int>{2} : o.workers)
           {
-            const Configuration c{
-              m, h, w, o.tolerance, e, o.mesh, o.interpolation};
+            const Configuration c{m,
+                                  h,
+                                  w,
+                                  o.tolerance,
+                                  e,
+                                  o.mesh,
+                                  o.interpolation,
+                                  o.smoke ? 0.018 : 0.0};
             std::cout << (m == "stvk" ? "St.Venant-Kirchhoff" :
                                         "Mooney-Rivlin (P1-P1)")
                       << ", h = " << h << " mm, " << w

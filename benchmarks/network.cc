@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run network [--quick] [--latency 0,1,5,20] [--loss 0,1]
+// benchmarks/run network [--quick|--smoke] [--latency 0,1,5,20] [--loss 0,1]
 //                        [--repeat 2] [--length CM] [--no-partition]
 //                        [--drop]
 //
@@ -28,8 +28,20 @@
 //    --quick 1 s), go on with server 1, keep every force finite, and exit
 //    with status 5 (doc/architecture.md, "Faults"). The benchmark reports
 //    when the force came back after the cut (from the force log).
+//
+// --smoke (the test suite's): one trial at 28 mm/s, 0 ms and no loss, a
+// stroke of 1 cm after a cloud of radius 18 mm (the least that holds a
+// cell of its 10 mm grid), no partition. Where network namespaces are
+// not permitted (not root, or a container without CAP_NET_ADMIN: most CI
+// machines), the same trial runs under mpirun on this machine alone,
+// without the switch (namespaces=no in its RESULT line): the palpate
+// program, its summary and the table are still exercised.
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +68,9 @@ namespace
     bool                drop      = false;
     /** Trials in a row a speed must pass. */
     unsigned int repeat = 2;
+    bool         smoke  = false;
+    /** --set arguments of every trial of the search, beyond the scene's. */
+    std::vector<std::string> settings;
   };
 
   /** One palpate run on the cluster: its summary and exit status. */
@@ -104,21 +119,15 @@ namespace
     return values;
   }
 
-  /**
-   * One interaction, exactly as `mpirun -np 3 palpate liver-stvk-mpi.prm`
-   * runs it, with the stroke at @p speed for @p length, the scene's other
-   * settings as shipped plus @p settings.
-   */
-  Trial
-  run_trial(netns_cluster::Cluster          &cluster,
-            const double                     speed,
-            const double                     length,
-            const std::vector<std::string>  &settings = {},
-            const netns_cluster::RunOptions &options  = {})
+  /** palpate's arguments for a trial: the scene with the stroke at
+   * @p speed for @p length, its output in @p directory, plus
+   * @p settings. */
+  std::vector<std::string>
+  trial_arguments(const double                    speed,
+                  const double                    length,
+                  const std::string              &directory,
+                  const std::vector<std::string> &settings)
   {
-    static unsigned int n = 0;
-    const std::string   directory =
-      cluster.work_directory() + "/trial-" + std::to_string(n++);
     std::ostringstream v, d;
     v << std::setprecision(9) << speed;
     d << std::setprecision(9) << length / speed;
@@ -137,13 +146,14 @@ namespace
         arguments.push_back("--set");
         arguments.push_back(s);
       }
-    Trial t;
-    t.speed = speed;
-    // A run that hangs ends after 3 minutes (a trial takes seconds).
-    netns_cluster::RunOptions limited = options;
-    if (limited.time_limit == 0)
-      limited.time_limit = 180;
-    t.run     = cluster.run(palpate_program, arguments, limited);
+    return arguments;
+  }
+
+  /** What the run @p t.run left in @p directory: its summary, its force
+   * log, and whether it passed. */
+  void
+  read_trial(Trial &t, const std::string &directory)
+  {
     t.status  = t.run.rank_status.empty() ? -1 : t.run.rank_status[0];
     t.summary = read_summary(directory + "/liver-stvk-mpi-summary.csv");
     {
@@ -171,6 +181,74 @@ namespace
     else if (t.number("missing_data_events") > 0)
       t.failure = "missing data";
     t.passed = t.failure.empty() && t.status == 0;
+  }
+
+  /**
+   * One interaction, exactly as `mpirun -np 3 palpate liver-stvk-mpi.prm`
+   * runs it, with the stroke at @p speed for @p length, the scene's other
+   * settings as shipped plus @p settings.
+   */
+  Trial
+  run_trial(netns_cluster::Cluster          &cluster,
+            const double                     speed,
+            const double                     length,
+            const std::vector<std::string>  &settings = {},
+            const netns_cluster::RunOptions &options  = {})
+  {
+    static unsigned int n = 0;
+    const std::string   directory =
+      cluster.work_directory() + "/trial-" + std::to_string(n++);
+    Trial t;
+    t.speed = speed;
+    // A run that hangs ends after 3 minutes (a trial takes seconds).
+    netns_cluster::RunOptions limited = options;
+    if (limited.time_limit == 0)
+      limited.time_limit = 180;
+    t.run = cluster.run(palpate_program,
+                        trial_arguments(speed, length, directory, settings),
+                        limited);
+    read_trial(t, directory);
+    return t;
+  }
+
+  /**
+   * The same interaction without network namespaces: `mpirun -np 3
+   * palpate` on this machine alone (Open MPI between local processes, no
+   * switch), in ./trial-local. For the smoke where namespaces are not
+   * permitted.
+   */
+  Trial
+  run_local_trial(const double                    speed,
+                  const double                    length,
+                  const std::vector<std::string> &settings)
+  {
+    const std::string directory =
+      std::filesystem::absolute("trial-local").string();
+    std::string command =
+      "mpirun --oversubscribe" +
+      std::string(geteuid() == 0 ? " --allow-run-as-root" : "") + " -np 3 '" +
+      palpate_program + "'";
+    for (const auto &a : trial_arguments(speed, length, directory, settings))
+      command += " '" + a + "'";
+    command += " 2>&1";
+    Trial t;
+    t.speed          = speed;
+    const auto start = netns_cluster::Clock::now();
+    if (FILE *pipe = popen(command.c_str(), "r"))
+      {
+        std::array<char, 4096> buffer;
+        std::size_t            n;
+        while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+          t.run.output.append(buffer.data(), n);
+        const int status    = pclose(pipe);
+        t.run.mpirun_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        // mpirun's status is rank 0's when the others end with 0.
+        t.run.rank_status = {t.run.mpirun_status};
+      }
+    t.run.seconds =
+      std::chrono::duration<double>(netns_cluster::Clock::now() - start)
+        .count();
+    read_trial(t, directory);
     return t;
   }
 
@@ -222,7 +300,7 @@ namespace
     // or held without a partition, an initial cloud not complete) says
     // nothing about the speed: counted, and the trial run again once.
     const auto trial = [&](const double v) {
-      Trial t = run_trial(cluster, v, o.length);
+      Trial t = run_trial(cluster, v, o.length, o.settings);
       ++trials;
       print_trial(t);
       if (t.summary.empty())
@@ -231,7 +309,7 @@ namespace
         {
           ++anomalies;
           std::cout << "      (" << t.failure << ": run again)" << std::endl;
-          t = run_trial(cluster, v, o.length);
+          t = run_trial(cluster, v, o.length, o.settings);
           ++trials;
           print_trial(t);
           if (t.summary.empty())
@@ -253,7 +331,7 @@ namespace
           }
         else
           high = v;
-        if (o.quick && stage >= 3)
+        if ((o.quick && stage >= 3) || o.smoke)
           break;
         if (high == 0)
           {
@@ -306,13 +384,17 @@ namespace
       << "  network: a switch with a fixed one-way delay and a loss rate per "
          "frame (MTU 9000), Open MPI TCP (btl tcp,self)\n"
       << "  scene:   parameters/liver-stvk-mpi.prm (liver501, StVK, tricubic "
-         "Hermite on 10 mm, cloud 25 mm), stroke of "
-      << 100 * o.length << " cm along -x after the initial cloud"
-      << (o.quick ? "  [--quick]" : "") << "\n";
+         "Hermite on 10 mm, cloud "
+      << (o.smoke ? 18 : 25) << " mm), stroke of " << 100 * o.length
+      << " cm along -x after the initial cloud"
+      << (o.smoke ? "  [--smoke]" :
+          o.quick ? "  [--quick]" :
+                    "")
+      << "\n";
     // How late this machine itself wakes a real-time thread (a virtual
     // machine's host may stall it): the switch's late frames and the
     // haptic loop's deadline misses are no better than this.
-    if (!o.quick)
+    if (!o.quick && !o.smoke)
       {
         const double seconds        = 10;
         const auto [misses, latest] = bare_loop(seconds, 1000);
@@ -482,6 +564,31 @@ namespace
       }
     return 0;
   }
+
+  /** The smoke where network namespaces are not permitted (@p why): the
+   * trial of the smoke on this machine alone. */
+  int
+  smoke_without_namespaces(const Options &o, const std::string &why)
+  {
+    std::cout << "The MPI engine, 1 client + 2 solver servers on this machine "
+                 "alone  [--smoke]\n"
+              << "  machine: " << machine()
+              << "\n  no network namespaces here (" << why
+              << "): mpirun without the switch\n\n";
+    const Trial t = run_local_trial(0.028, o.length, o.settings);
+    print_trial(t);
+    if (t.summary.empty())
+      throw std::runtime_error(t.failure);
+    std::cout << "\nRESULT network namespaces=no latency_ms=0 loss_pct=0"
+              << " speed_mm_s=" << fixed(1000 * t.speed, 1)
+              << " passed=" << (t.passed ? "yes" : "no")
+              << " missing=" << fixed(t.number("missing_data_events"), 0)
+              << " lost_servers=" << fixed(t.number("lost_servers"), 0)
+              << " state_ms=" << fixed(t.number("median_state_ms"), 1)
+              << " deadline_misses=" << fixed(t.number("deadline_misses"), 0)
+              << "\n";
+    return 0;
+  }
 } // namespace
 
 
@@ -506,6 +613,8 @@ run_benchmark(int argc, char **argv)
       };
       if (a == "--quick")
         o.quick = true;
+      else if (a == "--smoke")
+        o.smoke = true;
       else if (a == "--latency")
         o.latencies = list();
       else if (a == "--loss")
@@ -513,23 +622,38 @@ run_benchmark(int argc, char **argv)
       else if (a == "--length")
         o.length = 0.01 * list().at(0);
       else if (a == "--repeat")
-        o.repeat = static_cast<unsigned int>(list().at(0));
+        {
+          if (i + 1 >= argc)
+            throw std::invalid_argument(a + " needs a value");
+          o.repeat = whole_number(a, argv[++i], 1);
+        }
       else if (a == "--no-partition")
         o.partition = false;
       else if (a == "--drop")
         o.drop = true;
       else
         {
-          std::cerr << "network: unknown option " << a
-                    << "\nusage: benchmarks/run network [--quick] [--latency "
-                       "0,1,5,20] [--loss 0,1] [--repeat 2] [--length CM] "
-                       "[--no-partition] [--drop]\n";
+          std::cerr
+            << "network: unknown option " << a
+            << "\nusage: benchmarks/run network [--quick|--smoke] [--latency "
+               "0,1,5,20] [--loss 0,1] [--repeat 2] [--length CM] "
+               "[--no-partition] [--drop]\n";
           return 2;
         }
     }
   if (o.quick)
     o.repeat = 1;
-  if (const std::string why = netns_cluster::why_not(); !why.empty())
+  if (o.smoke)
+    {
+      o.latencies = {0};
+      o.losses    = {0};
+      o.repeat    = 1;
+      o.length    = 0.01;
+      o.partition = false;
+      o.settings  = {"Scheduler/Cloud radius=0.018"};
+    }
+  const std::string why = netns_cluster::why_not();
+  if (!why.empty() && !o.smoke)
     {
       std::cerr << "benchmarks/run network: cannot run here: " << why
                 << std::endl;
@@ -542,6 +666,8 @@ run_benchmark(int argc, char **argv)
                 << std::endl;
       return 1;
     }
+  if (!why.empty())
+    return smoke_without_namespaces(o, why);
 
   // An exception from measure() removes the clusters on its way out (each
   // one's destructor) and is reported by report_errors().

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run newton [--quick] [--material stvk|nh|mr] [--element
+// benchmarks/run newton [--quick|--smoke] [--material stvk|nh|mr] [--element
 // p1p1|taylor-hood]
 //                       [--targets N]
 //                       [--spacing H] [--radius R] [--seed S] [--no-studies]
@@ -23,6 +23,9 @@
 // Studies (unless --no-studies): where the time goes with each direct
 // solver and ordering, the symbolic analysis that is done once, assembly
 // threads, and what accuracy (the residual tolerance) costs in time.
+//
+// --smoke (the test suite's): every part above on a 2 cm grid within
+// 2 cm, 3 targets, the engine's path within 5 mm (seconds).
 
 #include <palpate/base/environment.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
@@ -54,6 +57,7 @@ namespace
   struct Options
   {
     bool         quick    = false;
+    bool         smoke    = false;
     std::string  material = "stvk";
     std::string  element  = "p1p1";
     double       spacing  = 0.01;
@@ -421,12 +425,14 @@ run_benchmark(int argc, char **argv)
       const std::string a = argv[i];
       if (a == "--quick")
         o.quick = true;
+      else if (a == "--smoke")
+        o.smoke = true;
       else if (a == "--material" && i + 1 < argc)
         o.material = argv[++i];
       else if (a == "--element" && i + 1 < argc)
         o.element = argv[++i];
       else if (a == "--targets" && i + 1 < argc)
-        o.targets = std::stoi(argv[++i]);
+        o.targets = whole_number(a, argv[++i], 1);
       else if (a == "--spacing" && i + 1 < argc)
         o.spacing = std::stod(argv[++i]);
       else if (a == "--radius" && i + 1 < argc)
@@ -441,7 +447,11 @@ run_benchmark(int argc, char **argv)
         o.studies = false;
       else
         {
-          std::cerr << "benchmarks/run newton: unknown option " << a << "\n";
+          std::cerr << "benchmarks/run newton: unknown option " << a
+                    << "\nusage: benchmarks/run newton [--quick|--smoke] "
+                       "[--material stvk|nh|mr] [--element p1p1|taylor-hood] "
+                       "[--targets N] [--spacing H] [--radius R] [--seed S] "
+                       "[--no-studies] [--mesh liver501|liver2k] [--growth]\n";
           return 2;
         }
     }
@@ -454,6 +464,8 @@ run_benchmark(int argc, char **argv)
   // factorisation): they alone would take two minutes.
   if (o.quick && o.mesh == "liver2k")
     o.studies = false;
+  if (o.smoke)
+    o.spacing = 0.02, o.radius = 0.02, o.targets = 3;
   if (o.mesh != "liver501" && o.mesh != "liver2k")
     {
       std::cerr << "benchmarks/run newton: --mesh is liver501 or liver2k\n";
@@ -583,7 +595,10 @@ run_benchmark(int argc, char **argv)
   {
     Options e = o;
     e.spacing = 0.005;
-    e.radius  = !o.quick ? 0.025 : o.mesh == "liver2k" ? 0.01 : 0.015;
+    e.radius  = o.smoke             ? 0.005 :
+                !o.quick            ? 0.025 :
+                o.mesh == "liver2k" ? 0.01 :
+                                      0.015;
     std::cout << "The engine's path: the " << 1000 * e.radius
               << " mm cloud around rest, 5 mm grid, breadth-first from "
                  "neighbours, one solver\n"

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run organ-speed [--quick] [--refinement 5,2.5] [--scaling]
+// benchmarks/run organ-speed [--quick|--smoke] [--refinement 5,2.5] [--scaling]
 //                            [--material nh,mr] [--lines L] [--no-stroke]
 //                            [--csv FILE]
 //
@@ -25,6 +25,11 @@
 // interactions as `palpate scene.prm` runs them, with the best
 // configuration, 2 solver threads and 2 MPI servers; speed doubled until a
 // missing-data event, then bisected.
+//
+// --smoke (the test suite's): every part on the liver meshed at 8 mm
+// near the probe, Mooney-Rivlin: part 1 with the unchanged solver and all
+// the levers, one state per line; part 3 with the initial cloud within
+// two grid steps; part 2 with one trial of the thread engine.
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
@@ -65,6 +70,7 @@ namespace
   struct Options
   {
     bool quick = false;
+    bool smoke = false;
     /** Refinement sizes near the probe (m): 2,012 nodes (the shipped
      * parameters/liver-indenter.prm) and 3,976 nodes. */
     std::vector<double>      sizes     = {0.004, 0.0025};
@@ -124,6 +130,15 @@ namespace
     double              assembly_ms = 0, solve_ms = 0, line_search_ms = 0;
     unsigned int        failed = 0;
   };
+
+  /** A lever's name as a RESULT value (one key=value token): spaces
+   * become dashes. */
+  std::string
+  dashed(std::string name)
+  {
+    std::replace(name.begin(), name.end(), ' ', '-');
+    return name;
+  }
 
   double
   median(std::vector<double> v)
@@ -536,22 +551,23 @@ run_benchmark(int argc, char **argv)
       };
       if (a == "--quick")
         o.quick = true;
+      else if (a == "--smoke")
+        o.smoke = o.quick = true;
       else if (a == "--refinement" && i + 1 < argc)
         list(o.sizes, [](const std::string &s) { return 1e-3 * std::stod(s); });
       else if (a == "--material" && i + 1 < argc)
         list(o.materials, [](const std::string &s) { return s; });
       else if (a == "--lines" && i + 1 < argc)
-        o.lines = std::stoul(argv[++i]);
+        o.lines = whole_number(a, argv[++i], 1);
       else if (a == "--no-stroke")
         o.stroke = false;
       else if (a == "--trace")
         o.trace = true;
       else if (a == "--krylov" && i + 1 < argc)
-        o.krylov = std::stoul(argv[++i]);
+        o.krylov = whole_number(a, argv[++i]);
       else if (a == "--levers" && i + 1 < argc)
-        list(o.levers, [](const std::string &s) {
-          return static_cast<unsigned int>(std::stoul(s));
-        });
+        list(o.levers,
+             [&a](const std::string &s) { return whole_number(a, s); });
       else if (a == "--scaling")
         {
           o.scaling   = true;
@@ -582,13 +598,13 @@ run_benchmark(int argc, char **argv)
         stroke_grid.condensed = std::string(argv[++i]) != "matrix";
       else if (a == "--cores" && i + 1 < argc)
         {
-          o.cores  = std::stoul(argv[++i]);
+          o.cores  = whole_number(a, argv[++i], 1);
           o.stroke = false; // part 1 only: the stroke's workers use a core
         }
       else
         {
           std::cerr
-            << "usage: benchmarks/run organ-speed [--quick] "
+            << "usage: benchmarks/run organ-speed [--quick|--smoke] "
                "[--refinement 5,2.5] [--scaling] [--csv FILE] [--material nh,mr] [--lines L] "
                "[--no-stroke] [--trace] [--krylov N] [--levers 0,4] "
                "[--cores K] [--interpolation NAME] [--step MM] [--increment MM] [--patch-residual R] [--spacing MM] [--hermite|--patch] [--engine threads|mpi] "
@@ -599,9 +615,11 @@ run_benchmark(int argc, char **argv)
   if (o.quick)
     {
       o.lines     = 2;
-      o.sizes     = {0.004};
+      o.sizes     = {o.smoke ? 0.008 : 0.004};
       o.materials = {"mr"};
     }
+  if (o.smoke)
+    o.lines = 1;
 
   // Each lever changes one setting; configuration l applies levers 0..l.
   const std::vector<Lever> levers = {
@@ -687,6 +705,10 @@ run_benchmark(int argc, char **argv)
      false},
   };
   const unsigned int amg_lever = levers.size() - 1;
+  // The smoke: the unchanged solver and every lever but AMG, which
+  // replaces the factorisation.
+  if (o.smoke && o.levers.empty())
+    o.levers = {amg_lever - 1};
   // Configuration l: every lever up to l.
   const auto configuration = [&levers, &o](const unsigned int l) {
     Lever c = levers[l];
@@ -717,7 +739,10 @@ run_benchmark(int argc, char **argv)
       csv.open(o.csv);
       csv << "mesh,nodes,unknowns,material,lever,state_ms\n";
     }
-  std::cout << "Organ speed (" << (o.quick ? "quick" : "full")
+  std::cout << "Organ speed ("
+            << (o.smoke ? "smoke" :
+                o.quick ? "quick" :
+                          "full")
             << " run)\nmachine: " << machine() << "\n\n";
   for (const double size : o.sizes)
     for (const std::string &material : o.materials)
@@ -801,7 +826,8 @@ run_benchmark(int argc, char **argv)
             results << "RESULT organ-speed mesh=" << name
                     << " nodes=" << mesh.n_vertices()
                     << " material=" << material << " unknowns=" << m.unknowns
-                    << " lever=" << m.lever << " state_ms=" << median(m.ms)
+                    << " lever=" << dashed(m.lever)
+                    << " state_ms=" << median(m.ms)
                     << " contact_state_ms=" << median(pressed)
                     << " contact_states=" << pressed.size() << " mean_ms="
                     << std::accumulate(m.ms.begin(), m.ms.end(), 0.0) /
@@ -825,7 +851,7 @@ run_benchmark(int argc, char **argv)
         // half the states press into the liver, up to 15 mm deep.
         if (o.engine != "mpi")
           std::cout << "  thread engine, the initial cloud within "
-                    << 3e3 *
+                    << (o.smoke ? 2e3 : 3e3) *
                          (stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005)
                     << " mm of rest:\n";
         for (const bool private_copies : {false, true})
@@ -837,9 +863,12 @@ run_benchmark(int argc, char **argv)
               {
                 const double h =
                   stroke_grid.spacing > 0 ? stroke_grid.spacing : 0.005;
-                const Throughput t = thread_throughput(
-                  size, material, workers, 3 * h, private_copies);
-                const double rate = t.seconds > 0 ? t.states / t.seconds : 0;
+                const Throughput t = thread_throughput(size,
+                                                       material,
+                                                       workers,
+                                                       (o.smoke ? 2 : 3) * h,
+                                                       private_copies);
+                const double rate  = t.seconds > 0 ? t.states / t.seconds : 0;
                 if (workers == 1)
                   one = rate;
                 std::cout << "    " << workers << " worker(s), MUMPS "
@@ -882,9 +911,14 @@ run_benchmark(int argc, char **argv)
               o.quick ? std::clamp(h / (4e-3 * state_ms), 0.0005, 0.028) :
               state_ms < 300 ? 0.028 :
                                0.004;
-            const auto [best, last] =
-              search(size, material, engine, start, o.quick ? 2 : 6);
-            const Trial &shown = best.passed ? best : last;
+            const auto [best, last] = search(size,
+                                             material,
+                                             engine,
+                                             start,
+                                             o.smoke ? 1 :
+                                             o.quick ? 2 :
+                                                       6);
+            const Trial &shown      = best.passed ? best : last;
             // The platform's own misses in as many ticks, with the
             // solvers' load beside it.
             const auto bare =

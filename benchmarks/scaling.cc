@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run scaling [--quick] [--repeat N] [--reuse yes|no]
+// benchmarks/run scaling [--quick|--smoke] [--repeat N] [--reuse yes|no]
 //
 // How the engine's throughput (states per second) grows with a second
 // solver: 1 and 2 solver threads (Engine / Type = threads) against 1 and 2
@@ -13,6 +13,9 @@
 // throughput = states finished (converged or failure points) in the
 // initial cloud / the time from attach until the cloud was complete.
 // The median of --repeat runs (3; 1 with --quick) is reported.
+// --smoke (the test suite's): one run each with a cloud of radius 9 mm
+// (the least that holds a cell), the same four engines and child
+// processes in a few seconds.
 // --reuse overrides the scene's Nonlinear solver / Reuse factorization
 // (paper-stvk.prm: false, measured best for it), to compare.
 //
@@ -116,25 +119,28 @@ run_benchmark(int argc, char **argv)
     }
 
   bool         quick  = false;
+  bool         smoke  = false;
   std::string  reuse  = "scene";
   unsigned int repeat = 3;
   for (unsigned int i = 0; i < args.size(); ++i)
     if (args[i] == "--quick")
       quick = true;
+    else if (args[i] == "--smoke")
+      smoke = true;
     else if (args[i] == "--reuse" && i + 1 < args.size() &&
              (args[i + 1] == "yes" || args[i + 1] == "no"))
       reuse = args[++i];
     else if (args[i] == "--repeat" && i + 1 < args.size())
-      repeat = std::stoul(args[++i]);
+      repeat = whole_number("--repeat", args[++i], 1);
     else
       {
-        std::cerr << "usage: benchmarks/run scaling [--quick] [--repeat N] "
-                     "[--reuse yes|no]\n";
+        std::cerr << "usage: benchmarks/run scaling [--quick|--smoke] "
+                     "[--repeat N] [--reuse yes|no]\n";
         return 2;
       }
-  if (quick)
+  if (quick || smoke)
     repeat = 1;
-  const double radius     = quick ? 0.015 : 0.025;
+  const double radius     = smoke ? 0.009 : quick ? 0.015 : 0.025;
   const bool   reuse_used = scene_for("threads", 1, radius, reuse)
                             .parameters.nonlinear_solver.reuse_factorization;
 
@@ -142,7 +148,10 @@ run_benchmark(int argc, char **argv)
             << "  machine: " << std::thread::hardware_concurrency()
             << " cores; liver501 StVK, h = 5 mm, initial cloud of radius "
             << 1000 * radius << " mm around rest; median of " << repeat
-            << " run" << (repeat > 1 ? "s" : "") << (quick ? " [--quick]" : "")
+            << " run" << (repeat > 1 ? "s" : "")
+            << (smoke ? " [--smoke]" :
+                quick ? " [--quick]" :
+                        "")
             << (reuse == "scene" ? std::string() : " [--reuse " + reuse + "]")
             << "\n\n";
 

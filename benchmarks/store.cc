@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-// benchmarks/run store [--quick]
+// benchmarks/run store [--quick|--smoke]
 //
 // The HDF5 state store (issue 15) on the StVK liver scene (2 solver
 // threads), for liver501 and liver2k:
@@ -17,6 +17,9 @@
 //   a store (liver501).
 //
 // --quick: liver501 only.
+// --smoke (the test suite's): liver501, a cloud of radius 9 mm (the least
+// that holds a cell) and a stroke of 0.1 s: every step above in a few
+// seconds.
 
 #include <palpate/app/interaction_run.h>
 #include <palpate/base/environment.h>
@@ -65,17 +68,22 @@ static int
 run_benchmark(int argc, char **argv)
 {
   Environment env(argc, argv);
-  bool        quick = false;
+  bool        quick = false, smoke = false;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--quick")
       quick = true;
+    else if (std::string(argv[i]) == "--smoke")
+      smoke = quick = true;
     else
       {
-        std::cerr << "usage: benchmarks/run store [--quick]\n";
+        std::cerr << "usage: benchmarks/run store [--quick|--smoke]\n";
         return 2;
       }
   std::cout << "The HDF5 state store: paper-stvk, " << machine()
-            << (quick ? " [--quick]" : "") << "\n\n"
+            << (smoke ? " [--smoke]" :
+                quick ? " [--quick]" :
+                        "")
+            << "\n\n"
             << "| mesh | cloud states | first force from nothing (s) | from "
                "the store (s) | write (states/s) | read (states/s) | bytes "
                "per state |\n|---|---|---|---|---|---|---|\n";
@@ -91,6 +99,11 @@ run_benchmark(int argc, char **argv)
         p.mesh.file_name =
           std::string(PALPATE_SOURCE_DIR) + "/meshes/liver-tetgen/liver2k.msh";
       p.state_space.store = "bench-" + mesh + ".h5";
+      if (smoke)
+        {
+          p.scheduler.cloud_radius      = 0.009;
+          p.haptics.trajectory.duration = 0.1;
+        }
       std::filesystem::remove(p.state_space.store);
 
       std::string  report;
