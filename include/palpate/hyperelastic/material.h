@@ -155,6 +155,13 @@ namespace palpate
 #define PALPATE_REGISTER_MATERIAL(classname, name, description) \
   PALPATE_REGISTER_PLUGIN(::palpate::Material, classname, name, description)
 
+  /** The Lame parameters lambda and mu of Young's modulus @p E and
+   * Poisson's ratio @p nu (the compressible models'). */
+  double
+  lame_lambda(const double E, const double nu);
+  double
+  lame_mu(const double E, const double nu);
+
   /**
    * Helpers for material plug-ins. They throw Plugins::EntryError naming
    * @p entry when a modulus is not positive.
