@@ -100,8 +100,13 @@ namespace palpate
      * benchmark to tell which ticks are slow and why. */
     struct Work
     {
-      unsigned int corners = 0, new_corners = 0, iterations = 0;
-      unsigned int factorizations = 0, largest_active = 0, largest_patch = 0;
+      /** Corners solved, and of them those without a warm start. */
+      unsigned int corners = 0, new_corners = 0;
+      /** Active-set iterations and factorisations of W's active block,
+       * summed over the corners. */
+      unsigned int iterations = 0, factorizations = 0;
+      /** The most nodes in contact, and the largest patch, of a corner. */
+      unsigned int largest_active = 0, largest_patch = 0;
     };
 
     /** The work of the last blend() or force() call. */
