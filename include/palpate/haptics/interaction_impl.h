@@ -221,9 +221,10 @@ namespace palpate
     /**
      * With Interpolation = contact patch: the force of the complete
      * @p sample at @p position from its corners' contact patches, solved
-     * for the sphere there (PatchContact), in place of the trilinear one
-     * interpolate_force() gave. A corner without a patch leaves the sample
-     * trilinear. Real-time safe.
+     * for the sphere there (PatchContact), in place of the force linear
+     * on the HIP's tetrahedron that interpolate_on_tetrahedron() gave. A
+     * corner of that tetrahedron without a patch (dropped for the memory
+     * budget) leaves the sample's linear force. Real-time safe.
      */
     void
     render_contact_patch(const Utilities::Point3 &position,
