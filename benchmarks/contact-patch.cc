@@ -21,7 +21,7 @@
 // A sample whose cell has a failure point for a corner is left out and
 // counted (`uncovered`). contact_patch blends the patches of the 4 corners
 // of the HIP's tetrahedron in its cell, as palpate renders
-// (PatchContact::weights()); patch_8_corners the cell's 8 by trilinear
+// (simplex_weights()); patch_8_corners the cell's 8 by trilinear
 // weights with the same confidence; patch_plain those by the trilinear
 // weights alone, without PatchContact::blend()'s confidence; all in the
 // same run, each replay by a solver of its own.
@@ -44,10 +44,10 @@
 #include <palpate/base/environment.h>
 #include <palpate/base/utilities.h>
 #include <palpate/haptics/force_interpolation.h>
-#include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/contact_lcp.h>
 #include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/patch_contact.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/generators.h>
 #include <palpate/mesh/mesh.h>
@@ -263,7 +263,7 @@ namespace
   };
 
   /** How a replay blends the corners' patches: as palpate renders (the
-   * HIP's tetrahedron, PatchContact::weights()), the cell's 8 corners by
+   * HIP's tetrahedron, simplex_weights()), the cell's 8 corners by
    * trilinear weights with the same confidence, or those alone. */
   enum class Blend
   {
@@ -380,8 +380,8 @@ namespace
           patches[c] = s->contact_patch.get();
         }
       std::array<double, 9> K;
-      const auto   w = blend == Blend::rendered ? PatchContact::weights(local) :
-                                                    trilinear_weights(local);
+      const auto   w     = blend == Blend::rendered ? simplex_weights(local) :
+                                                        trilinear_weights(local);
       const double cpu   = thread_cpu_seconds();
       const auto   start = std::chrono::steady_clock::now();
       bool         settled;
@@ -730,6 +730,9 @@ namespace
   {
     Environment env(argc, argv);
     Options     o;
+    // --quick and --smoke choose the liver at 10 mm unless --body or
+    // --spacing say otherwise.
+    bool body_given = false, spacing_given = false;
     for (int i = 1; i < argc; ++i)
       {
         const std::string a = argv[i];
@@ -744,6 +747,7 @@ namespace
             const std::string b = argv[++i];
             o.bodies = b == "all" ? std::vector<std::string>{"liver", "blob"} :
                                     std::vector<std::string>{b};
+            body_given = true;
           }
         else if (a == "--patch-residual" && i + 1 < argc)
           o.patch_residual = std::stod(argv[++i]);
@@ -752,6 +756,7 @@ namespace
             o.spacings.clear();
             for (const auto &s : Utilities::split(argv[++i], ','))
               o.spacings.push_back(1e-3 * std::stod(s));
+            spacing_given = true;
           }
         else
           {
@@ -762,15 +767,12 @@ namespace
             return 2;
           }
       }
-    if (o.quick)
+    if (o.quick || o.smoke)
       {
-        o.bodies   = {"liver"};
-        o.spacings = {0.01};
-      }
-    if (o.smoke)
-      {
-        o.bodies   = {"liver"};
-        o.spacings = {0.01};
+        if (!body_given)
+          o.bodies = {"liver"};
+        if (!spacing_given)
+          o.spacings = {0.01};
       }
     std::cout << "The force between the states with the sphere; machine: "
               << machine() << "\n\n";

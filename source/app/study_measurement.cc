@@ -10,9 +10,9 @@
 
 #include <palpate/app/study_impl.h>
 #include <palpate/haptics/force_interpolation.h>
-#include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/contact_patch.h>
 #include <palpate/hyperelastic/hyperelastic_system.h>
+#include <palpate/hyperelastic/patch_contact.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/state_space/state_cache.h>
@@ -274,7 +274,7 @@ namespace palpate
                   ForceSample      &sample)
       {
         // The patches of the HIP's tetrahedron, as the haptic loop reads.
-        const auto w = PatchContact::weights(sample.local);
+        const auto                          w = simplex_weights(sample.local);
         std::array<const ContactPatch *, 8> patches{};
         for (unsigned int c = 0; c < 8; ++c)
           {

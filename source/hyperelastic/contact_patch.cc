@@ -24,7 +24,7 @@ namespace palpate
   {
     return sizeof(ContactPatch) + nodes.size() * sizeof(unsigned int) +
            (position.size() + normal.size() + free_position.size() +
-            lambda.size() + offset.size() + W.size()) *
+            lambda.size() + offset.size() + W.size() + neighbour_force.size()) *
              sizeof(double) +
            H.size() * sizeof(float);
   }
@@ -33,6 +33,10 @@ namespace palpate
 
   namespace
   {
+    /** The entries of ContactPatch::neighbour_force: the 3 x 3 x 3 grid
+     * points around the state and its own. */
+    constexpr std::size_t neighbour_entries = 27;
+
     /** The parts of a patch in the order its bytes hold them, for writing
      * and for reading. */
     template <typename Patch, typename Visit>
@@ -55,8 +59,9 @@ namespace palpate
   std::vector<char>
   patch_bytes(const ContactPatch &patch)
   {
-    const std::uint64_t n     = patch.size();
-    std::size_t         bytes = sizeof(n) + 10 * sizeof(double);
+    const std::uint64_t n = patch.size();
+    std::size_t         bytes =
+      sizeof(n) + 11 * sizeof(double) + neighbour_entries * sizeof(double);
     visit_arrays(patch,
                  [&](const auto &v) { bytes += v.size() * sizeof(v[0]); });
     std::vector<char> out(bytes);
@@ -70,9 +75,14 @@ namespace palpate
     put(patch.center.data(), 3 * sizeof(double));
     put(&patch.radius, sizeof(double));
     put(patch.force.data(), 3 * sizeof(double));
+    put(&patch.spacing, sizeof(double));
     visit_arrays(patch, [&](const auto &v) {
       put(v.data(), v.size() * sizeof(v[0]));
     });
+    std::vector<double> neighbours(neighbour_entries, -1.0);
+    if (patch.neighbour_force.size() == neighbour_entries)
+      neighbours = patch.neighbour_force;
+    put(neighbours.data(), neighbour_entries * sizeof(double));
     return out;
   }
 
@@ -100,6 +110,7 @@ namespace palpate
     get(patch->center.data(), 3 * sizeof(double));
     get(&patch->radius, sizeof(double));
     get(patch->force.data(), 3 * sizeof(double));
+    get(&patch->spacing, sizeof(double));
     patch->nodes.resize(n);
     patch->position.resize(3 * n);
     patch->normal.resize(3 * n);
@@ -110,6 +121,13 @@ namespace palpate
     patch->H.resize(9 * n * n);
     visit_arrays(*patch,
                  [&](auto &v) { get(v.data(), v.size() * sizeof(v[0])); });
+    patch->neighbour_force.resize(neighbour_entries);
+    get(patch->neighbour_force.data(), neighbour_entries * sizeof(double));
+    // A patch written without the table has -1 throughout: none.
+    if (std::all_of(patch->neighbour_force.begin(),
+                    patch->neighbour_force.end(),
+                    [](const double f) { return f < 0; }))
+      patch->neighbour_force.clear();
     if (p != end)
       throw std::runtime_error("a contact patch has the wrong length");
     return patch;
@@ -139,7 +157,7 @@ namespace palpate
 
 
 
-  std::shared_ptr<const ContactPatch>
+  std::shared_ptr<ContactPatch>
   make_contact_patch(const HyperelasticSystem                    &system,
                      const std::vector<unsigned int>             &nodes,
                      const std::vector<double>                   &block,

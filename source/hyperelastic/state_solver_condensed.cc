@@ -6,6 +6,7 @@
 // the candidates' compliance, and the probe's stiffness from it.
 
 #include <palpate/hyperelastic/contact_patch.h>
+#include <palpate/hyperelastic/patch_contact.h>
 #include <palpate/hyperelastic/state_solver_impl.h>
 
 #include <algorithm>
@@ -253,13 +254,17 @@ namespace palpate
           return false;
         state.stiffness_factorizations += made;
       }
-    state.contact_patch = make_contact_patch(*system,
-                                             patch_nodes,
-                                             patch_block,
-                                             x,
-                                             state.active_displacement,
-                                             patch_rows);
-    return state.contact_patch != nullptr;
+    auto patch = make_contact_patch(*system,
+                                    patch_nodes,
+                                    patch_block,
+                                    x,
+                                    state.active_displacement,
+                                    patch_rows);
+    if (!patch)
+      return false;
+    tabulate_neighbours(*patch, grid_spacing);
+    state.contact_patch = std::move(patch);
+    return true;
   }
 
 

@@ -63,15 +63,24 @@ namespace palpate
       {
         const std::string stored = s.attribute(field);
         if (stored != value && field == "contact patches")
-          s.fail(stored == "kept" ?
-                   "the store keeps contact patches (it was made with "
-                   "State space / Interpolation = contact patch), and this "
-                   "scene interpolates otherwise" :
-                   "the store keeps no contact patches (it was made with "
-                   "another State space / Interpolation), and contact patch "
-                   "needs each state's",
-                 "use another store file for this scene (State space / "
-                 "Store), or the interpolation the store was made with.");
+          {
+            if (stored == "kept" && value != "none")
+              s.fail("the store's contact patches are of an older layout "
+                     "(without their model's force at the neighbouring "
+                     "states, which the blend corrects each corner by)",
+                     "delete the store to compute its states again with "
+                     "this palpate, or name another store file (State "
+                     "space / Store).");
+            s.fail(stored != "none" ?
+                     "the store keeps contact patches (it was made with "
+                     "State space / Interpolation = contact patch), and "
+                     "this scene interpolates otherwise" :
+                     "the store keeps no contact patches (it was made with "
+                     "another State space / Interpolation), and contact "
+                     "patch needs each state's",
+                   "use another store file for this scene (State space / "
+                   "Store), or the interpolation the store was made with.");
+          }
         if (stored != value)
           s.fail("the store was computed for other physics: its " + field +
                    " is '" + stored + "', the scene's is '" + value +

@@ -120,9 +120,12 @@ namespace palpate
     // A store of states without their patches cannot serve Interpolation
     // = contact patch (its cells would render without them), nor the
     // reverse be told apart by the states alone.
+    // Layout 2: each patch with its model's force at the neighbours
+    // (ContactPatch::neighbour_force); a store of layout 1 is another
+    // store.
     f.fields.emplace_back("contact patches",
                           p.state_space.interpolation == "contact patch" ?
-                            "kept" :
+                            "kept (layout 2)" :
                             "none");
     f.fields.emplace_back("palpate version", PALPATE_VERSION);
     return f;

@@ -19,8 +19,8 @@
 #include <palpate/engine/hip_channel.h>
 #include <palpate/engine/mpi_engine.h>
 #include <palpate/engine/thread_engine.h>
-#include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/contact_patch.h>
+#include <palpate/hyperelastic/patch_contact.h>
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
@@ -80,7 +80,7 @@ namespace
             return {{0, 0, 0}};
           }
       }
-    weights = palpate::PatchContact::weights(t);
+    weights = palpate::simplex_weights(t);
     Point3 f;
     // Twenty ticks where the hand rests: the fixed-point iteration settles.
     for (unsigned int tick = 0; tick < 20; ++tick)

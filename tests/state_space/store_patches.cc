@@ -17,8 +17,8 @@
 //   reads them.
 
 #include <palpate/base/exceptions.h>
-#include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/contact_patch.h>
+#include <palpate/hyperelastic/patch_contact.h>
 #include <palpate/hyperelastic/state_solver.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -28,6 +28,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -215,4 +216,38 @@ main(int argc, char **argv)
                        palpate::StoreFingerprint::of(h.scene, h.mesh, h.nodes))
             << std::endl;
   }
+
+  // Patches of the first layout (no model forces at the neighbours): a
+  // contact-patch store whose fingerprint says so.
+  {
+    std::filesystem::remove("layout-1.h5");
+    {
+      palpate::StateStore store("layout-1.h5", fingerprint);
+      store.append(states[0].first, states[0].second);
+    }
+    const hid_t       f     = H5Fopen("layout-1.h5", H5F_ACC_RDWR, H5P_DEFAULT);
+    const std::string value = "kept";
+    H5Adelete(f, "contact patches");
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, value.size());
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t a =
+      H5Acreate2(f, "contact patches", type, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a, type, value.data());
+    H5Aclose(a);
+    H5Sclose(space);
+    H5Tclose(type);
+    H5Fclose(f);
+    deallog << "a store of the first patch layout: "
+            << refusal("layout-1.h5", fingerprint) << std::endl;
+  }
+  deallog << "the patches carry their model's force at the 27 grid points "
+             "around them: "
+          << ok(std::all_of(
+               states.begin(),
+               states.end(),
+               [](const auto &s) {
+                 return s.second.contact_patch->neighbour_force.size() == 27;
+               }))
+          << std::endl;
 }

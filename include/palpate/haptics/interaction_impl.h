@@ -18,7 +18,7 @@
 #include <palpate/engine/hip_channel.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/interaction.h>
-#include <palpate/haptics/patch_contact.h>
+#include <palpate/hyperelastic/patch_contact.h>
 #include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/mesh/mesh.h>
@@ -250,7 +250,7 @@ namespace palpate
       if (all)
         {
           patch_contact->blend(patches,
-                               PatchContact::weights(sample.local),
+                               simplex_weights(sample.local),
                                position,
                                sample.force,
                                &sample.stiffness);
@@ -287,7 +287,7 @@ namespace palpate
           std::clamp((position[d] - last_origin[d]) / grid.spacing(), 0.0, 1.0);
       // The tetrahedron of the clamped position, less a corner whose patch
       // was not there (the last cell was complete for another tetrahedron).
-      auto   weights = PatchContact::weights(local);
+      auto   weights = simplex_weights(local);
       double total   = 0;
       for (unsigned int c = 0; c < 8; ++c)
         total += last_patches[c] ? weights[c] : (weights[c] = 0);

@@ -82,6 +82,17 @@ namespace palpate
      * while the set of nodes in contact stays. */
     std::vector<double> W;
 
+    /**
+     * The grid spacing h (m) of the states around this one, and the
+     * magnitude of this model's force (N) at each of them, solved by
+     * following the sphere there from the state (tabulate_neighbours()):
+     * neighbour_force[9 (k + 1) + 3 (j + 1) + (i + 1)] for the HIP at
+     * target + h (i, j, k), i, j, k in {-1, 0, 1}; 27 entries, or none
+     * (then the blend does not correct the model: PatchContact::blend()).
+     */
+    double              spacing = 0;
+    std::vector<double> neighbour_force;
+
     /** The number of nodes. */
     unsigned int
     size() const noexcept
@@ -100,9 +111,10 @@ namespace palpate
 
   /**
    * @p patch as bytes, the same on every machine of one byte order: its
-   * node count, target, centre, radius and force (10 doubles), then its
-   * arrays, whose lengths follow from the count (n node numbers, 3n, 3n,
-   * 3n, n, n and n^2 doubles, 9 n^2 floats for H). What an MPI result
+   * node count, target, centre, radius, force and spacing (11 doubles),
+   * then its arrays, whose lengths follow from the count (n node numbers,
+   * 3n, 3n, 3n, n, n and n^2 doubles, 9 n^2 floats for H, 27 doubles of
+   * neighbour_force, -1 where it has none). What an MPI result
    * carries after its header and a state store keeps beside a state.
    */
   std::vector<char>
@@ -139,7 +151,7 @@ namespace palpate
    * contact_patch_nodes()'s unknowns: InverseBlock::compute()), of the
    * tangent at x or at an iterate close to it. @p rows is work space.
    */
-  std::shared_ptr<const ContactPatch>
+  std::shared_ptr<ContactPatch>
   make_contact_patch(const HyperelasticSystem                    &system,
                      const std::vector<unsigned int>             &nodes,
                      const std::vector<double>                   &block,

@@ -75,6 +75,7 @@ namespace palpate
       if (p.state_space.interpolation == "contact patch")
         patch_reach = std::sqrt(3.0) * p.state_space.grid_spacing +
                       0.25 * p.boundary_conditions.active_node.tip_radius;
+      grid_spacing     = p.state_space.grid_spacing;
       const auto start = std::chrono::steady_clock::now();
       system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
       // The load effects the scene switches on, and only those.
@@ -554,6 +555,8 @@ namespace palpate
     // With Interpolation = contact patch: how far from the sphere a
     // patch's nodes may be (m); 0: no patches.
     double patch_reach = 0;
+    // The grid's spacing (m): where a patch tabulates its model's force.
+    double grid_spacing = 0;
 
     // The body's equilibrium with the sphere touching nothing (empty
     // until a state shows it), and the rows of a check against it.

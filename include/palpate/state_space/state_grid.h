@@ -131,6 +131,11 @@ namespace palpate
    * triangulation (6 tetrahedra along its main diagonal) holding
    * @p local: at most 4 are not zero, they sum to 1, are continuous
    * across cells and tetrahedra, and are 1 at their own corner.
+   *
+   * The contact patch blends its corners by them (PatchContact::blend()),
+   * so that a tick solves the contact of 4 corners, not 8: against the
+   * trilinear weights of all 8 the same accuracy against direct solves
+   * for half the work (doc/benchmarks/contact-patch.md).
    */
   std::array<double, 8>
   simplex_weights(const std::array<double, 3> &local) noexcept;

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-#include <palpate/haptics/patch_contact.h>
 #include <palpate/hyperelastic/contact_lcp.h>
 #include <palpate/hyperelastic/contact_patch.h>
-#include <palpate/state_space/state_grid.h>
+#include <palpate/hyperelastic/patch_contact.h>
 
 #include <algorithm>
 #include <cmath>
@@ -110,16 +109,23 @@ namespace palpate
     // across a face.
     , slots(12)
     , q(max_nodes)
+    , gap(max_nodes)
     , w(max_nodes)
     , rhs(3 * this->max_active)
     , rho(max_nodes)
     , u(max_nodes)
     , loaded(max_nodes)
+    , left(max_nodes)
+    , block_capacity(std::min(this->max_active, 64u))
   {
     for (Slot &s : slots)
       {
         s.lambda.resize(max_nodes);
         s.y.resize(3 * std::size_t(max_nodes));
+        s.direction.resize(3 * std::size_t(max_nodes));
+        s.block.resize(std::size_t(block_capacity) * block_capacity * 9);
+        s.block_nodes.resize(block_capacity);
+        s.block_pos.assign(max_nodes, -1);
         s.active.resize(max_nodes);
         s.index.resize(this->max_active);
         s.LU.resize(std::size_t(this->max_active) * this->max_active);
@@ -152,6 +158,7 @@ namespace palpate
     s.id       = patch.id;
     s.used     = clock;
     s.factored = false;
+    forget_blocks(s);
     std::copy(patch.lambda.begin(), patch.lambda.end(), s.lambda.begin());
     std::copy(patch.position.begin(), patch.position.end(), s.y.begin());
     for (unsigned int i = 0; i < patch.size(); ++i)
@@ -173,9 +180,7 @@ namespace palpate
             return false;
           s.index[m++] = i;
         }
-    for (unsigned int a = 0; a < m; ++a)
-      for (unsigned int b = 0; b < m; ++b)
-        s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
+    assemble_active_block(patch, s, m);
     s.n_active = m;
     ++work.factorizations;
     // W is a compliance, symmetric positive definite at a stable state:
@@ -184,14 +189,109 @@ namespace palpate
     s.cholesky = cholesky(s.LU.data(), m);
     if (!s.cholesky)
       {
-        for (unsigned int a = 0; a < m; ++a)
-          for (unsigned int b = 0; b < m; ++b)
-            s.LU[a * m + b] = patch.W[std::size_t(s.index[a]) * n + s.index[b]];
+        assemble_active_block(patch, s, m);
         s.factored = lu_factorize(s.LU.data(), m, s.pivot.data());
       }
     else
       s.factored = true;
     return s.factored;
+  }
+
+
+
+  void
+  PatchContact::assemble_active_block(const ContactPatch &patch,
+                                      Slot               &s,
+                                      const unsigned int  m) noexcept
+  {
+    for (unsigned int a = 0; a < m; ++a)
+      {
+        const unsigned int i = s.index[a];
+        for (unsigned int r = 0; r < 3; ++r)
+          s.direction[3 * i + r] = u[i][r] / rho[i];
+      }
+    const bool        from_block = keep_blocks(patch, s, m);
+    const std::size_t M          = 3 * std::size_t(patch.size());
+    for (unsigned int a = 0; a < m; ++a)
+      {
+        const unsigned int i  = s.index[a];
+        const double      *di = s.direction.data() + 3 * std::size_t(i);
+        for (unsigned int b = a; b < m; ++b)
+          {
+            const unsigned int j  = s.index[b];
+            const double      *dj = s.direction.data() + 3 * std::size_t(j);
+            double             v  = 0;
+            for (unsigned int r = 0; r < 3; ++r)
+              {
+                const float *h =
+                  from_block ? s.block.data() +
+                                 (std::size_t(s.block_pos[i]) * block_capacity +
+                                  s.block_pos[j]) *
+                                   9 +
+                                 3 * r :
+                               patch.H.data() + (3 * i + r) * M + 3 * j;
+                v += di[r] * (h[0] * dj[0] + h[1] * dj[1] + h[2] * dj[2]);
+              }
+            s.LU[a * m + b] = s.LU[b * m + a] = v;
+          }
+      }
+  }
+
+
+
+  bool
+  PatchContact::keep_blocks(const ContactPatch &patch,
+                            Slot               &s,
+                            const unsigned int  m) noexcept
+  {
+    // H's 3 x 3 blocks on the nodes in contact lie rows of H apart: each
+    // tick that the normals turn would gather them through memory again.
+    // The slot keeps them side by side for the nodes it has seen in
+    // contact, adding those that join, and starts again when full.
+    unsigned int missing = 0;
+    for (unsigned int a = 0; a < m; ++a)
+      missing += s.block_pos[s.index[a]] < 0;
+    if (missing == 0)
+      return true;
+    if (m > block_capacity)
+      return false;
+    if (s.n_block + missing > block_capacity)
+      forget_blocks(s);
+    const std::size_t M = 3 * std::size_t(patch.size());
+    for (unsigned int a = 0; a < m; ++a)
+      {
+        const unsigned int i = s.index[a];
+        if (s.block_pos[i] >= 0)
+          continue;
+        const unsigned int p = s.n_block++;
+        s.block_pos[i]       = p;
+        s.block_nodes[p]     = i;
+        for (unsigned int q = 0; q <= p; ++q)
+          {
+            const unsigned int j = s.block_nodes[q];
+            // Both blocks as H holds them (not one the other's transpose):
+            // W is then what gathering from H gives, to the bit.
+            for (unsigned int r = 0; r < 3; ++r)
+              for (unsigned int c = 0; c < 3; ++c)
+                {
+                  s.block[(std::size_t(p) * block_capacity + q) * 9 + 3 * r +
+                          c] = patch.H[(3 * i + r) * M + 3 * j + c];
+                  s.block[(std::size_t(q) * block_capacity + p) * 9 + 3 * r +
+                          c] = patch.H[(3 * j + r) * M + 3 * i + c];
+                }
+          }
+      }
+    return true;
+  }
+
+
+
+  void
+  PatchContact::forget_blocks(Slot &s) noexcept
+  {
+    for (unsigned int q = 0; q < s.n_block; ++q)
+      s.block_pos[s.block_nodes[q]] = -1;
+    s.n_block = 0;
   }
 
 
@@ -230,7 +330,8 @@ namespace palpate
             r2 += u[i][a] * u[i][a];
           }
         rho[i]   = std::sqrt(r2);
-        q[i]     = rho[i] - patch.radius + patch.offset[i];
+        gap[i]   = rho[i] - patch.radius + patch.offset[i];
+        q[i]     = gap[i];
         touching = touching || q[i] < -gap_tolerance;
         if (s.lambda[i] > 0)
           loaded[n_loaded++] = i;
@@ -254,6 +355,18 @@ namespace palpate
               patch.W.data() + std::size_t(loaded[l]) * n,
               -s.lambda[loaded[l]],
               n);
+    std::fill(left.begin(), left.begin() + n, 0);
+    // The factors are of W along the directions of their time: stale once
+    // the sphere's normals at the nodes in contact have turned.
+    if (s.factored)
+      for (unsigned int a = 0; a < s.n_active && s.factored; ++a)
+        {
+          const unsigned int i = s.index[a];
+          for (unsigned int r = 0; r < 3; ++r)
+            if (std::abs(u[i][r] / rho[i] - s.direction[3 * i + r]) >
+                direction_tolerance)
+              s.factored = false;
+        }
 
     // Primal-dual active set: the forces of the nodes in contact close
     // their gaps, the others carry none; nodes pulled leave, nodes inside
@@ -268,7 +381,7 @@ namespace palpate
           break;
         const unsigned int m = s.n_active;
         for (unsigned int a = 0; a < m; ++a)
-          rhs[a] = -q[s.index[a]];
+          rhs[a] = -free_gap(patch, s, s.index[a]);
         solve_active(s, rhs.data());
         std::fill(s.lambda.begin(), s.lambda.begin() + n, 0.0);
         for (unsigned int a = 0; a < m; ++a)
@@ -280,13 +393,19 @@ namespace palpate
                   patch.W.data() + std::size_t(s.index[a]) * n,
                   rhs[a],
                   n);
+        // The gaps w of the nodes not in contact are predicted along the
+        // state's normals, their forces along the sphere's current ones:
+        // a node the prediction brings in and the solve pushes out again
+        // stays out for this step (the next step's gaps are exact), so
+        // that the two cannot take turns.
         settled = true;
         for (unsigned int i = 0; i < n; ++i)
           {
             const bool now =
-              s.active[i] ? s.lambda[i] > 0 : w[i] < -gap_tolerance;
+              s.active[i] ? s.lambda[i] > 0 : w[i] < -gap_tolerance && !left[i];
             if (now != bool(s.active[i]))
               {
+                left[i]     = !now;
                 s.active[i] = now;
                 settled     = false;
               }
@@ -296,6 +415,22 @@ namespace palpate
       }
 
     return settled;
+  }
+
+
+
+  double
+  PatchContact::free_gap(const ContactPatch &patch,
+                         const Slot         &s,
+                         const unsigned int  i) const noexcept
+  {
+    // The nodes are at y = x_free + H f: node i's gap along its direction
+    // of factorisation with every force taken off.
+    const double *d    = s.direction.data() + 3 * std::size_t(i);
+    double        move = 0;
+    for (unsigned int r = 0; r < 3; ++r)
+      move += d[r] * (s.y[3 * i + r] - patch.free_position[3 * i + r]);
+    return gap[i] - move;
   }
 
 
@@ -409,14 +544,6 @@ namespace palpate
 
 
 
-  std::array<double, 8>
-  PatchContact::weights(const std::array<double, 3> &local) noexcept
-  {
-    return simplex_weights(local);
-  }
-
-
-
   bool
   PatchContact::blend(const std::array<const ContactPatch *, 8> &corners,
                       const std::array<double, 8>               &weights,
@@ -438,6 +565,12 @@ namespace palpate
           continue;
         settled =
           corner_force(*corners[c], x, f, stiffness ? &k : nullptr) && settled;
+        const double stiffening = stiffening_ratio(corners, weights, c);
+        for (unsigned int a = 0; a < 3; ++a)
+          f[a] *= stiffening;
+        if (stiffness)
+          for (double &e : k)
+            e *= stiffening;
         // A corner pressing harder than the contact at x does is trusted
         // less (see blend() in the header).
         const double own = Utilities::norm(corners[c]->force);
@@ -461,5 +594,102 @@ namespace palpate
             (*stiffness)[e] /= total;
       }
     return settled;
+  }
+
+
+
+  double
+  PatchContact::stiffening_ratio(
+    const std::array<const ContactPatch *, 8> &corners,
+    const std::array<double, 8>               &weights,
+    const unsigned int                         c) noexcept
+  {
+    const ContactPatch &patch = *corners[c];
+    if (patch.neighbour_force.size() != 27)
+      return 1;
+    double log_ratio = 0;
+    for (unsigned int j = 0; j < 8; ++j)
+      {
+        if (j == c || weights[j] == 0)
+          continue;
+        // Corner j's offset from corner c in grid steps: the bits of the
+        // corner numbers are the axes (StateGrid::corners()).
+        unsigned int entry = 0, stride = 1;
+        for (unsigned int a = 0; a < 3; ++a, stride *= 3)
+          entry += stride * (1 + int((j >> a) & 1) - int((c >> a) & 1));
+        const double model = patch.neighbour_force[entry];
+        const double state = Utilities::norm(corners[j]->force);
+        if (model < force_floor || state < force_floor)
+          continue;
+        const double r =
+          std::clamp(state / model, 1 / largest_ratio, largest_ratio);
+        log_ratio += weights[j] * std::log(r);
+      }
+    return std::exp(log_ratio);
+  }
+
+
+
+  void
+  PatchContact::forget() noexcept
+  {
+    for (Slot &s : slots)
+      {
+        s.patch = nullptr;
+        s.id    = 0;
+        s.used  = 0;
+      }
+  }
+
+
+
+  void
+  tabulate_neighbours(ContactPatch &patch, const double spacing)
+  {
+    patch.spacing = spacing;
+    patch.neighbour_force.assign(27, 0.0);
+    const unsigned int n = patch.size();
+    if (n == 0)
+      return;
+    PatchContact solver(n, n);
+    // The largest step on the way (m): ten ticks of a hand at 25 mm/s,
+    // 2.5 % of the sphere's 1 cm radius, which keeps each node on the
+    // side of the sphere it is on.
+    constexpr double step = 2.5e-4;
+    for (int k = -1; k <= 1; ++k)
+      for (int j = -1; j <= 1; ++j)
+        for (int i = -1; i <= 1; ++i)
+          {
+            const Utilities::Point3 to = {{patch.target[0] + i * spacing,
+                                           patch.target[1] + j * spacing,
+                                           patch.target[2] + k * spacing}};
+            const unsigned int      steps =
+              std::max(1.0,
+                       std::ceil(Utilities::distance(patch.target, to) / step));
+            solver.forget();
+            Utilities::Point3 f;
+            for (unsigned int t = 1; t <= steps; ++t)
+              {
+                const double      s = double(t) / steps;
+                Utilities::Point3 x;
+                for (unsigned int a = 0; a < 3; ++a)
+                  x[a] = patch.target[a] + s * (to[a] - patch.target[a]);
+                solver.force(patch, x, f);
+              }
+            // Then held there until the model settles (it converges
+            // at the rate of its slowest sliding mode).
+            Utilities::Point3 last = f;
+            for (unsigned int t = 0; t < 200; ++t)
+              {
+                const bool settled = solver.force(patch, to, f);
+                if (settled && Utilities::distance(f, last) <=
+                                 1e-6 * std::max(Utilities::norm(f),
+                                                 PatchContact::force_floor))
+                  break;
+                last = f;
+              }
+            patch.neighbour_force[9 * (k + 1) + 3 * (j + 1) + (i + 1)] =
+              Utilities::norm(f);
+          }
   }
 } // namespace palpate
