@@ -2,7 +2,7 @@
 // Copyright (C) 2026 the palpate authors
 
 // benchmarks/run contact-patch [--quick|--smoke] [--body liver|blob|all]
-//                              [--spacing 5,10,20] [--verbose]
+//                              [--spacing 5,10,20] [--verbose] [--dump FILE]
 //
 // The force between the states with the sphere (issue 45): on the shipped
 // indenter liver (parameters/liver-indenter.prm, 2,012 nodes) and on the
@@ -30,7 +30,11 @@
 // 20 ticks between neighbouring samples (the sphere moving about 0.05 mm a
 // tick) in one thread, as the haptic loop calls it; held_tick_us_p999: as
 // many ticks with the HIP held still (the same work each tick), this VM's
-// jitter for a tick of that size in the same run.
+// jitter for a tick of that size in the same run; tick_work_us_p999: each
+// tick's least time over three replays of the same ticks by fresh solvers
+// (the tick's own work, the VM's interruptions taken out), beside
+// bare_loop_us_p999, a loop of fixed arithmetic as long as the median tick
+// timed as many times (what the VM alone makes of a loop of that length).
 //
 // Targets: contact patch at 10 mm: err_p95_pct <= 3.5, err_max_pct <= 7,
 // tick_us_p999 <= 100, and below Hermite's error at the same spacing.
@@ -40,6 +44,8 @@
 // (not 4 mm), 10 mm, one sweep in contact on the normal (1 to 4 mm deep,
 // 0.5 mm steps), the grid states with one cutback: every interpolation
 // and the ticks.
+// --dump FILE: the corners' forces at each sample, for trying blends
+// off-line (dump_corners()).
 
 #include <palpate/base/environment.h>
 #include <palpate/base/utilities.h>
@@ -62,6 +68,7 @@
 #include <cmath>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -86,6 +93,8 @@ namespace
     /** The grid states' Nonlinear solver / patch_factor_residual
      * (--patch-residual R; 0: the scene's). */
     double patch_residual = 0;
+    /** --dump FILE: the corners' forces at each sample (dump_corners()). */
+    std::string dump;
   };
 
   Point3
@@ -259,6 +268,8 @@ namespace
     std::string body, interpolation;
     double spacing_mm = 0, p95 = 0, max = 0, tick_p999 = 0, states_per_cm = 0;
     double held_p50 = 0, held_p999 = 0, cpu_p999 = 0;
+    // The tick's least time over three replays, and the bare loop's.
+    double       work_p999 = 0, bare_p999 = 0;
     unsigned int samples = 0, uncovered = 0;
   };
 
@@ -269,7 +280,10 @@ namespace
   {
     rendered,
     cell,
-    plain
+    plain,
+    // The HIP's tetrahedron's corners, each's force kept apart
+    // (Replay::corner_force): for --dump.
+    corners
   };
 
   /** A replay of the sweeps through a PatchContact: the force at each
@@ -283,6 +297,9 @@ namespace
     std::vector<double>             tick_us, cpu_us, held_us;
     std::vector<PatchContact::Work> works;
     unsigned int                    unsettled = 0;
+    // Blend::corners: at each sample, each corner's weight and force.
+    std::vector<std::array<double, 8>> corner_weight;
+    std::vector<std::array<Point3, 8>> corner_force;
   };
 
   /** The slowest ticks (the p99.9 tail and a few more) with the work they
@@ -298,9 +315,10 @@ namespace
       return tick_us[a] > tick_us[b];
     });
     const std::size_t shown = std::min<std::size_t>(order.size(), 8);
-    std::cout << "  the slowest ticks: us (corners, new corners, active-set "
-                 "iterations, factorisations, largest active set, largest "
-                 "patch)\n";
+    std::cout
+      << "  the slowest ticks (least of 3 replays): us (corners, new corners, active-set "
+         "iterations, factorisations, largest active set, largest "
+         "patch)\n";
     for (std::size_t k = 0; k < shown; ++k)
       {
         const auto &w = works[order[k]];
@@ -364,8 +382,11 @@ namespace
          PatchContact                           &solver,
          const Blend                             blend)
   {
-    Replay r;
-    auto   tick = [&](const Point3 &x, Point3 &f) {
+    Replay                r;
+    std::array<double, 8> last_weight{};
+    std::array<Point3, 8> last_force{};
+    auto                  tick = [&](const Point3 &x, Point3 &f) {
+      last_force = {};
       GridIndex             lower;
       std::array<double, 3> local;
       if (!grid.locate(x, lower, local))
@@ -380,12 +401,14 @@ namespace
           patches[c] = s->contact_patch.get();
         }
       std::array<double, 9> K;
-      const auto   w     = blend == Blend::rendered ? simplex_weights(local) :
-                                                        trilinear_weights(local);
+      const auto w = blend == Blend::rendered || blend == Blend::corners ?
+                                        simplex_weights(local) :
+                                        trilinear_weights(local);
+      last_weight        = w;
       const double cpu   = thread_cpu_seconds();
       const auto   start = std::chrono::steady_clock::now();
       bool         settled;
-      if (blend != Blend::plain)
+      if (blend == Blend::rendered || blend == Blend::cell)
         settled = solver.blend(patches, w, x, f, &K);
       else
         {
@@ -396,7 +419,8 @@ namespace
               {
                 Point3 fc;
                 settled = solver.force(*patches[c], x, fc) && settled;
-                f       = add(f, fc, w[c]);
+                f             = add(f, fc, w[c]);
+                last_force[c] = fc;
               }
         }
       r.tick_us.push_back(1e6 * Utilities::seconds_since(start));
@@ -432,6 +456,8 @@ namespace
                      f);
           r.force.push_back(f);
           r.covered.push_back(covered);
+          r.corner_weight.push_back(last_weight);
+          r.corner_force.push_back(last_force);
         }
     if (!lines.empty() && !lines.back().empty())
       {
@@ -449,6 +475,120 @@ namespace
         r.tick_force.resize(n_ticks);
       }
     return r;
+  }
+
+  /** The tick's own time, without this VM's jitter: the sweeps replayed
+   * again by fresh solvers (the same ticks, the same work: the forces must
+   * agree to the bit), each tick's least time over the replays; and a bare
+   * loop of fixed arithmetic as long as the median tick, timed as often in
+   * the same run (the tail the VM alone gives a loop of that length). */
+  struct TickWork
+  {
+    std::vector<double> least_us;
+    std::vector<double> bare_us;
+  };
+
+  /** Busy arithmetic for about @p n steps, not optimised away. */
+  double
+  bare_work(const unsigned int n)
+  {
+    volatile double sink = 0;
+    double          v    = 1;
+    for (unsigned int i = 0; i < n; ++i)
+      v = v * 1.0000001 + 1e-9;
+    sink = v;
+    return sink;
+  }
+
+  TickWork
+  tick_work(const StateGrid                        &grid,
+            const StateCache                       &cache,
+            const std::vector<std::vector<Point3>> &lines,
+            const Replay                           &first,
+            const unsigned int                      max_nodes)
+  {
+    TickWork work;
+    work.least_us = first.tick_us;
+    for (unsigned int pass = 0; pass < 2; ++pass)
+      {
+        PatchContact again(max_nodes, 256);
+        const Replay r = replay(grid, cache, lines, again, Blend::rendered);
+        if (r.tick_force != first.tick_force)
+          throw std::runtime_error("contact-patch: a replay of the same "
+                                   "ticks rendered other forces");
+        for (std::size_t t = 0; t < r.tick_us.size(); ++t)
+          work.least_us[t] = std::min(work.least_us[t], r.tick_us[t]);
+      }
+    // The loop's length: as many steps as take the median tick's time.
+    const double        target = percentile(first.tick_us, 0.5);
+    std::vector<double> calibration;
+    for (unsigned int t = 0; t < 101; ++t)
+      {
+        const auto start = std::chrono::steady_clock::now();
+        bare_work(100000);
+        calibration.push_back(1e6 * Utilities::seconds_since(start));
+      }
+    const unsigned int steps =
+      std::max(1.0, 100000 * target / percentile(calibration, 0.5));
+    for (std::size_t t = 0; t < first.tick_us.size(); ++t)
+      {
+        const auto start = std::chrono::steady_clock::now();
+        bare_work(steps);
+        work.bare_us.push_back(1e6 * Utilities::seconds_since(start));
+      }
+    return work;
+  }
+
+  /**
+   * --dump FILE: per sample and corner of the HIP's tetrahedron, the
+   * corner's weight, its patch's force at the sample (uncorrected), its
+   * state's force and its model's force at the 27 grid points around it
+   * (ContactPatch::neighbour_force), after the direct force: what a blend
+   * is made from, for trying blends off-line. Appends (one body after the
+   * other), one line per sample:
+   *   body i x y z fx fy fz [c w Fx Fy Fz Sx Sy Sz m0 ... m26]...
+   */
+  void
+  dump_corners(const std::string         &file,
+               const std::string         &body,
+               const StateGrid           &grid,
+               const StateCache          &cache,
+               const std::vector<Point3> &samples,
+               const std::vector<Point3> &f_direct,
+               const Replay              &r)
+  {
+    std::ofstream out(file, std::ios::app);
+    out << std::setprecision(17);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      {
+        if (!r.covered[i])
+          continue;
+        GridIndex             lower;
+        std::array<double, 3> local;
+        grid.locate(samples[i], lower, local);
+        const auto corners = grid.corners(lower);
+        out << body << ' ' << i;
+        for (const Point3 *v : {&samples[i], &f_direct[i]})
+          for (const double e : *v)
+            out << ' ' << e;
+        for (unsigned int c = 0; c < 8; ++c)
+          {
+            if (r.corner_weight[i][c] == 0)
+              continue;
+            const auto &patch = *cache.state(corners[c])->contact_patch;
+            out << ' ' << c << ' ' << r.corner_weight[i][c];
+            for (const double e : r.corner_force[i][c])
+              out << ' ' << e;
+            for (const double e : patch.force)
+              out << ' ' << e;
+            for (unsigned int e = 0; e < 27; ++e)
+              out << ' '
+                  << (patch.neighbour_force.size() == 27 ?
+                        patch.neighbour_force[e] :
+                        -1.0);
+          }
+        out << '\n';
+      }
   }
 
   /** Everything measured on one body. */
@@ -659,10 +799,25 @@ namespace
         PatchContact plain_contact(contact.size(), 256);
         const Replay ticks =
           replay(grid, cache, direct_lines, rendered, Blend::rendered);
+        const TickWork work =
+          tick_work(grid, cache, direct_lines, ticks, contact.size());
         const Replay cell =
           replay(grid, cache, direct_lines, cell_contact, Blend::cell);
         const Replay plain =
           replay(grid, cache, direct_lines, plain_contact, Blend::plain);
+
+        if (!o.dump.empty())
+          {
+            PatchContact dump_contact(contact.size(), 256);
+            dump_corners(
+              o.dump,
+              body,
+              grid,
+              cache,
+              samples,
+              f_direct,
+              replay(grid, cache, direct_lines, dump_contact, Blend::corners));
+          }
 
         std::vector<double> err, err_cell, err_plain;
         for (std::size_t i = 0; i < samples.size(); ++i)
@@ -683,7 +838,7 @@ namespace
           }
         print_work(ticks, "contact patch (the HIP's tetrahedron, 4 corners)");
         print_work(cell, "the cell's 8 corners, trilinear weights");
-        print_slowest_ticks(ticks.tick_us, ticks.works);
+        print_slowest_ticks(work.least_us, ticks.works);
         auto timed = [&](Row r, const Replay &replayed) {
           r.tick_p999 = percentile(replayed.tick_us, 0.999);
           r.held_p50  = percentile(replayed.held_us, 0.5);
@@ -694,7 +849,12 @@ namespace
         row.samples = err.size();
         row.p95     = percentile(err, 0.95);
         row.max     = percentile(err, 1.0);
-        rows.push_back(timed(row, ticks));
+        {
+          Row timed_row       = timed(row, ticks);
+          timed_row.work_p999 = percentile(work.least_us, 0.999);
+          timed_row.bare_p999 = percentile(work.bare_us, 0.999);
+          rows.push_back(timed_row);
+        }
         Row cell_row           = timed(row, cell);
         cell_row.interpolation = "patch_8_corners";
         cell_row.p95           = percentile(err_cell, 0.95);
@@ -718,6 +878,12 @@ namespace
                   << percentile(ticks.tick_us, 0.99) << " us, p999 "
                   << r.tick_p999 << " us; held in place: p50 " << r.held_p50
                   << " us, p999 " << r.held_p999 << " us" << std::endl;
+        std::cout << "  the same ticks' least time over 3 replays: p50 "
+                  << percentile(work.least_us, 0.5) << " us, p99 "
+                  << percentile(work.least_us, 0.99) << " us, p999 "
+                  << r.work_p999 << " us; a bare loop as long as the median "
+                  << "tick: p50 " << percentile(work.bare_us, 0.5)
+                  << " us, p999 " << r.bare_p999 << " us" << std::endl;
         std::cout << "  the same ticks' thread CPU time: p50 "
                   << percentile(ticks.cpu_us, 0.5) << " us, p99 "
                   << percentile(ticks.cpu_us, 0.99) << " us, p999 "
@@ -749,6 +915,8 @@ namespace
                                     std::vector<std::string>{b};
             body_given = true;
           }
+        else if (a == "--dump" && i + 1 < argc)
+          o.dump = argv[++i];
         else if (a == "--patch-residual" && i + 1 < argc)
           o.patch_residual = std::stod(argv[++i]);
         else if (a == "--spacing" && i + 1 < argc)
@@ -763,7 +931,7 @@ namespace
             std::cerr
               << "usage: benchmarks/run contact-patch [--quick|--smoke] "
                  "[--body liver|blob|all] [--spacing 5,10,20] "
-                 "[--patch-residual R]\n";
+                 "[--patch-residual R] [--verbose] [--dump FILE]\n";
             return 2;
           }
       }
@@ -802,6 +970,8 @@ namespace
                 << " err_max_pct=" << r.max << " tick_us_p999=" << r.tick_p999
                 << " held_tick_us_p999=" << r.held_p999
                 << " tick_cpu_us_p999=" << r.cpu_p999
+                << " tick_work_us_p999=" << r.work_p999
+                << " bare_loop_us_p999=" << r.bare_p999
                 << " states_per_cm=" << r.states_per_cm
                 << " samples=" << r.samples << " uncovered=" << r.uncovered
                 << "\n";

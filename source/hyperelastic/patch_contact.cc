@@ -660,6 +660,15 @@ namespace palpate
       for (int j = -1; j <= 1; ++j)
         for (int i = -1; i <= 1; ++i)
           {
+            // The corners of a tetrahedron of the grid's Kuhn triangulation
+            // (simplex_corners()) differ by steps all up or all down: a
+            // neighbour up one axis and down another never shares one with
+            // this state, and blend() never asks for it (-1: none).
+            if (std::min({i, j, k}) < 0 && std::max({i, j, k}) > 0)
+              {
+                patch.neighbour_force[9 * (k + 1) + 3 * (j + 1) + (i + 1)] = -1;
+                continue;
+              }
             const Utilities::Point3 to = {{patch.target[0] + i * spacing,
                                            patch.target[1] + j * spacing,
                                            patch.target[2] + k * spacing}};

@@ -87,8 +87,10 @@ namespace palpate
      * magnitude of this model's force (N) at each of them, solved by
      * following the sphere there from the state (tabulate_neighbours()):
      * neighbour_force[9 (k + 1) + 3 (j + 1) + (i + 1)] for the HIP at
-     * target + h (i, j, k), i, j, k in {-1, 0, 1}; 27 entries, or none
-     * (then the blend does not correct the model: PatchContact::blend()).
+     * target + h (i, j, k), i, j, k in {-1, 0, 1}; 27 entries (-1 where
+     * not solved: at the neighbours that share no tetrahedron of the grid
+     * with this state), or none (then the blend does not correct the
+     * model: PatchContact::blend()).
      */
     double              spacing = 0;
     std::vector<double> neighbour_force;

@@ -314,9 +314,11 @@ namespace palpate
   };
 
   /**
-   * The magnitude of @p patch's model force at each of the 26 grid points
-   * around its state, @p spacing apart, and at its own, into
-   * patch.neighbour_force (with patch.spacing): the model solved by
+   * The magnitude of @p patch's model force at each of the 14 grid points
+   * around its state, @p spacing apart, that share a tetrahedron of the
+   * grid with it (steps all up or all down; -1 at the other 12), and at
+   * its own, into patch.neighbour_force (with patch.spacing): the model
+   * solved by
    * following the sphere from the state to each in steps of at most
    * 0.25 mm, as a hand would move it (a model met far from its state can
    * settle on another branch: nodes on the far side of the sphere), then
