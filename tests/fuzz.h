@@ -11,6 +11,7 @@
 #define palpate_tests_fuzz_h
 
 #include <cctype>
+#include <ctime>
 #include <random>
 #include <string>
 #include <vector>
@@ -37,6 +38,39 @@ namespace fuzz
   {
     return n == 0 ? 0 : rng() % n;
   }
+
+  /**
+   * The CPU time the calling thread has used since construction (s): what
+   * the fuzzers bound a mutant's parse by. A hang shows in it as in the
+   * wall clock, but the test suite's other processes on the same cores do
+   * not lengthen it (the wall clock's bound tripped on a loaded machine),
+   * nor do the fuzzer's other threads (fuzz_scenes runs mutants side by
+   * side). A hang outside the thread is ctest's TIMEOUT's.
+   */
+  class CpuTimer
+  {
+  public:
+    CpuTimer()
+      : start(now())
+    {}
+
+    double
+    seconds() const
+    {
+      return now() - start;
+    }
+
+  private:
+    static double
+    now()
+    {
+      timespec t{};
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+      return t.tv_sec + 1e-9 * t.tv_nsec;
+    }
+
+    double start;
+  };
 
   /** One to three mutations of @p s. */
   inline std::string

@@ -153,7 +153,7 @@ main(int argc, char **argv)
       120);
     deallog << "preemption: both servers on cloud states off the new path "
             << ok(ready) << "; the HIP moves on: a running state given up "
-            << ok(preempted >= 0 && preempted < 0.2 * state_time)
+            << ok(preempted >= 0 && preempted < state_time)
             << ", the HIP's new cell complete " << ok(corners >= 0)
             << std::endl;
     std::cout << "preempted after " << preempted << " s, cell complete after "
@@ -170,10 +170,9 @@ main(int argc, char **argv)
   const auto stats = engine.statistics();
   // A server sees the cancellation between two Newton iterations, so it
   // frees itself within about one iteration, sooner than finishing the
-  // state. (A fifth held on a quiet machine; under CI's load with two
-  // tests at once it took 0.34 s of a 1.17 s state, and half a state's
-  // time failed once in CI's run of c896bd7: the bound is the state's
-  // own time, which a server that ignored the cancel would need.)
+  // state: the bound is the state's own time, which a server that ignored
+  // the cancel would need (a fraction of it depends on the machine's load;
+  // preemption above likewise).
   deallog << "the HIP jumps 9 cm away: running states cancelled "
           << ok(stats.cancelled >= 1) << ", sooner than a state's time "
           << ok(freed >= 0 && freed < state_time) << std::endl;

@@ -12,7 +12,6 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/haptics/trajectory.h>
 
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -49,7 +48,7 @@ main()
   for (unsigned int i = 0; i < n; ++i)
     {
       write_file("mutant.csv", fuzz::mutate(text, rng));
-      const auto start = std::chrono::steady_clock::now();
+      const fuzz::CpuTimer timer;
       try
         {
           const palpate::Replay replay("mutant.csv");
@@ -75,7 +74,7 @@ main()
             deallog << "mutant " << i << ": NOT an input error: " << e.what()
                     << std::endl;
         }
-      if (std::chrono::steady_clock::now() - start > std::chrono::seconds(2))
+      if (timer.seconds() > 2)
         ++slow;
     }
   deallog << n << " mutants: " << valid << " valid recordings, " << rejected

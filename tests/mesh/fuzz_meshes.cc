@@ -15,7 +15,6 @@
 #include <palpate/mesh/mesh.h>
 #include <palpate/scene/scene.h>
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -50,7 +49,7 @@ main(int argc, char **argv)
       for (unsigned int i = 0; i < per_seed; ++i)
         {
           write_file(file, fuzz::mutate(text, rng));
-          const auto start = std::chrono::steady_clock::now();
+          const fuzz::CpuTimer timer;
           try
             {
               const palpate::Mesh mesh(palpate::read_mesh_file(file),
@@ -77,8 +76,7 @@ main(int argc, char **argv)
                 deallog << "mutant " << i << " of " << seed
                         << ": NOT an input error: " << e.what() << std::endl;
             }
-          if (std::chrono::steady_clock::now() - start >
-              std::chrono::seconds(2))
+          if (timer.seconds() > 2)
             ++slow;
         }
       deallog << std::filesystem::path(seed).filename().string() << ": "

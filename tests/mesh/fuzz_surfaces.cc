@@ -11,7 +11,6 @@
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/surface.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -106,7 +105,7 @@ main()
       for (unsigned int i = 0; i < per_seed; ++i)
         {
           write_file(file, fuzz::mutate(text, rng));
-          const auto start = std::chrono::steady_clock::now();
+          const fuzz::CpuTimer timer;
           try
             {
               const palpate::Surface m      = palpate::read_surface(file);
@@ -135,8 +134,7 @@ main()
                 deallog << "mutant " << i << " of " << seed
                         << ": NOT an input error: " << e.what() << std::endl;
             }
-          if (std::chrono::steady_clock::now() - start >
-              std::chrono::seconds(2))
+          if (timer.seconds() > 2)
             ++slow;
         }
       deallog << "  " << valid << " valid surfaces, " << rejected
