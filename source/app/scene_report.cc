@@ -104,8 +104,8 @@ namespace palpate
       const MeshQuality quality = mesh_quality(mesh.vertices(), mesh.cells());
       s << "  quality:       " << quality.summary() << "\n";
       report_slivers_near_active_node(s, mesh, nodes, quality);
-      // A body smaller than 2 cm or larger than 1 m is likely a unit slip
-      // (2 mm and 2 m are refused outright).
+      // A body smaller or larger than an organ is likely a unit slip
+      // (beyond Limits::min_body_size and max_body_size it is refused).
       if (const std::string advice =
             unit_advice(mesh.diameter(),
                         source->from_file() ? p.mesh.scale_factor : 1.0);

@@ -118,11 +118,8 @@ namespace palpate
         const double best      = suggested.factor;
         throw scene.error(
           "Mesh/Scale factor",
-          "with this scale factor the body is " +
-            Utilities::to_string(size, 3) +
-            " m across (the diagonal of its bounding box); a body to palpate "
-            "is between 0.002 and 2 m: the mesh file's unit is not the one "
-            "the scale factor assumes",
+          "with this scale factor " + Limits::body_size_problem(size) +
+            ": the mesh file's unit is not the one the scale factor assumes",
           "set Scale factor to the metres per mesh-file unit: 0.001 for "
           "millimetres, 0.01 for centimetres; here " +
             Utilities::to_string(best, 6) + " makes the body " +

@@ -5,6 +5,7 @@
 #include <palpate/base/stop_request.h>
 #include <palpate/mesh/mesh_file.h>
 #include <palpate/mesh/volume_mesher.h>
+#include <palpate/scene/scene.h>
 
 #include <gmsh.h>
 #include <signal.h>
@@ -579,7 +580,7 @@ namespace palpate
   std::string
   unit_advice(const double size, const double factor)
   {
-    if (size >= 0.02 && size <= 1)
+    if (size >= Limits::min_organ_size && size <= Limits::max_organ_size)
       return "";
     // The file's own size, and the units that would make it an organ.
     const double                          file_size = size / factor;
@@ -587,7 +588,8 @@ namespace palpate
                                                        {0.01, "centimetres"},
                                                        {1, "metres"}};
     for (const auto &[unit, name] : units)
-      if (file_size * unit >= 0.02 && file_size * unit <= 1)
+      if (file_size * unit >= Limits::min_organ_size &&
+          file_size * unit <= Limits::max_organ_size)
         return std::string("it looks like ") + name + ": set " +
                Utilities::to_string(unit, 3) + " (the body is then " +
                Utilities::to_string(file_size * unit, 3) + " m across)";
@@ -679,8 +681,9 @@ namespace palpate
   {
     /**
      * That the surface @p s, read at @p scale (the entry @p scale_entry
-     * sets it), has sizes an organ has: no overflow, no wild vertex, 2 cm
-     * to 1 m across (@p report: its measures).
+     * sets it), has sizes an organ has: no overflow, no wild vertex, a
+     * size within the scenes' limits (Limits::body_size_problem(); @p
+     * report: its measures).
      */
     void
     check_surface_size(const Surface           &s,
@@ -716,17 +719,16 @@ namespace palpate
                            "a mistyped or corrupted coordinate",
                          "correct that vertex in the file, or export the "
                          "surface again.");
-      // An organ is 2 cm to 1 m across: anything else is a unit mistake.
-      if (const std::string advice = unit_advice(report.diameter, scale);
-          !advice.empty())
+      // A body outside the scenes' limits is a unit mistake (refused with
+      // the same words as a scene's mesh; unit_advice() says which unit).
+      if (!(report.diameter >= Limits::min_body_size &&
+            report.diameter <= Limits::max_body_size))
         throw InputError(surface_file,
                          0,
                          scale_entry + " = " + Utilities::to_string(scale, 6),
-                         "with this scale factor the body is " +
-                           Utilities::to_string(report.diameter, 3) +
-                           " m across (the diagonal of its bounding box); an "
-                           "organ is 0.02 to 1 m across",
-                         advice + ".");
+                         "with this scale factor " +
+                           Limits::body_size_problem(report.diameter),
+                         unit_advice(report.diameter, scale) + ".");
     }
 
 

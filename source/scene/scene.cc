@@ -213,4 +213,17 @@ namespace palpate
                                                 entry + "=") == 0;
                        });
   }
+  std::string
+  Limits::body_size_problem(const double size)
+  {
+    const double limit = size < min_body_size ? min_body_size : max_body_size;
+    return "the body is " + Utilities::to_string_apart(size, limit) +
+           " m across (the diagonal of its bounding box); a body to palpate "
+           "is between " +
+           Utilities::to_string(min_body_size, 3) + " and " +
+           Utilities::to_string(max_body_size, 3) + " m";
+  }
+
+
+
 } // namespace palpate

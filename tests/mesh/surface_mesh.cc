@@ -17,7 +17,9 @@
 // - The time limit stops Gmsh.
 // - Quality: the regular tetrahedron has radius ratio 1 and dihedral
 //   angles of 70.53 degrees; a flat one is a sliver.
-// - Plausibility: a surface in millimetres read as metres names the unit.
+// - Plausibility: a surface in millimetres read as metres names the unit,
+//   in the words and limits of a scene's mesh; a size just past a limit
+//   reads as more (or less) than the limit.
 
 #include <palpate/base/exceptions.h>
 #include <palpate/mesh/mesh_quality.h>
@@ -263,4 +265,8 @@ main(int argc, char **argv)
   }) << std::endl;
   deallog << "advice for 192 m at scale 1: " << palpate::unit_advice(192, 1)
           << std::endl;
+  // Sizes just past the limits do not read as the limits.
+  deallog << "2.0004 m: " << palpate::Limits::body_size_problem(2.0004)
+          << "; 0.0019996 m: "
+          << palpate::Limits::body_size_problem(0.0019996) << std::endl;
 }

@@ -132,7 +132,7 @@ namespace palpate
    * Advice for a body @p size metres across at @p factor metres per file
    * unit: which unit the file most likely uses and the factor to set
    * ("it looks like millimetres: set 0.001"), or "" if the size is an
-   * organ's (2 cm to 1 m).
+   * organ's (Limits::min_organ_size to max_organ_size).
    */
   std::string
   unit_advice(const double size, const double factor);

@@ -47,6 +47,20 @@ namespace palpate
      * (the diagonal of its bounding box; a mesh in the wrong unit is
      * outside). */
     constexpr double min_body_size = 0.002, max_body_size = 2;
+    /** An organ is this many metres across, at least and at most: a body
+     * within the limits above but outside these is likely in the wrong
+     * unit (the scene report warns), and unit advice aims within them. */
+    constexpr double min_organ_size = 0.02, max_organ_size = 1;
+
+    /**
+     * "the body is S m across (the diagonal of its bounding box); a body to
+     * palpate is between 0.002 and 2 m", for a body of @p size (m) outside
+     * those limits: every message that refuses a body's size (a scene's
+     * mesh, `palpate mesh`'s surface) states one range, from the
+     * constants, and a size just past a limit does not read as the limit.
+     */
+    std::string
+    body_size_problem(const double size);
   } // namespace Limits
 
   /**
