@@ -267,6 +267,6 @@ main(int argc, char **argv)
           << std::endl;
   // Sizes just past the limits do not read as the limits.
   deallog << "2.0004 m: " << palpate::Limits::body_size_problem(2.0004)
-          << "; 0.0019996 m: "
-          << palpate::Limits::body_size_problem(0.0019996) << std::endl;
+          << "; 0.0019996 m: " << palpate::Limits::body_size_problem(0.0019996)
+          << std::endl;
 }
