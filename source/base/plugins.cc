@@ -78,6 +78,17 @@ namespace palpate
 
 
 
+    const Declaration *
+    find_declaration(const std::string &kind, const std::string &name)
+    {
+      for (const auto &d : declarations(kind))
+        if (d.name == name)
+          return &d;
+      return nullptr;
+    }
+
+
+
     void
     check_entries(const std::string &kind,
                   const std::string &name,

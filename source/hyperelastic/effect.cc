@@ -3,6 +3,8 @@
 
 #include <palpate/base/plugins.templates.h>
 #include <palpate/hyperelastic/effect.h>
+#include <palpate/mesh/node_selection.h>
+#include <palpate/scene/scene.h>
 
 namespace palpate
 {
@@ -27,6 +29,34 @@ namespace palpate
         }
     return effects;
   }
+
+
+
+  namespace
+  {
+    /**
+     * The enabled effects that depend on the mesh (a traction's faces)
+     * check it when the scene's nodes are chosen (NodeSelection::create()),
+     * before anything is computed.
+     */
+    void
+    check_effects_on_mesh(const Scene &scene, const Mesh &mesh)
+    {
+      for (const auto &effect :
+           Effect::create_enabled(scene.parameters.effects))
+        try
+          {
+            effect->check(mesh);
+          }
+        catch (const Plugins::EntryError &e)
+          {
+            throw scene.error("Effects/" + e.entry, e.problem, e.fix);
+          }
+    }
+
+    [[maybe_unused]] const bool effects_check_the_mesh =
+      add_mesh_check(&check_effects_on_mesh);
+  } // namespace
 
 
 

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Copyright (C) 2026 the palpate authors
 
-#include <palpate/hyperelastic/effect.h>
 #include <palpate/mesh/fixed_region.h>
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
@@ -12,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <vector>
 
 namespace palpate
 {
@@ -142,23 +142,13 @@ namespace palpate
 
 
 
-    /**
-     * The effects that depend on the mesh (a traction's faces) check it
-     * now, before anything is computed.
-     */
-    void
-    check_effects(const Scene &scene, const Mesh &mesh)
+    /** The checks of the mesh that the layers above it added. */
+    std::vector<MeshCheck> &
+    mesh_checks()
     {
-      for (const auto &effect :
-           Effect::create_enabled(scene.parameters.effects))
-        try
-          {
-            effect->check(mesh);
-          }
-        catch (const Plugins::EntryError &e)
-          {
-            throw scene.error("Effects/" + e.entry, e.problem, e.fix);
-          }
+      // A function-local static: filled at static initialisation.
+      static std::vector<MeshCheck> checks;
+      return checks;
     }
 
   } // namespace
@@ -288,6 +278,15 @@ namespace palpate
 
 
 
+  bool
+  add_mesh_check(const MeshCheck check)
+  {
+    mesh_checks().push_back(check);
+    return true;
+  }
+
+
+
   NodeSelection
   NodeSelection::create(const Scene       &scene,
                         const Mesh        &mesh,
@@ -301,7 +300,8 @@ namespace palpate
     selection.fixed_vertices.assign(region.fixed.begin(), region.fixed.end());
     selection.fixed_description = region.description;
 
-    check_effects(scene, mesh);
+    for (const MeshCheck check : mesh_checks())
+      check(scene, mesh);
 
     internal::select_active_vertex(scene, mesh, selection);
     check_active_not_fixed(scene, mesh, region.fixed, selection);

@@ -7,8 +7,6 @@
 // their entries), Nonlinear solver and Linear solver (the linear solver
 // plug-ins), each declared with its help text and read back into its struct.
 
-#include <palpate/hyperelastic/effect.h>
-#include <palpate/hyperelastic/material.h>
 #include <palpate/scene/parameters_impl.h>
 
 #include <iomanip>
@@ -28,7 +26,7 @@ namespace palpate
                        const std::string &entry,
                        const std::string &value)
     {
-      const auto *plugin = MaterialRegistry::find(model);
+      const auto *plugin = Plugins::find_declaration("material", model);
       AssertThrow(plugin != nullptr,
                   ExcMessage("no material model called " + model));
       auto &entries = models[model];
@@ -67,7 +65,7 @@ namespace palpate
       const auto m = models.find(model);
       if (m != models.end() && m->second.count(entry) == 1)
         return m->second.at(entry);
-      const auto *plugin = MaterialRegistry::find(model);
+      const auto *plugin = Plugins::find_declaration("material", model);
       AssertThrow(plugin != nullptr,
                   ExcMessage("no material model called " + model));
       const auto defaults =
@@ -97,12 +95,12 @@ namespace palpate
         // The models are plug-ins: the choice and each model's subsection
         // come from the registry (doc/extending.md).
         std::string doc = "The hyperelastic constitutive law:";
-        for (const auto &plugin : MaterialRegistry::plugins())
+        for (const auto &plugin : Plugins::declarations("material"))
           doc += " " + plugin.name + ": " + plugin.description + ";";
         doc.back() = '.';
         prm.declare_entry("Model name",
                           "St.Venant-Kirchhoff",
-                          Patterns::Selection(MaterialRegistry::selection()),
+                          Patterns::Selection(Plugins::selection("material")),
                           doc);
         prm.declare_entry("Density",
                           "1060",
@@ -110,7 +108,7 @@ namespace palpate
                           "Mass density of the tissue in the reference "
                           "configuration (kg/m^3); used only when the "
                           "gravity effect is on. 1060 is liver tissue.");
-        for (const auto &plugin : MaterialRegistry::plugins())
+        for (const auto &plugin : Plugins::declarations("material"))
           {
             prm.enter_subsection(plugin.name);
             plugin.declare_parameters(prm);
@@ -130,7 +128,7 @@ namespace palpate
         model_name = prm.get("Model name");
         density    = prm.get_double("Density");
         models.clear();
-        for (const auto &plugin : MaterialRegistry::plugins())
+        for (const auto &plugin : Plugins::declarations("material"))
           {
             auto &entries = models[plugin.name];
             prm.enter_subsection(plugin.name);
@@ -146,7 +144,7 @@ namespace palpate
       // Scene::validate()'s, with the entry's line.
       try
         {
-          Material::create(*this);
+          Plugins::check_entries("material", model_name, models[model_name]);
         }
       catch (const Plugins::EntryError &)
         {}
@@ -205,7 +203,7 @@ namespace palpate
     void
     Effects::turn_on(const std::string &name, const bool on)
     {
-      AssertThrow(EffectRegistry::find(name) != nullptr,
+      AssertThrow(Plugins::find_declaration("effect", name) != nullptr,
                   ExcMessage("no effect called " + name));
       switches[name] = on;
     }
@@ -217,7 +215,7 @@ namespace palpate
                  const std::string &entry,
                  const std::string &value)
     {
-      const auto *plugin = EffectRegistry::find(effect);
+      const auto *plugin = Plugins::find_declaration("effect", effect);
       AssertThrow(plugin != nullptr, ExcMessage("no effect called " + effect));
       auto &entries = loads[effect];
       if (entries.empty())
@@ -236,7 +234,7 @@ namespace palpate
       {
         // The load effects are plug-ins: each one's switch and entries
         // come from the registry (doc/extending.md).
-        for (const auto &plugin : EffectRegistry::plugins())
+        for (const auto &plugin : Plugins::declarations("effect"))
           {
             prm.declare_entry(plugin.name,
                               "false",
@@ -310,7 +308,7 @@ namespace palpate
       {
         switches.clear();
         loads.clear();
-        for (const auto &plugin : EffectRegistry::plugins())
+        for (const auto &plugin : Plugins::declarations("effect"))
           {
             switches[plugin.name] = prm.get_bool(plugin.name);
             auto &entries         = loads[plugin.name];
@@ -318,12 +316,16 @@ namespace palpate
                  Plugins::declared_entries(plugin.declare_parameters))
               entries[entry.first] = prm.get(entry.first);
           }
-        try
-          {
-            Effect::create_enabled(*this);
-          }
-        catch (const Plugins::EntryError &)
-          {}
+        for (const auto &plugin : Plugins::declarations("effect"))
+          if (on(plugin.name))
+            try
+              {
+                Plugins::check_entries("effect",
+                                       plugin.name,
+                                       loads[plugin.name]);
+              }
+            catch (const Plugins::EntryError &)
+              {}
         shape_output       = prm.get_bool("Shape output");
         shape_output_rate  = prm.get_double("Shape output rate");
         shape_output_limit = prm.get_double("Shape output limit");

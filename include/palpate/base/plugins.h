@@ -107,6 +107,11 @@ namespace palpate
        * is read, throwing the scene's InputError (Scene::error()); nullptr
        * if it has no check_scene(). */
       void (*check_scene)(const Scene &scene) = nullptr;
+      /** For a material: the displacement degree its element pair fixes,
+       * from its own entries (0: Discretization / Polynomial degree
+       * decides); nullptr for the other kinds. */
+      unsigned int (*element_degree)(const dealii::ParameterHandler &own) =
+        nullptr;
     };
 
     /** A plug-in class's `static void check_parameters(const
@@ -157,6 +162,10 @@ namespace palpate
     /** The plug-ins of @p kind, sorted by name. */
     const std::vector<Declaration> &
     declarations(const std::string &kind);
+
+    /** The plug-in of @p kind called @p name, or nullptr. */
+    const Declaration *
+    find_declaration(const std::string &kind, const std::string &name);
 
     /** Their names joined by '|', for a Patterns::Selection. */
     std::string

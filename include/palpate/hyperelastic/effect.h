@@ -70,8 +70,34 @@ namespace palpate
   using EffectRegistry = Plugins::Registry<Effect>;
   extern template class Plugins::Registry<Effect>;
 
-#define PALPATE_REGISTER_EFFECT(classname, name, description) \
-  PALPATE_REGISTER_PLUGIN(::palpate::Effect, classname, name, description)
+  /** An effect plug-in's entries checked by building it (its
+   * Declaration's check_parameters: the scene checks them so, without
+   * including this header). */
+  template <typename Class>
+  void
+  check_effect_entries(const dealii::ParameterHandler &own)
+  {
+    Class::create(own);
+  }
+
+  /* Registered in EffectRegistry (the solver builds the effect from it)
+   * and declared as an "effect" (Plugins::declarations(): the scene
+   * declares and checks its entries without including this header). */
+#define PALPATE_REGISTER_EFFECT(classname, name, description)           \
+  namespace                                                             \
+  {                                                                     \
+    [[maybe_unused]] const bool palpate_effect_registered_##classname = \
+      ::palpate::EffectRegistry::add({name,                             \
+                                      description,                      \
+                                      &classname::declare_parameters,   \
+                                      &classname::create}) &&           \
+      ::palpate::Plugins::add_declaration(                              \
+        "effect",                                                       \
+        {name,                                                          \
+         description,                                                   \
+         &classname::declare_parameters,                                \
+         &::palpate::check_effect_entries<classname>});                 \
+  }
 } // namespace palpate
 
 #endif

@@ -152,8 +152,56 @@ namespace palpate
   using MaterialRegistry = Plugins::Registry<Material>;
   extern template class Plugins::Registry<Material>;
 
-#define PALPATE_REGISTER_MATERIAL(classname, name, description) \
-  PALPATE_REGISTER_PLUGIN(::palpate::Material, classname, name, description)
+  /** A material plug-in's entries checked by building it (its
+   * Declaration's check_parameters: the scene checks them so, without
+   * including this header). */
+  template <typename Class>
+  void
+  check_material_entries(const dealii::ParameterHandler &own)
+  {
+    Class::create(own);
+  }
+
+  /** The displacement degree a material plug-in's element pair fixes
+   * (its Declaration's element_degree). */
+  template <typename Class>
+  unsigned int
+  material_element_degree(const dealii::ParameterHandler &own)
+  {
+    return Class::create(own)->formulation().displacement_degree;
+  }
+
+  /**
+   * What every material's constants must satisfy beyond their own checks,
+   * in the scene (its Declaration's check_scene, run by Scene::validate()):
+   * each modulus and the stiffness scale they make within the bounds of a
+   * solid, the first Lame constant they make with Poisson's ratio too, and
+   * Discretization / Polynomial degree agreeing with the element pair's.
+   */
+  void
+  check_material_scene(const Scene &scene);
+
+  /* Registered in MaterialRegistry (the solver builds the material from
+   * it) and declared as a "material" (Plugins::declarations(): the scene
+   * declares, checks and sizes the material's entries without including
+   * this header). */
+#define PALPATE_REGISTER_MATERIAL(classname, name, description)           \
+  namespace                                                               \
+  {                                                                       \
+    [[maybe_unused]] const bool palpate_material_registered_##classname = \
+      ::palpate::MaterialRegistry::add({name,                             \
+                                        description,                      \
+                                        &classname::declare_parameters,   \
+                                        &classname::create}) &&           \
+      ::palpate::Plugins::add_declaration(                                \
+        "material",                                                       \
+        {name,                                                            \
+         description,                                                     \
+         &classname::declare_parameters,                                  \
+         &::palpate::check_material_entries<classname>,                   \
+         &::palpate::check_material_scene,                                \
+         &::palpate::material_element_degree<classname>});                \
+  }
 
   /** The Lame parameters lambda and mu of Young's modulus @p E and
    * Poisson's ratio @p nu (the compressible models'). */

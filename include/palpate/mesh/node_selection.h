@@ -108,6 +108,20 @@ namespace palpate
                       const Utilities::Point3 &push,
                       const SphereTrial       &trial = SphereTrial()) const;
   };
+
+
+  /**
+   * A check of a scene's mesh that a layer above the mesh adds (the
+   * effects': a traction's faces), run by NodeSelection::create() after the
+   * fixed nodes are chosen and before the active node, so that a scene
+   * fails before anything is computed. Throws the scene's InputError.
+   */
+  using MeshCheck = void (*)(const Scene &scene, const Mesh &mesh);
+
+  /** Add @p check to those NodeSelection::create() runs (at static
+   * initialisation, by the layer that defines it). Returns true. */
+  bool
+  add_mesh_check(MeshCheck check);
 } // namespace palpate
 
 #endif

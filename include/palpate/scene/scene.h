@@ -39,6 +39,9 @@ namespace palpate
     constexpr double min_shape_output_limit = 1;
     /** Elastic moduli (Pa): diamond's Young's modulus is 1.2e12 Pa. */
     constexpr double max_modulus = 1e13;
+    /** Moduli (Pa): below this round-off decides the force (fat, the
+     * softest tissue, is ~1e2 Pa). */
+    constexpr double min_modulus = 1e-3;
     /** Nodes of a generated mesh (beam). */
     constexpr double max_generated_nodes = 1e5;
     /** Active node / Tip radius of a sphere (m): a probe, not a wall. */

@@ -45,9 +45,6 @@ namespace palpate
   {
     // Bounds on the numbers that set a loop count, an allocation or a
     // time (issue 26): without them a typo hangs a run or overflows.
-    /** Moduli (Pa): below this round-off decides the force (fat, the
-     * softest tissue, is ~1e2 Pa). */
-    constexpr double min_modulus = 1e-3;
     /** Haptics / Loop rate (Hz): below this there is no haptic loop. */
     constexpr double min_loop_rate = 1;
     /** Scheduler / Rate (Hz): below, planning lags the hand by seconds. */
