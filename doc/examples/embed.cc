@@ -1,5 +1,6 @@
 // palpate inside a haptics application that owns its device loop (see
-// doc/embedding.md). Build: link against libpalpate; run: embed scene.prm
+// doc/embedding.md). Build: link against palpate's layer libraries
+// (doc/embedding.md); run: embed scene.prm
 #include <palpate/base/environment.h>
 #include <palpate/haptics/interaction.h>
 #include <palpate/haptics/run_summary.h>
