@@ -347,8 +347,7 @@ main(int argc, char **argv)
     // away): a bound far below that and far above any load's delay.
     deallog << "stop() returned long before the next frame (within 60 s of "
                "1000 s): "
-            << (took < 60 ? "yes" : "NO")
-            << ", PVD written: "
+            << (took < 60 ? "yes" : "NO") << ", PVD written: "
             << (std::filesystem::exists("slow/beam-shape.pvd") ? "yes" : "NO")
             << std::endl;
     std::filesystem::remove_all("slow");
