@@ -21,9 +21,11 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -56,6 +58,20 @@ initlog(const unsigned int precision = 6)
   deallog.depth_console(0);
   deallog << std::setprecision(precision);
   logfile << std::setprecision(precision);
+}
+
+/** The scenes palpate ships (parameters/*.prm), sorted: found on disk, so
+ * that a newly shipped scene is tested too. */
+inline std::vector<std::filesystem::path>
+shipped_scenes()
+{
+  std::vector<std::filesystem::path> scenes;
+  for (const auto &f :
+       std::filesystem::directory_iterator(palpate_source_dir + "/parameters"))
+    if (f.path().extension() == ".prm")
+      scenes.push_back(f.path());
+  std::sort(scenes.begin(), scenes.end());
+  return scenes;
 }
 
 /** What running the palpate program produced. */

@@ -57,17 +57,11 @@ int
 main()
 {
   initlog();
-  std::vector<std::filesystem::path> scenes;
-  for (const auto &entry :
-       std::filesystem::directory_iterator(palpate_source_dir + "/parameters"))
-    if (entry.path().extension() == ".prm")
-      scenes.push_back(entry.path());
-  std::sort(scenes.begin(), scenes.end());
 
   // A surface meshed by palpate is meshed once and then reused: which of
   // the two this run did is not the scene's.
   const std::regex meshed_or_reused(R"( \((meshed now in [^)]*|reused)\))");
-  for (const auto &scene : scenes)
+  for (const auto &scene : shipped_scenes())
     {
       const std::string name = scene.stem().string();
       const ProgramRun  r    = run_palpate("solve " + scene.string() +

@@ -19,13 +19,7 @@ main(int argc, char **argv)
   palpate::Environment env(argc, argv);
   initlog();
 
-  std::vector<std::filesystem::path> scenes;
-  for (const auto &f :
-       std::filesystem::directory_iterator(palpate_source_dir + "/parameters"))
-    if (f.path().extension() == ".prm")
-      scenes.push_back(f.path());
-  std::sort(scenes.begin(), scenes.end());
-
+  const auto scenes = shipped_scenes();
   for (const auto &file : scenes)
     {
       const auto  scene = palpate::Scene::read(file.string());
