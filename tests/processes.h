@@ -103,15 +103,11 @@ namespace test_processes
                 const std::string &text,
                 const double       seconds = 120)
   {
-    const auto end =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (read_file(file).find(text) == std::string::npos)
-      {
-        if (std::chrono::steady_clock::now() >= end)
-          return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      }
-    return true;
+    return wait_until(
+      [&] { return read_file(file).find(text) != std::string::npos; },
+      seconds,
+      "\"" + text + "\" in " + file,
+      std::chrono::milliseconds(20));
   }
 
   /** The line of @p text that contains @p what, from there on; "(none)". */

@@ -33,6 +33,8 @@
 #include <utility>
 #include <vector>
 
+#include "wait.h"
+
 using dealii::deallog;
 
 /** The project's source tree, its example organs (meshes/, README there)

@@ -50,12 +50,13 @@ namespace palpate
 
     // Freeze this process for @p seconds as a stopped machine would (every
     // thread, heartbeats included), for tests: a child that touches
-    // nothing of MPI's resumes it.
+    // nothing of MPI's resumes it. With @p seconds = 0 nothing resumes it:
+    // the test sends SIGCONT when what it checks has happened.
     void
     pause_for(const double seconds)
     {
       const pid_t me = getpid();
-      if (fork() == 0)
+      if (seconds > 0 && fork() == 0)
         {
           const timespec t{static_cast<time_t>(seconds),
                            static_cast<long>((seconds - std::floor(seconds)) *

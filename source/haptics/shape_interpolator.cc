@@ -154,8 +154,10 @@ namespace palpate
     std::atomic<unsigned int> written{0}, skipped{0}, busy{0}, over{0},
       thinned{0};
     std::string failure; // written by the thread before it ends
-    PvdIndex    index;
-    std::thread thread;
+    // Set once failure is written: the thread writes no more frames.
+    std::atomic<bool> failed{false};
+    PvdIndex          index;
+    std::thread       thread;
   };
 
 
@@ -278,10 +280,12 @@ namespace palpate
     catch (const std::exception &e)
       {
         failure = e.what();
+        failed.store(true, std::memory_order_release);
       }
     catch (...)
       {
         failure = "an exception of unknown type";
+        failed.store(true, std::memory_order_release);
       }
   }
 
@@ -480,6 +484,14 @@ namespace palpate
   ShapeInterpolator::failure() const
   {
     return impl->failure;
+  }
+
+
+
+  bool
+  ShapeInterpolator::failed() const noexcept
+  {
+    return impl->failed.load(std::memory_order_acquire);
   }
 
 

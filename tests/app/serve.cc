@@ -240,10 +240,10 @@ main(int argc, char **argv)
           << std::endl;
 
   // The initial cloud, then a target on a grid point.
-  const auto start = std::chrono::steady_clock::now();
-  while (!server.interaction().initial_cloud_complete() &&
-         std::chrono::steady_clock::now() - start < std::chrono::seconds(120))
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  wait_until([&] { return server.interaction().initial_cloud_complete(); },
+             120,
+             "the initial cloud",
+             std::chrono::milliseconds(20));
   const auto                &grid   = server.interaction().grid();
   const auto                 point  = grid.linear({{0, 0, -1}});
   const auto                 target = grid.position(point);
@@ -259,11 +259,23 @@ main(int argc, char **argv)
   // spare; without the smoothing 5 cm/s at once) and at most 5 cm/s. Each
   // sample is taken between two clock readings: the bounds use the widest
   // interval it can stand for, so a preempted test thread cannot fail it.
-  bool smooth = true, limited = true;
-  auto previous = std::make_pair(sent_at, from);
-  for (unsigned int k = 0; k < 200; ++k)
-    {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  // Sampled (at least 50 times) until the probe is at the target and the
+  // frame shows the state's force and the shape there: the probe can
+  // arrive before the state it lands on has been computed.
+  bool                smooth = true, limited = true;
+  auto                previous = std::make_pair(sent_at, from);
+  unsigned int        samples  = 0;
+  std::string         frame;
+  std::vector<double> shown;
+  std::shared_ptr<const palpate::State> state;
+  const auto                            shows_state = [&] {
+    return state && shown.size() == 3 &&
+           palpate::Utilities::distance({{shown[0], shown[1], shown[2]}},
+                                        state->force) <
+             1e-9 * palpate::Utilities::norm(state->force) + 1e-12;
+  };
+  wait_until(
+    [&] {
       const auto before = std::chrono::steady_clock::now();
       server.last(hip, force);
       const auto   now = std::chrono::steady_clock::now();
@@ -276,24 +288,24 @@ main(int argc, char **argv)
       limited = limited && palpate::Utilities::distance(hip, previous.second) <=
                              0.05 * (dt + 0.002) + 1e-9;
       previous = {before, hip};
-      if (palpate::Utilities::distance(hip, target) < 1e-12 && k > 50)
-        break;
-    }
-  const auto frame = client.Get("/frame");
-  const auto shown = numbers(frame->body, "force");
-  const auto state = server.interaction().cache().state(point);
+      if (++samples <= 50 || palpate::Utilities::distance(hip, target) >= 1e-12)
+        return false;
+      const auto f = client.Get("/frame");
+      frame        = f ? f->body : "";
+      shown        = numbers(frame, "force");
+      state        = server.interaction().cache().state(point);
+      return shows_state() && frame.find("\"shape\":true") != std::string::npos;
+    },
+    generous_deadline,
+    "the probe at the target, showing the state's force and the shape",
+    std::chrono::milliseconds(10));
   deallog << "target sent: " << ok(sent && sent->status == 200)
           << ", the probe moves smoothly: " << ok(smooth)
           << ", at most 5 cm/s: " << ok(limited) << ", reached: "
           << ok(palpate::Utilities::distance(hip, target) < 1e-12)
-          << ", force shown = the state's force (1e-9): "
-          << ok(state && shown.size() == 3 &&
-                palpate::Utilities::distance({{shown[0], shown[1], shown[2]}},
-                                             state->force) <
-                  1e-9 * palpate::Utilities::norm(state->force) + 1e-12)
+          << ", force shown = the state's force (1e-9): " << ok(shows_state())
           << ", shape shown: "
-          << ok(frame->body.find("\"shape\":true") != std::string::npos)
-          << std::endl;
+          << ok(frame.find("\"shape\":true") != std::string::npos) << std::endl;
 
   // Garbage, a flood, a silent client.
   const auto garbage =
@@ -336,11 +348,14 @@ main(int argc, char **argv)
               palpate::Utilities::to_string(target, 17),
               palpate::LiveServer::command_type);
   std::shared_ptr<const palpate::State> again;
-  for (unsigned int k = 0; k < 1200 && !again; ++k)
-    {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  wait_until(
+    [&] {
       again = server.interaction().cache().state(point);
-    }
+      return again != nullptr;
+    },
+    generous_deadline,
+    "the state at the doubled modulus",
+    std::chrono::milliseconds(50));
   deallog << "Young's modulus doubled on the fly: "
           << ok(changed && changed->status == 200)
           << ", the force doubles (1e-6): "
@@ -586,34 +601,42 @@ main(int argc, char **argv)
                 palpate::Utilities::distance({{drawn[0], drawn[1], drawn[2]}},
                                              centre) < 1e-9 &&
                 drawn[3] == 0.01);
-  const auto begin = std::chrono::steady_clock::now();
-  while (!indenter.interaction().initial_cloud_complete() &&
-         std::chrono::steady_clock::now() - begin < std::chrono::seconds(120))
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  wait_until([&] { return indenter.interaction().initial_cloud_complete(); },
+             120,
+             "the indenter's initial cloud",
+             std::chrono::milliseconds(20));
   const auto &sphere_grid = indenter.interaction().grid();
   const auto  pressed     = sphere_grid.linear({{0, 0, -1}});
   const auto  into        = sphere_grid.position(pressed);
   to_indenter.Post("/hip",
                    palpate::Utilities::to_string(into, 17),
                    palpate::LiveServer::command_type);
-  for (unsigned int k = 0; k < 300; ++k)
-    {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  // Until the probe is there and the frame shows the state's force (the
+  // force settles after the probe arrives, and the state may come later).
+  std::vector<double>                   pressed_shown;
+  std::shared_ptr<const palpate::State> pressed_state;
+  const auto                            shows_pressed = [&] {
+    return pressed_state && pressed_shown.size() == 3 &&
+           palpate::Utilities::distance(
+             {{pressed_shown[0], pressed_shown[1], pressed_shown[2]}},
+             pressed_state->force) <
+             1e-9 * palpate::Utilities::norm(pressed_state->force);
+  };
+  wait_until(
+    [&] {
       indenter.last(hip, force);
-      if (palpate::Utilities::distance(hip, into) < 1e-12)
-        break;
-    }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200)); // settle
-  const auto pressed_frame = to_indenter.Get("/frame");
-  const auto pressed_shown = numbers(pressed_frame->body, "force");
-  const auto pressed_state = indenter.interaction().cache().state(pressed);
+      if (palpate::Utilities::distance(hip, into) >= 1e-12)
+        return false;
+      const auto f  = to_indenter.Get("/frame");
+      pressed_shown = numbers(f ? f->body : "", "force");
+      pressed_state = indenter.interaction().cache().state(pressed);
+      return shows_pressed();
+    },
+    generous_deadline,
+    "the probe 2 mm in, showing the state's force",
+    std::chrono::milliseconds(10));
   deallog << "; 2 mm in, force shown = the state's (1e-9): "
-          << ok(pressed_state && pressed_shown.size() == 3 &&
-                palpate::Utilities::distance(
-                  {{pressed_shown[0], pressed_shown[1], pressed_shown[2]}},
-                  pressed_state->force) <
-                  1e-9 * palpate::Utilities::norm(pressed_state->force))
-          << ", pushing the probe out: "
+          << ok(shows_pressed()) << ", pushing the probe out: "
           << ok(pressed_shown.size() == 3 && pressed_shown[2] > 0) << std::endl;
   // Another active node moves the sphere: the frames say where it is now
   // (the page draws it there), its centre one radius out along the

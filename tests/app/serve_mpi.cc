@@ -44,10 +44,10 @@ main(int argc, char **argv)
   client.set_default_headers(
     {{palpate::LiveServer::token_header, server.token()}});
   client.set_read_timeout(10, 0);
-  const auto start = std::chrono::steady_clock::now();
-  while (!server.interaction().initial_cloud_complete() &&
-         std::chrono::steady_clock::now() - start < std::chrono::seconds(120))
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  wait_until([&] { return server.interaction().initial_cloud_complete(); },
+             120,
+             "the initial cloud",
+             std::chrono::milliseconds(20));
 
   const auto &grid   = server.interaction().grid();
   const auto  point  = grid.linear({{0, -1, 0}});
@@ -55,33 +55,33 @@ main(int argc, char **argv)
   client.Post("/hip",
               palpate::Utilities::to_string(target, 17),
               palpate::LiveServer::command_type);
-  palpate::Utilities::Point3 hip, force;
-  std::string                frame;
-  for (unsigned int k = 0; k < 500; ++k)
-    {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Until the probe is at the target, rendering the state's force there,
+  // with the shape shown: the state (fetched from its server if the client
+  // does not hold it yet) and the shape's states can come after the probe.
+  palpate::Utilities::Point3            hip, force;
+  std::string                           frame;
+  std::shared_ptr<const palpate::State> state;
+  const auto                            renders_state = [&] {
+    return state && palpate::Utilities::distance(force, state->force) <
+                      1e-9 * palpate::Utilities::norm(state->force);
+  };
+  wait_until(
+    [&] {
       server.last(hip, force);
       const auto f = client.Get("/frame");
       frame        = f ? f->body : "";
-      if (palpate::Utilities::distance(hip, target) < 1e-12 &&
-          frame.find("\"shape\":true") != std::string::npos)
-        break;
-    }
-  // The state itself, fetched from its server if the client does not hold
-  // it yet.
-  std::shared_ptr<const palpate::State> state;
-  for (unsigned int k = 0; k < 500 && !state; ++k)
-    {
-      state = server.interaction().cache().state(point);
-      if (!state)
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+      state        = server.interaction().cache().state(point);
+      return palpate::Utilities::distance(hip, target) < 1e-12 &&
+             frame.find("\"shape\":true") != std::string::npos &&
+             renders_state();
+    },
+    generous_deadline,
+    "the probe at the target, rendering the state's force, shape shown",
+    std::chrono::milliseconds(20));
   deallog << "target reached: "
           << ok(palpate::Utilities::distance(hip, target) < 1e-12)
           << ", the force rendered is the state's (1e-9): "
-          << ok(state && palpate::Utilities::distance(force, state->force) <
-                           1e-9 * palpate::Utilities::norm(state->force))
-          << ", shape shown: "
+          << ok(renders_state()) << ", shape shown: "
           << ok(frame.find("\"shape\":true") != std::string::npos)
           << ", load of 2 workers: "
           << ok(frame.find("\"load\":{\"workers\":2,") != std::string::npos)

@@ -52,6 +52,91 @@ namespace
         }
     return {last, rows};
   }
+
+  /** The processor time (s) the process @p pid has used so far, all its
+   * threads (/proc/PID/stat: utime and stime); -1 if it cannot be read. */
+  double
+  cpu_seconds(const pid_t pid)
+  {
+    const std::string stat =
+      read_file("/proc/" + std::to_string(pid) + "/stat");
+    // The fields after the command name (which may hold spaces), from the
+    // third on: utime and stime are the 14th and 15th.
+    const auto name_end = stat.rfind(')');
+    if (name_end == std::string::npos)
+      return -1;
+    std::istringstream fields(stat.substr(name_end + 2));
+    std::string        field;
+    for (unsigned int k = 3; k < 14; ++k)
+      fields >> field;
+    double user = -1, system = -1;
+    fields >> user >> system;
+    if (!fields)
+      return -1;
+    return (user + system) / sysconf(_SC_CLK_TCK);
+  }
+
+  /** How many frames the PVD index @p file lists now. */
+  unsigned int
+  frames_listed(const std::string &file)
+  {
+    return test_processes::count(read_file(file), "<DataSet");
+  }
+
+  /**
+   * Wait until the force log @p file has more than @p rows rows, the last
+   * past t = @p t (s): the progress a check after a stop counts on having
+   * happened before it. False (and a line on stderr) if it does not come
+   * within a generous deadline. (palpate serve writes its log as it runs;
+   * an interaction writes it at its end: see wait_for_motion().)
+   */
+  bool
+  wait_for_rows(const std::string &file,
+                const unsigned int rows,
+                const double       t = 0)
+  {
+    return wait_until(
+      [&] {
+        const auto [last, logged] = force_log(file);
+        return logged > rows && last > t;
+      },
+      generous_deadline,
+      "more than " + std::to_string(rows) + " rows in " + file,
+      std::chrono::milliseconds(20));
+  }
+
+  /**
+   * Wait until the PVD index @p file lists a frame past @p t seconds of
+   * motion (its timestep): an interaction's progress while it runs, since
+   * its force log (a row per tick of motion) is written at its end. False
+   * (and a line on stderr) if that does not come.
+   */
+  bool
+  wait_for_motion(const std::string &file, const double t)
+  {
+    const auto last_timestep = [&] {
+      const std::string pvd = read_file(file);
+      const auto        at  = pvd.rfind("timestep=\"");
+      return at == std::string::npos ? -1. : std::atof(pvd.c_str() + at + 10);
+    };
+    return wait_until([&] { return last_timestep() > t; },
+                      generous_deadline,
+                      "a frame past " + std::to_string(t) + " s of motion in " +
+                        file,
+                      std::chrono::milliseconds(20));
+  }
+
+  /** Wait until the PVD index @p file lists more than @p frames frames
+   * (false, and a line on stderr, if that does not come). */
+  bool
+  wait_for_frames(const std::string &file, const unsigned int frames)
+  {
+    return wait_until([&] { return frames_listed(file) > frames; },
+                      generous_deadline,
+                      "more than " + std::to_string(frames) +
+                        " frames listed in " + file,
+                      std::chrono::milliseconds(20));
+  }
 } // namespace
 
 
@@ -95,7 +180,10 @@ main()
       start_afresh();
       const pid_t pid     = start_palpate(interaction, out, err);
       const bool  started = wait_for_text(out, "; motion starts");
-      std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+      // Stopped once the shape output shows more than a second of motion
+      // (1.2 s: 1000 ticks of the force log and a frame listed, what the
+      // checks below look for; they fail if it never came).
+      wait_for_motion(dir + "/paper-stvk-shape.pvd", 1.2);
       kill(pid, signal);
       const int         status = wait_status(pid);
       const std::string text   = read_file(out);
@@ -115,8 +203,8 @@ main()
               << ok(read_file(err).find("stopped by " + name) !=
                     std::string::npos)
               << std::endl;
-      // The force log runs until the stop (more than the 1.5 s waited,
-      // far less than the 30 s planned), a row per tick.
+      // The force log runs until the stop (past the second waited for,
+      // far short of the 30 s planned), a row per tick.
       deallog << "  force log: last row at t in (1, 25) s "
               << ok(last > 1 && last < 25) << ", rows " << ok(rows > 1000)
               << std::endl;
@@ -147,7 +235,7 @@ main()
     start_afresh();
     const pid_t pid     = start_palpate(interaction, out, err);
     const bool  started = wait_for_text(out, "; motion starts");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    wait_for_motion(dir + "/paper-stvk-shape.pvd", 0.7); // 500 ticks logged
     const auto first = std::chrono::steady_clock::now();
     kill(pid, SIGTERM);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -184,7 +272,15 @@ main()
                 {"--set", "Nonlinear solver/Maximum increment length=0.0001"});
     const pid_t pid     = start_palpate(slow, out, err);
     const bool  waiting = wait_for_text(out, "grid points around the rest");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    // The solver threads are the only ones working now (the haptic loop
+    // sleeps between ticks, the main thread polls): once they have used a
+    // second of processor time since the cloud started, states are being
+    // computed, and none of them (seconds each) is done yet.
+    const double at_start = cpu_seconds(pid);
+    wait_until([&] { return cpu_seconds(pid) > at_start + 1; },
+               generous_deadline,
+               "a second of solving in the initial cloud",
+               std::chrono::milliseconds(20));
     kill(pid, SIGTERM);
     const int         status = wait_status(pid);
     const std::string text   = read_file(out);
@@ -235,7 +331,7 @@ main()
     start_afresh();
     const pid_t pid     = start_palpate(interaction, out, err);
     const bool  started = wait_for_text(out, "; motion starts");
-    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    wait_for_frames(dir + "/paper-stvk-shape.pvd", 10);
     kill(pid, SIGKILL);
     const int          status = wait_status(pid);
     const std::string  pvd    = read_file(dir + "/paper-stvk-shape.pvd");
@@ -268,7 +364,7 @@ main()
     with_vtu.push_back("Effects/VTU export=true");
     const pid_t pid     = start_palpate(with_vtu, out, err);
     const bool  started = wait_for_text(out, "; motion starts");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    wait_for_motion(dir + "/paper-stvk-shape.pvd", 1.2); // 1000 ticks logged
     kill(pid, SIGINT);
     // The export has begun once a state's file (or its temporary) is there.
     const auto exporting_now = [&] {
@@ -277,13 +373,10 @@ main()
           return true;
       return false;
     };
-    bool exporting = false;
-    for (unsigned int i = 0; i < 60000 && !exporting; ++i)
-      {
-        exporting = exporting_now();
-        if (!exporting)
-          std::this_thread::sleep_for(std::chrono::microseconds(500));
-      }
+    const bool exporting = wait_until(exporting_now,
+                                      generous_deadline,
+                                      "a state file being exported",
+                                      std::chrono::microseconds(500));
     kill(pid, SIGINT);
     const int status = wait_status(pid);
     // No state file cut short under its name: every .vtu is whole (one
@@ -321,16 +414,16 @@ main()
     with_vtu.push_back("--set");
     with_vtu.push_back("Effects/VTU export=true");
     const pid_t pid       = start_palpate(with_vtu, out, err);
-    bool        exporting = false;
-    for (unsigned int i = 0; i < 240000 && !exporting; ++i)
-      {
+    const bool  exporting = wait_until(
+      [&] {
         for (const auto &f : std::filesystem::directory_iterator(dir))
-          exporting =
-            exporting ||
-            f.path().filename().string().rfind("paper-stvk-state-", 0) == 0;
-        if (!exporting)
-          std::this_thread::sleep_for(std::chrono::microseconds(500));
-      }
+          if (f.path().filename().string().rfind("paper-stvk-state-", 0) == 0)
+            return true;
+        return false;
+      },
+      120,
+      "a state file being exported after the motion",
+      std::chrono::microseconds(500));
     kill(pid, SIGINT);
     const int status     = wait_status(pid);
     bool      no_partial = true;
@@ -370,7 +463,8 @@ main()
                     out,
                     err);
     const bool started = wait_for_text(out, "active node:    from rest");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    // Stopped in the middle of the path, once two frames are listed.
+    wait_for_frames(dir + "/paper-stvk-shape.pvd", 1);
     kill(pid, SIGINT);
     const int         status  = wait_status(pid);
     const std::string text    = read_file(out);
@@ -460,7 +554,7 @@ main()
                           ") is running this scene with its outputs") !=
                   std::string::npos)
             << std::endl;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+    wait_for_rows(dir + "/paper-stvk-serve-forces.csv", 1000, 1);
     kill(pid, SIGINT);
     const int         status = wait_status(pid);
     const std::string text   = read_file(out);
@@ -475,7 +569,7 @@ main()
             << ", shape output said not written "
             << ok(text.find("Shape output: not written by palpate serve") !=
                   std::string::npos)
-            << ", force log: a row per tick for the 2 s "
+            << ", force log: a row per tick past 1 s "
             << ok(rows > 1000 && last > 1) << ", JSON names the stop "
             << ok(read_file(dir + "/paper-stvk-serve-summary.json")
                     .find("\"stopped_by\": \"by SIGINT") != std::string::npos)
@@ -604,12 +698,11 @@ main()
                                     out,
                                     err);
     unsetenv("PYTHONPATH");
-    bool started = false;
-    for (unsigned int k = 0; k < 3000 && !started; ++k)
-      {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        started = std::filesystem::exists(marker);
-      }
+    const bool started =
+      wait_until([&] { return std::filesystem::exists(marker); },
+                 300,
+                 "the Pareto plot's python to start",
+                 std::chrono::milliseconds(100));
     kill(pid, SIGTERM);
     int        status = -1;
     const bool ended  = wait_status_for(pid, 20, status);

@@ -105,9 +105,18 @@ main()
   const pid_t mpirun  = start(argv, out, err);
   const bool  started = wait_for_text(out, "; motion starts", 300);
   deallog << "the motion started: " << ok(started) << std::endl;
-  std::this_thread::sleep_for(std::chrono::seconds(1));
 
-  const pid_t client = rank_process(mpirun, 0);
+  // Rank 0 is killed as soon as it is found: the servers are then serving
+  // the motion.
+  pid_t client = 0;
+  wait_until(
+    [&] {
+      client = rank_process(mpirun, 0);
+      return client > 0;
+    },
+    generous_deadline,
+    "rank 0 among mpirun's children",
+    std::chrono::milliseconds(50));
   deallog << "rank 0 found among mpirun's children: " << ok(client > 0)
           << std::endl;
   if (client > 0)

@@ -119,7 +119,9 @@ main(int argc, char **argv)
   palpate::ThreadEngine threads(
     body.mesh, body.nodes, p, grid, threads_cache, threads_hip);
   deallog << "threads: idle at every stop: "
-          << (rest_until_idle(threads, threads_hip, path) ? "yes" : "NO")
+          << (rest_until_idle(threads, threads_hip, grid, threads_cache, path) ?
+                "yes" :
+                "NO")
           << std::endl;
 
   palpate::StateCache mpi_cache(grid, budget);
@@ -127,7 +129,8 @@ main(int argc, char **argv)
   {
     palpate::MpiEngine mpi(p, grid, mpi_cache, mpi_hip);
     deallog << "mpi: idle at every stop: "
-            << (rest_until_idle(mpi, mpi_hip, path) ? "yes" : "NO")
+            << (rest_until_idle(mpi, mpi_hip, grid, mpi_cache, path) ? "yes" :
+                                                                       "NO")
             << std::endl;
 
     unsigned int both = 0, with_patch = 0, same_nodes = 0, touching = 0;

@@ -32,7 +32,6 @@
 namespace
 {
   using palpate::Utilities::Point3;
-  using Clock = std::chrono::steady_clock;
 
   const std::vector<Point3> path = {{{0, 0, 0}},
                                     {{0.003, 0, -0.002}},
@@ -68,7 +67,9 @@ main(int argc, char **argv)
     body.mesh, body.nodes, p, grid, threads_cache, threads_hip);
   deallog << "threads: " << threads.n_workers() << " solver threads, idle at "
           << "every stop: "
-          << (rest_until_idle(threads, threads_hip, path) ? "yes" : "NO")
+          << (rest_until_idle(threads, threads_hip, grid, threads_cache, path) ?
+                "yes" :
+                "NO")
           << std::endl;
 
   palpate::StateCache mpi_cache(grid, budget);
@@ -76,7 +77,9 @@ main(int argc, char **argv)
   {
     palpate::MpiEngine mpi(p, grid, mpi_cache, mpi_hip);
     deallog << "mpi: " << mpi.n_workers() << " solver servers, idle at every "
-            << "stop: " << (rest_until_idle(mpi, mpi_hip, path) ? "yes" : "NO")
+            << "stop: "
+            << (rest_until_idle(mpi, mpi_hip, grid, mpi_cache, path) ? "yes" :
+                                                                       "NO")
             << std::endl;
 
     // The same points, the same forces.
@@ -113,10 +116,9 @@ main(int argc, char **argv)
     const unsigned int wanted    = grid.linear({{2, -1, -1}});
     const bool         first_ask = mpi_cache.state(wanted) != nullptr;
     std::shared_ptr<const palpate::State> state;
-    const auto                            start = Clock::now();
-    while (!(state = mpi_cache.state(wanted)) &&
-           Clock::now() - start < std::chrono::seconds(30))
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    wait_until([&] { return (state = mpi_cache.state(wanted)) != nullptr; },
+               generous_deadline,
+               "the state asked for to arrive");
     stats = mpi.statistics();
     deallog << "asked for point " << wanted << ": held at first ask "
             << first_ask << ", arrived " << (state != nullptr)

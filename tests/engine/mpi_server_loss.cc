@@ -13,7 +13,8 @@
 // - the haptic side's interpolated forces stay finite throughout;
 // - the engine says it is degraded (PrecomputationEngine::degraded(): the
 //   haptic side then holds the force instead of fading it) while the dead
-//   server is silent, and not before it died nor 3 s after it was lost;
+//   server is silent, and not before it died; it stops saying so after the
+//   loss (3 s after it, its work re-planned);
 // - the client shuts the survivor down and finishes cleanly.
 
 #include <palpate/engine/hip_channel.h>
@@ -85,14 +86,17 @@ main(int argc, char **argv)
           }
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
-    // 3 s after the loss the re-planned work is done: no longer degraded.
-    std::this_thread::sleep_for(std::chrono::milliseconds(3500));
-    const bool degraded_after = engine.degraded();
+    // The engine stays degraded for 3 s after the loss (the survivor is
+    // heard, the lost server's work re-planned), then says it no longer is:
+    // waited for, so that a slow machine only makes the wait longer.
+    const bool recovered = wait_until([&] { return !engine.degraded(); },
+                                      generous_deadline,
+                                      "the engine to be no longer degraded");
     engine.stop();
     const auto stats = engine.statistics();
     deallog << "degraded while server 2 was silent: "
             << (degraded_while_silent ? "yes" : "NO")
-            << "; 3.5 s after the loss: " << (degraded_after ? "STILL" : "no")
+            << "; after the loss: " << (recovered ? "no" : "STILL")
             << std::endl;
     deallog << "engine idle (cloud done) within 3 minutes: "
             << (finished ? "yes" : "NO") << std::endl;

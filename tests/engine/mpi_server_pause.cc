@@ -2,14 +2,15 @@
 // Copyright (C) 2026 the palpate authors
 
 // A solver server freezes mid-run and comes back (rank 2 stops its own
-// process with SIGSTOP on its second task, as a machine that froze would,
-// and a child resumes it 5 s later; issue 26). The client declares it lost
-// after Engine / Server timeout (1 s here), plans its work again and
-// finishes the cloud with the survivor, as for a dead server. What this
-// test adds: the server that comes back must end too. It finds the
-// shutdown the client sent it when it was lost and exits, and so mpirun
-// returns; before, it waited for a client that no longer talked to it and
-// mpirun never returned (the test then hits the harness's time limit).
+// process with SIGSTOP on its second task, as a machine that froze would;
+// issue 26). The client declares it lost after Engine / Server timeout (1 s
+// here), plans its work again and finishes the cloud with the survivor, as
+// for a dead server. What this test adds: the server that comes back must
+// end too. The test resumes it (SIGCONT from rank 0) once the client has
+// declared it lost, however long that took; it finds the shutdown the
+// client sent it then and exits, and so mpirun returns; before, it waited
+// for a client that no longer talked to it and mpirun never returned (the
+// test then hits the harness's time limit).
 
 #include <palpate/engine/hip_channel.h>
 #include <palpate/engine/mpi_engine.h>
@@ -17,9 +18,14 @@
 #include <palpate/state_space/state_cache.h>
 #include <palpate/state_space/state_grid.h>
 
+#include <mpi.h>
+#include <signal.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <thread>
+#include <vector>
 
 #include "../tests.h"
 
@@ -36,14 +42,17 @@ main(int argc, char **argv)
   p.engine.server_timeout = 1;
   p.material_model.set("St.Venant-Kirchhoff", "Young's modulus", 1e6);
   const Body body(scene);
+  // Rank 0 resumes the frozen server: it needs its process id (every rank
+  // runs on this machine).
+  int pid = getpid(), ranks = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  std::vector<int> pids(ranks);
+  MPI_Gather(&pid, 1, MPI_INT, pids.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (palpate::mpi_rank() > 0)
     {
       palpate::ServerFaults faults;
       if (palpate::mpi_rank() == 2)
-        {
-          faults.pause_after_tasks = 2;
-          faults.pause_seconds     = 5;
-        }
+        faults.pause_after_tasks = 2; // until rank 0 resumes it
       return palpate::run_solver_server(scene, body.mesh, body.nodes, faults);
     }
 
@@ -58,9 +67,12 @@ main(int argc, char **argv)
     palpate::MpiEngine engine(p, grid, cache, hip);
     engine.start();
     const auto start    = Clock::now();
-    bool       finished = false;
+    bool       finished = false, resumed = false;
     while (Clock::now() - start < std::chrono::minutes(3))
       {
+        // Server 2 comes back once it is lost, while the survivor works.
+        if (!resumed && !engine.statistics().lost_servers.empty())
+          resumed = kill(pids[2], SIGCONT) == 0;
         if (engine.idle())
           {
             finished = true;
@@ -68,6 +80,10 @@ main(int argc, char **argv)
           }
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
+    // Never declared lost (the output says so): resumed all the same, so
+    // that it can end and mpirun return.
+    if (!resumed)
+      kill(pids[2], SIGCONT);
     engine.stop();
     const auto stats = engine.statistics();
     deallog << "engine idle (cloud done) within 3 minutes: "

@@ -5,40 +5,58 @@
 #define palpate_tests_engine_rest_until_idle_h
 
 // The engine tests' drive: the HIP rests at each point of a path until the
-// engine has nothing left to do there.
+// engine has computed the cell around it and has nothing left to do there.
 
 #include <palpate/base/utilities.h>
 #include <palpate/engine/engine.h>
 #include <palpate/engine/hip_channel.h>
+#include <palpate/state_space/state_cache.h>
+#include <palpate/state_space/state_grid.h>
 
 #include <chrono>
-#include <thread>
 #include <vector>
 
-/** Start @p engine, rest the HIP at each point of @p path until the engine
- * is idle, stop it. False if it was still busy after 5 minutes at one
- * point. */
+#include "../wait.h"
+
+/**
+ * Start @p engine, rest the HIP at each point of @p path until the 8
+ * corners of its cell are in @p cache (computed or failure points) and the
+ * engine is idle, stop it. False if that did not come within 5 minutes at
+ * one point.
+ *
+ * The corners say that the scheduler has seen the new position: idle()
+ * alone may still describe the last one, and the cloud around this one
+ * would then never be computed.
+ */
 inline bool
 rest_until_idle(palpate::PrecomputationEngine                 &engine,
                 palpate::HipChannel                           &hip,
+                const palpate::StateGrid                      &grid,
+                const palpate::StateCache                     &cache,
                 const std::vector<palpate::Utilities::Point3> &path)
 {
-  using Clock = std::chrono::steady_clock;
   const palpate::Utilities::Point3 zero{{0, 0, 0}};
   hip.write(path.front(), zero);
   engine.start();
   for (const auto &x : path)
     {
       hip.write(x, zero);
-      // Let the scheduler see the new position (100 Hz) before asking
-      // whether anything is left to do.
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      const auto start = Clock::now();
-      while (!engine.idle())
+      palpate::GridIndex    lower;
+      std::array<double, 3> local;
+      if (!grid.locate(x, lower, local) ||
+          !wait_until(
+            [&] {
+              for (const unsigned int q : grid.corners(lower))
+                if (cache.status(q) == palpate::PointStatus::missing)
+                  return false;
+              return engine.idle();
+            },
+            300,
+            "the engine to compute the cell around the HIP and be idle",
+            std::chrono::milliseconds(10)))
         {
-          if (Clock::now() - start > std::chrono::minutes(5))
-            return false;
-          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          engine.stop();
+          return false;
         }
     }
   engine.stop();

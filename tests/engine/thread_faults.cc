@@ -34,22 +34,6 @@
 
 namespace
 {
-  /** Wait at most @p seconds for @p done(); whether it came. */
-  template <typename Predicate>
-  bool
-  wait_for(const Predicate &done, const double seconds)
-  {
-    const auto start = std::chrono::steady_clock::now();
-    while (!done())
-      {
-        if (std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                          start)
-              .count() > seconds)
-          return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    return true;
-  }
   /** What a ThreadEngine works on: a body, a grid, a cache, a HIP. */
   struct Rig
   {
@@ -86,7 +70,8 @@ main(int argc, char **argv)
     palpate::ThreadEngine engine(
       rig.body.mesh, rig.body.nodes, p, grid, cache, rig.hip, faults);
     engine.start();
-    const bool idle  = wait_for([&] { return engine.idle(); }, 60);
+    const bool idle =
+      wait_until([&] { return engine.idle(); }, 60, "the engine to be idle");
     const auto stats = engine.statistics();
     deallog << "engine idle after the fault: " << (idle ? "yes" : "NO")
             << ", running: " << (engine.running() ? "YES" : "no")
@@ -100,12 +85,13 @@ main(int argc, char **argv)
       cloud +=
         palpate::Utilities::norm(grid.position(q)) <= p.scheduler.cloud_radius;
     engine.start();
-    const bool computed = wait_for(
+    const bool computed = wait_until(
       [&] {
         return engine.idle() &&
                cache.counts().first + cache.counts().second >= cloud;
       },
-      300);
+      300,
+      "the cloud computed again");
     engine.stop();
     deallog << "attached again: the cloud of " << cloud << " points is "
             << (computed ? "computed" : "NOT computed")
@@ -122,7 +108,8 @@ main(int argc, char **argv)
     palpate::ThreadEngine engine(
       rig.body.mesh, rig.body.nodes, p, grid, cache, rig.hip, faults);
     engine.start();
-    const bool idle = wait_for([&] { return engine.idle(); }, 60);
+    const bool idle =
+      wait_until([&] { return engine.idle(); }, 60, "the engine to be idle");
     engine.stop();
     const auto stats = engine.statistics();
     deallog << "engine idle: " << (idle ? "yes" : "NO") << "; every task a "
@@ -142,7 +129,9 @@ main(int argc, char **argv)
     palpate::Interaction interaction(scene);
     interaction.attach();
     const bool cloud =
-      wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
+      wait_until([&] { return interaction.initial_cloud_complete(); },
+                 300,
+                 "the initial cloud");
     palpate::ShapeInterpolator shape(interaction, 50, "shapes", "beam");
     shape.start();
     // Frames are written while the probe moves: move it.
@@ -150,26 +139,33 @@ main(int argc, char **argv)
     const auto   move = [&] {
       interaction.force({{1e-5 * (++step % 20), 0, 0}});
     };
-    const bool some = wait_for(
+    const bool some = wait_until(
       [&] {
         move();
         return shape.frames().first >= 3;
       },
-      60);
+      60,
+      "three frames");
     std::filesystem::remove_all("shapes");
     write_file("shapes", "a file where the directory was\n");
-    for (unsigned int k = 0; k < 20; ++k)
-      {
+    // The probe keeps moving until the thread meets the missing directory
+    // (its next frame), and then for 20 more moves, frames that would be
+    // written if it went on.
+    const bool failed = wait_until(
+      [&] {
         move();
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      }
+        return shape.failed();
+      },
+      generous_deadline,
+      "the shape thread to fail on the missing directory",
+      std::chrono::milliseconds(10));
     const unsigned int before = shape.frames().first;
     for (unsigned int k = 0; k < 20; ++k)
       {
         move();
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
       }
-    const bool stopped_writing = shape.frames().first == before;
+    const bool stopped_writing = failed && shape.frames().first == before;
     shape.stop();
     const palpate::Utilities::Point3 f = interaction.force({{0, 0, 0}});
     interaction.detach();
@@ -199,19 +195,22 @@ main(int argc, char **argv)
     std::filesystem::remove_all("full");
     palpate::Interaction interaction(scene);
     interaction.attach();
-    wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
+    wait_until([&] { return interaction.initial_cloud_complete(); },
+               300,
+               "the initial cloud");
     palpate::ShapeInterpolator shape(interaction, 50, "full", "beam");
     shape.start();
     unsigned int step = 0;
     const auto   move = [&] {
       interaction.force({{1e-5 * (++step % 20), 0, 0}});
     };
-    const bool some = wait_for(
+    const bool some = wait_until(
       [&] {
         move();
         return shape.frames().first >= 3;
       },
-      60);
+      60,
+      "three frames");
     const auto frame_size =
       std::filesystem::file_size("full/beam-shape-00000.vtu");
     std::signal(SIGXFSZ, SIG_IGN);
@@ -220,11 +219,15 @@ main(int argc, char **argv)
     rlimit full   = old_limit;
     full.rlim_cur = frame_size / 2;
     setrlimit(RLIMIT_FSIZE, &full);
-    for (unsigned int k = 0; k < 40; ++k)
-      {
+    // Moving until a frame could not be written.
+    wait_until(
+      [&] {
         move();
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      }
+        return shape.failed();
+      },
+      generous_deadline,
+      "the shape thread to fail on the full disk",
+      std::chrono::milliseconds(10));
     shape.stop();
     setrlimit(RLIMIT_FSIZE, &old_limit);
     interaction.detach();
@@ -274,18 +277,21 @@ main(int argc, char **argv)
     palpate::Interaction interaction(scene);
     interaction.attach();
     const bool cloud =
-      wait_for([&] { return interaction.initial_cloud_complete(); }, 300);
+      wait_until([&] { return interaction.initial_cloud_complete(); },
+                 300,
+                 "the initial cloud");
     // One byte: the first frame is written, then none.
     palpate::ShapeInterpolator shape(
       interaction, 50, "limited", "beam", nullptr, 1);
     shape.start();
     unsigned int step     = 0;
-    const bool   left_out = wait_for(
+    const bool   left_out = wait_until(
       [&] {
         interaction.force({{1e-5 * (++step % 20), 0, 0}});
         return shape.frames_over_limit() >= 3;
       },
-      60);
+      60,
+      "three frames over the limit");
     shape.stop();
     interaction.detach();
     deallog << "initial cloud: " << (cloud ? "yes" : "NO")
@@ -301,17 +307,20 @@ main(int argc, char **argv)
     // 7/8 every 8th; then none.
     palpate::Interaction decimated(scene);
     decimated.attach();
-    wait_for([&] { return decimated.initial_cloud_complete(); }, 300);
+    wait_until([&] { return decimated.initial_cloud_complete(); },
+               300,
+               "the initial cloud");
     palpate::ShapeInterpolator thinned(
       decimated, 50, "limited", "beam", nullptr, 8.0 * frame_bytes);
     thinned.start();
     step               = 0;
-    const bool reached = wait_for(
+    const bool reached = wait_until(
       [&] {
         decimated.force({{1e-5 * (++step % 20), 0, 0}});
         return thinned.frames_over_limit() >= 3;
       },
-      60);
+      60,
+      "three frames over the limit");
     thinned.stop();
     decimated.detach();
     const unsigned int written = thinned.frames().first;

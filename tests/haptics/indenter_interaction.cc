@@ -56,8 +56,9 @@ main(int argc, char **argv)
     palpate::Interaction interaction(scene);
     interaction.force(inside);
     interaction.attach();
-    while (!interaction.initial_cloud_complete())
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    wait_until([&] { return interaction.initial_cloud_complete(); },
+               300,
+               "the initial cloud");
 
     const auto          &grid  = interaction.grid();
     const auto          &cache = interaction.cache();
@@ -95,13 +96,16 @@ main(int argc, char **argv)
             << std::endl;
 
     // Above the surface the cell's corners are computed on demand.
-    Point3 off = interaction.force(above);
-    for (unsigned int i = 0; i < 2000 && !interaction.data_complete(); ++i)
-      {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        off = interaction.force(above);
-      }
-    off = settled_force(interaction, above);
+    // The probe held there (force() called, as the haptic loop does)
+    // until they are.
+    wait_until(
+      [&] {
+        interaction.force(above);
+        return interaction.data_complete();
+      },
+      generous_deadline,
+      "the cell above the surface");
+    const Point3 off = settled_force(interaction, above);
     deallog << "3 mm above the surface: force exactly 0: "
             << ok(off[0] == 0 && off[1] == 0 && off[2] == 0)
             << ", nothing missing: " << ok(interaction.data_complete())
@@ -112,8 +116,9 @@ main(int argc, char **argv)
   palpate::Interaction again(scene);
   again.force(inside);
   again.attach();
-  while (!again.initial_cloud_complete())
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  wait_until([&] { return again.initial_cloud_complete(); },
+             300,
+             "the second interaction's initial cloud");
   const Point3 f = settled_force(again, inside);
   deallog << "a second interaction loads the store (at least the initial "
              "cloud): "

@@ -41,14 +41,9 @@ namespace
   bool
   wait_for_cloud(palpate::Interaction &interaction)
   {
-    const auto start = std::chrono::steady_clock::now();
-    while (!interaction.initial_cloud_complete())
-      {
-        if (std::chrono::steady_clock::now() - start > std::chrono::minutes(5))
-          return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    return true;
+    return wait_until([&] { return interaction.initial_cloud_complete(); },
+                      300,
+                      "the initial cloud");
   }
 
   /** The trilinear interpolation at @p x of states computed directly from
@@ -218,9 +213,10 @@ main(int argc, char **argv)
                .complete
           << std::endl;
   interaction.attach();
+  // Read as the haptic side would (every 0.1 ms) until the cloud is there.
   unsigned int complete_reads = 0, stale_reads = 0;
-  while (!interaction.initial_cloud_complete())
-    {
+  wait_until(
+    [&] {
       const auto s =
         palpate::interpolate_force(interaction.grid(), interaction.cache(), x);
       if (s.complete)
@@ -231,8 +227,11 @@ main(int argc, char **argv)
             c *= 2;
           stale_reads += relative_difference(s.force, twice) > 1e-6;
         }
-      std::this_thread::sleep_for(std::chrono::microseconds(100));
-    }
+      return interaction.initial_cloud_complete();
+    },
+    300,
+    "the cloud at the doubled modulus",
+    std::chrono::microseconds(100));
   const Point3 f_new =
     palpate::interpolate_force(interaction.grid(), interaction.cache(), x)
       .force;

@@ -68,28 +68,31 @@ main(int argc, char **argv)
     interaction, device, 1000, palpate::HapticLoop::continuous, true);
   loop.start(palpate::HapticLoop::continuous);
   loop.start_motion();
-  // Until the loop has run 100 ticks of motion (about 0.1 s; on a loaded
-  // machine the thread may start late, and a hold before the first logged
-  // tick leaves no gap in the log: the fresh-clone CI's ctest -j2 saw
-  // that once).
+  // Until the loop has run 100 ticks of motion (about 0.1 s; the thread
+  // may start late, and a hold before the first logged tick leaves no gap
+  // in the log to check).
   const auto waited = [&](const unsigned long n) {
-    for (unsigned int k = 0; k < 1000 && device.calls.load() < n; ++k)
-      std::this_thread::sleep_for(10ms);
+    return wait_until([&] { return device.calls.load() >= n; },
+                      generous_deadline,
+                      std::to_string(n) + " calls of the loop",
+                      1ms);
   };
   waited(100);
 
+  // Held for 0.1 s: the scenario (the loop must read nothing meanwhile).
   loop.hold();
   const auto          held_since = std::chrono::steady_clock::now();
   const unsigned long held_at    = device.calls.load();
   std::this_thread::sleep_for(100ms);
   const unsigned long while_held = device.calls.load() - held_at;
-  // How long it was held, as this thread saw it (a loaded machine
-  // oversleeps).
+  loop.release();
+  // How long the log's gap can be, as this thread saw it: from the hold
+  // until the loop's first tick after the release (a loaded machine
+  // oversleeps, and wakes the loop late).
+  waited(held_at + while_held + 1);
   const double held_for =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - held_since)
       .count();
-  loop.release();
-  std::this_thread::sleep_for(100ms);
   waited(held_at + while_held + 51);
   const unsigned long after = device.calls.load() - held_at - while_held;
   deallog << "positions read while held: " << while_held
@@ -98,13 +101,18 @@ main(int argc, char **argv)
 
   // 2 mm away at 5 cm/s: about 0.1 s with the acceleration limit.
   device.set_target({{0.002, 0, -0.001}});
+  // The log drained while the probe goes there, as the live view does.
   std::ostringstream csv;
   std::size_t        rows = 0;
-  for (unsigned int k = 0; k < 10; ++k)
-    {
-      std::this_thread::sleep_for(100ms);
+  wait_until(
+    [&] {
       rows += loop.drain_force_log(csv);
-    }
+      return palpate::Utilities::distance(device.hip(), device.target()) <
+             1e-12;
+    },
+    generous_deadline,
+    "the follower at its target",
+    10ms);
   const auto x = device.hip();
   deallog << "target reached: "
           << ok(palpate::Utilities::distance(x, device.target()) < 1e-12)
@@ -115,9 +123,9 @@ main(int argc, char **argv)
 
   // The rows: times one period apart (a held tick is not logged: one gap
   // of about 0.1 s), finite, as many as drained. The gap's upper bound is
-  // what this thread held plus 0.5 s: CI's loaded machine delays the loop's
-  // first tick after the release by more than 50 ms (the check failed there
-  // once at + 0.05 s); a loop that did not come back fails "goes on" above.
+  // what this thread saw from the hold to the loop's first tick after it,
+  // plus 0.5 s for a last tick before the hold that the loop ran late; a
+  // loop that did not come back fails "goes on" above.
   std::istringstream in(csv.str());
   std::string        line;
   double             previous = -1, largest_gap = 0;

@@ -32,15 +32,15 @@ namespace
   Point3
   force_at(palpate::Interaction &interaction, const Point3 &x)
   {
-    interaction.force(x);
-    for (unsigned int i = 0;
-         i < 4000 && !interaction.data_complete() &&
-         interaction.missing_cause() != palpate::MissingCause::outside;
-         ++i)
-      {
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    wait_until(
+      [&] {
         interaction.force(x);
-      }
+        return interaction.data_complete() ||
+               interaction.missing_cause() == palpate::MissingCause::outside;
+      },
+      generous_deadline,
+      "the HIP's cell (or the HIP outside the grid)",
+      std::chrono::milliseconds(2));
     return settled_force(interaction, x);
   }
 } // namespace
@@ -60,8 +60,9 @@ main(int argc, char **argv)
   palpate::Interaction interaction(scene);
   interaction.force({{0.0007, 0, depth}});
   interaction.attach();
-  while (!interaction.initial_cloud_complete())
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  wait_until([&] { return interaction.initial_cloud_complete(); },
+             300,
+             "the initial cloud");
 
   // Along +x in steps of 0.1 mm, each step's cell computed first.
   double largest_step = 0;

@@ -185,15 +185,33 @@ main(int argc, char **argv)
       palpate::StateStore store("killed.h5", fingerprint);
       store.append(states[0].first, states[0].second);
     }
+    // The child says (a byte on a pipe) when it has appended 20 records,
+    // and goes on appending: it is killed in the middle of one.
+    int appended[2];
+    AssertThrow(pipe(appended) == 0, dealii::ExcMessage("no pipe"));
     const pid_t child = fork();
     if (child == 0)
       {
+        close(appended[0]);
         palpate::StateStore store("killed.h5", fingerprint);
         for (unsigned int k = 0;; ++k)
-          store.append(grid.linear({{int(k % 7) - 3, 0, 0}}),
-                       states[1 + k % 3].second);
+          {
+            store.append(grid.linear({{int(k % 7) - 3, 0, 0}}),
+                         states[1 + k % 3].second);
+            if (k == 19)
+              {
+                const char c = 1;
+                if (write(appended[1], &c, 1) != 1)
+                  _exit(1);
+                close(appended[1]);
+              }
+          }
       }
-    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    close(appended[1]);
+    char c = 0; // 0 bytes read: the child ended before 20 (then it fails)
+    if (read(appended[0], &c, 1) != 1)
+      deallog << "  (the writer ended before 20 records)" << std::endl;
+    close(appended[0]);
     kill(child, SIGKILL);
     waitpid(child, nullptr, 0);
     palpate::StateStore store("killed.h5", fingerprint);
@@ -269,23 +287,28 @@ main(int argc, char **argv)
       palpate::Interaction first(with_store);
       cloud = first.initial_cloud_size();
       first.attach();
-      const auto start = std::chrono::steady_clock::now();
-      while (!first.initial_cloud_complete() &&
-             std::chrono::steady_clock::now() - start <
-               std::chrono::seconds(120))
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      wait_until([&] { return first.initial_cloud_complete(); },
+                 120,
+                 "the first interaction's initial cloud",
+                 std::chrono::milliseconds(20));
       first.detach();
       deallog << "first interaction: " << first.store_report().substr(0, 44)
               << "..." << std::endl;
     }
+    // The store is loaded when the interaction is made; the cloud is then
+    // complete once the engine has looked at it, with nothing to compute.
     palpate::Interaction second(with_store);
+    const auto           counts = second.cache().counts();
     second.attach();
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    const auto counts = second.cache().counts();
+    const bool complete =
+      wait_until([&] { return second.initial_cloud_complete(); },
+                 generous_deadline,
+                 "the second interaction's initial cloud");
+    second.detach();
     deallog << "second interaction: the " << cloud << " cloud states loaded: "
             << ok(counts.first + counts.second >= cloud)
-            << ", initial cloud complete at once: "
-            << ok(second.initial_cloud_complete()) << std::endl;
-    second.detach();
+            << ", initial cloud complete with no state computed: "
+            << ok(complete && second.summary().states_computed == 0)
+            << std::endl;
   }
 }

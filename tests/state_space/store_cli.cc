@@ -195,19 +195,6 @@ namespace
                    "store keeps: +([0-9]+) states and ([0-9]+) failure "
                    "points in [^ ]+ \\(([0-9]+) appended by this run");
   }
-
-  bool
-  wait_until(const std::function<bool()> &condition)
-  {
-    const auto start = std::chrono::steady_clock::now();
-    while (!condition())
-      {
-        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(60))
-          return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    return true;
-  }
 } // namespace
 
 int
@@ -225,10 +212,13 @@ main(int argc, char **argv)
   {
     const Started first =
       start("precompute beam-store.prm --radius 0.02", "first.txt");
-    const bool locked = wait_until([&] {
-      return read_file("beam.h5.lock")
-               .find("pid " + std::to_string(first.pid)) != std::string::npos;
-    });
+    const bool locked = wait_until(
+      [&] {
+        return read_file("beam.h5.lock")
+                 .find("pid " + std::to_string(first.pid)) != std::string::npos;
+      },
+      generous_deadline,
+      "the first precompute's lock");
     kill(first.pid, SIGSTOP);
     const auto second = run("precompute beam-store.prm --radius 0.02");
     const auto touch  = run("beam-store.prm --set Run/Mode=interaction");
@@ -277,17 +267,20 @@ main(int argc, char **argv)
                                 store,
                               "signal.txt");
       // Signalled in the middle: once the store holds 100 records.
-      const bool middle = wait_until([&] {
-        try
-          {
-            const auto c = contents(store);
-            return c.states + c.failures >= 100;
-          }
-        catch (const palpate::InputError &)
-          {
-            return false; // not made yet
-          }
-      });
+      const bool middle = wait_until(
+        [&] {
+          try
+            {
+              const auto c = contents(store);
+              return c.states + c.failures >= 100;
+            }
+          catch (const palpate::InputError &)
+            {
+              return false; // not made yet
+            }
+        },
+        generous_deadline,
+        "100 records in " + store);
       kill(p.pid, signal);
       if (twice)
         {

@@ -26,6 +26,7 @@
 #include <palpate/state_space/state_grid.h>
 #include <palpate/state_space/state_store.h>
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -96,20 +97,6 @@ namespace
       text.replace(at, dir.size(), "<dir>");
     return text;
   }
-
-  /** Wait (at most 30 s) until the file @p name holds @p what. */
-  bool
-  wait_for_text(const std::string &name, const std::string &what)
-  {
-    const auto start = std::chrono::steady_clock::now();
-    while (read_file(name).find(what) == std::string::npos)
-      {
-        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(30))
-          return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-      }
-    return true;
-  }
 } // namespace
 
 int
@@ -152,7 +139,6 @@ main(int argc, char **argv)
                               "read.h5",
                               "full.h5",
                               "refusal.txt",
-                              "ready.txt",
                               "full.txt"})
     std::filesystem::remove(f);
 
@@ -332,17 +318,32 @@ main(int argc, char **argv)
 
   // --- A writer killed with SIGKILL does not block the next one.
   {
+    // The writer says (a byte on a pipe) when it has appended 10 records,
+    // and goes on appending: it is killed in the middle of one. A writer
+    // that ended before closes the pipe instead (ready: no).
+    int appended[2];
+    AssertThrow(pipe(appended) == 0, dealii::ExcMessage("pipe() failed"));
     const pid_t child = fork();
     if (child == 0)
       {
+        close(appended[0]);
         palpate::StateStore store("stale.h5", fingerprint);
-        append(store, 0);
-        write_file("ready.txt", "ready\n");
-        for (unsigned int k = 1;; ++k)
-          append(store, k);
+        for (unsigned int k = 0;; ++k)
+          {
+            append(store, k);
+            if (k == 9)
+              {
+                const char byte = 'x';
+                if (write(appended[1], &byte, 1) != 1)
+                  _exit(1);
+                close(appended[1]);
+              }
+          }
       }
-    const bool ready = wait_for_text("ready.txt", "ready");
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    close(appended[1]);
+    char       byte  = 0;
+    const bool ready = read(appended[0], &byte, 1) == 1;
+    close(appended[0]);
     kill(child, SIGKILL);
     waitpid(child, nullptr, 0);
     const bool left =
@@ -372,28 +373,46 @@ main(int argc, char **argv)
       palpate::StateStore store("read.h5", fingerprint);
       append(store, 0);
     }
+    // The writer appends paced (at most 5000 records/s) and waits at
+    // every 100th record until the reader has read once more (a byte each
+    // way on two pipes): the reader reads in the middle of the appends at
+    // least 5 times, however busy the machine, and reads while records are
+    // appended in between.
     const unsigned int n_records = 600;
-    const pid_t        child     = fork();
+    int                paused[2], resume[2];
+    AssertThrow(pipe(paused) == 0 && pipe(resume) == 0,
+                dealii::ExcMessage("pipe() failed"));
+    fcntl(paused[0], F_SETFL, O_NONBLOCK);
+    const pid_t child = fork();
     if (child == 0)
       {
+        close(paused[0]);
+        close(resume[1]);
         {
           palpate::StateStore store("read.h5", fingerprint);
-          // Paced (at most 5000 records/s), so that the reader surely
-          // reads while it appends, however busy the machine.
           for (unsigned int k = 1; k < n_records; ++k)
             {
               append(store, k);
               std::this_thread::sleep_for(std::chrono::microseconds(200));
+              char byte = 'x';
+              if (k % 100 == 0 && (write(paused[1], &byte, 1) != 1 ||
+                                   read(resume[0], &byte, 1) != 1))
+                _exit(1);
             }
         }
         _exit(0);
       }
+    close(paused[1]);
+    close(resume[0]);
     unsigned int reads = 0, refused = 0, damaged_seen = 0, incomplete_seen = 0,
                  wrong = 0, shrank = 0, during = 0;
     std::size_t last = 0;
     for (bool done = false; !done;)
       {
-        done = waitpid(child, nullptr, WNOHANG) == child;
+        // The writer waiting at a 100th record: this read is in the middle.
+        char       byte    = 0;
+        const bool waiting = read(paused[0], &byte, 1) == 1;
+        done               = waitpid(child, nullptr, WNOHANG) == child;
         try
           {
             const palpate::StateStore store("read.h5",
@@ -414,7 +433,11 @@ main(int argc, char **argv)
             if (++refused == 1)
               deallog << "  a read failed: " << e.problem() << std::endl;
           }
+        if (waiting && write(resume[1], &byte, 1) != 1)
+          deallog << "  the writer could not be resumed" << std::endl;
       }
+    close(paused[0]);
+    close(resume[1]);
     deallog << "a reader while a writer appends " << n_records
             << " records: read " << (during >= 3 ? ">= 3" : "< 3")
             << " times in the middle, every record whole and right "

@@ -105,7 +105,8 @@ namespace palpate
     unsigned int die_after_tasks = 0;
     /** After this many tasks received, the server stops its own process
      * (SIGSTOP) as a frozen machine would, and a child process resumes it
-     * (SIGCONT) @p pause_seconds later; 0: never. */
+     * (SIGCONT) @p pause_seconds later; 0: never. With pause_seconds = 0
+     * it stays stopped until another process sends it SIGCONT. */
     unsigned int pause_after_tasks = 0;
     double       pause_seconds     = 0;
   };

@@ -174,6 +174,14 @@ namespace palpate
     const std::string &
     failure() const;
 
+    /**
+     * Whether the shape output stopped early (failure() says why): safe to
+     * call while the thread runs, and once true no more frames are
+     * written, so that a caller can wait for it instead of for a time.
+     */
+    bool
+    failed() const noexcept;
+
   private:
     struct Impl;
     std::unique_ptr<Impl> impl;
