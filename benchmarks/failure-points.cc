@@ -86,8 +86,7 @@ namespace
       p.material_model.model_name = "Neo-Hookean";
     p.boundary_conditions.active_node.tip_radius = c.tip_mm / 1000;
     p.boundary_conditions.active_node.tip =
-      c.tip_mm > 0 ? Parameters::ActiveNode::Tip::glued_nodes :
-                     Parameters::ActiveNode::Tip::point;
+      c.tip_mm > 0 ? "glued nodes" : "point";
     p.nonlinear_solver.set_reuse(false);
     p.nonlinear_solver.max_increment_length = 0.01;
     return scene;

@@ -195,9 +195,8 @@ touch_beam_with_sphere(palpate::Scene &scene, const double radius)
   auto &p                                        = scene.parameters;
   p.boundary_conditions.fixed_nodes.boundary_ids = {4};
   p.boundary_conditions.active_node.point        = {{0.05, 0, 0.01}};
-  p.boundary_conditions.active_node.tip =
-    palpate::Parameters::ActiveNode::Tip::sphere;
-  p.boundary_conditions.active_node.tip_radius = radius;
+  p.boundary_conditions.active_node.tip          = "sphere";
+  p.boundary_conditions.active_node.tip_radius   = radius;
 }
 
 /**

@@ -371,7 +371,7 @@ namespace palpate
       // between the surface nodes, those states are failure points and
       // the force is held there (the summary counts it).
       const auto &a = p.boundary_conditions.active_node;
-      if (a.tip != Parameters::ActiveNode::Tip::sphere)
+      if (!interaction->nodes().sphere_tip)
         return;
       // Its farthest point drags the sphere farthest along the surface,
       // its deepest presses it deepest (a circle's need not be the same).

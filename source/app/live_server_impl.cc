@@ -220,7 +220,7 @@ namespace palpate
     const NodeSelection &nodes = interaction.nodes();
     const auto          &tip =
       interaction.scene().parameters.boundary_conditions.active_node;
-    const bool sphere = tip.tip == Parameters::ActiveNode::Tip::sphere;
+    const bool sphere = nodes.sphere_tip;
     const bool none   = nodes.active_vertex == NodeSelection::no_active_node;
     std::ostringstream a;
     a << "\"active\":" << (none ? -1L : mesh.node_id(nodes.active_vertex))

@@ -8,6 +8,7 @@
 #include <palpate/mesh/mesh_quality.h>
 #include <palpate/mesh/mesh_source.h>
 #include <palpate/mesh/node_selection.h>
+#include <palpate/mesh/probe_tip.h>
 #include <palpate/mesh/volume_mesher.h>
 #include <palpate/scene/scene.h>
 
@@ -114,47 +115,26 @@ namespace palpate
           << " m across: is Mesh / Scale factor right? " << advice << ".\n";
     }
 
-    /** The probe tip's line, if the probe has a tip. */
+    /** The probe tip's line, if the tip has one to say. */
     void
-    report_probe_tip(std::ostream                    &s,
-                     const Parameters::AllParameters &p,
-                     const NodeSelection             &nodes)
+    report_probe_tip(std::ostream        &s,
+                     const Scene         &scene,
+                     const NodeSelection &nodes)
     {
-      const auto &a = p.boundary_conditions.active_node;
-      using Tip     = Parameters::ActiveNode::Tip;
-      if (a.tip == Tip::sphere)
-        s << "\n  probe tip:     a rigid sphere of radius "
-          << 1000 * a.tip_radius
-          << " mm in frictionless contact with the surface; at HIP = 0 it "
-             "touches the surface from outside, its centre at ("
-          << Utilities::to_string(nodes.sphere_center, 4) << ") m, normal ("
-          << Utilities::to_string(nodes.active_normal, 3) << ")"
-          << (nodes.sphere_lift > 0 ?
-                ", lifted " +
-                  Utilities::to_string(1000 * nodes.sphere_lift, 3) +
-                  " mm along the normal so that it presses on no other node "
-                  "(the surface is concave there)" :
-                std::string());
-      else if (a.tip == Tip::glued_nodes)
-        s << "\n  probe tip:     radius "
-          << 1000 * p.boundary_conditions.active_node.tip_radius
-          << " mm: " << nodes.tip_vertices.size()
-          << " more surface nodes move with the probe (rigid tip)"
-          << (nodes.tip_vertices.empty() ?
-                "; the nearest is " +
-                  Utilities::to_string(1000 * nodes.tip_neighbour_distance, 3) +
-                  " mm away, so on this mesh the tip is a point probe (a "
-                  "finer mesh, or a radius of at least that, makes a tip)" :
-                std::string());
+      if (const std::string line =
+            ProbeTip::create(scene)->report(scene, nodes);
+          !line.empty())
+        s << "\n  probe tip:     " << line;
     }
 
     /** The fixed nodes, the active node and the probe tip. */
     void
-    report_boundary_conditions(std::ostream                    &s,
-                               const Parameters::AllParameters &p,
-                               const Mesh                      &mesh,
-                               const NodeSelection             &nodes)
+    report_boundary_conditions(std::ostream        &s,
+                               const Scene         &scene,
+                               const Mesh          &mesh,
+                               const NodeSelection &nodes)
     {
+      const auto &p  = scene.parameters;
       const auto &f  = p.boundary_conditions.fixed_nodes;
       const auto &a  = p.boundary_conditions.active_node;
       const auto &xa = mesh.vertices()[nodes.active_vertex];
@@ -174,7 +154,7 @@ namespace palpate
           << 100 * nodes.active_distance / mesh.diameter()
           << " % of its size): is it in the mesh's scaled coordinates "
              "(metres, after Scale factor)? The mesh's bounding box is above.";
-      report_probe_tip(s, p, nodes);
+      report_probe_tip(s, scene, nodes);
       s << "\n";
     }
 
@@ -201,13 +181,12 @@ namespace palpate
 
     /** The effects the scene switches on, and those it leaves off. */
     void
-    report_effects(std::ostream                    &s,
-                   const Parameters::AllParameters &p,
-                   const Mesh                      &mesh,
-                   const NodeSelection             &nodes)
+    report_effects(std::ostream        &s,
+                   const Scene         &scene,
+                   const Mesh          &mesh,
+                   const NodeSelection &nodes)
     {
-      const auto &a = p.boundary_conditions.active_node;
-      using Tip     = Parameters::ActiveNode::Tip;
+      const auto &p = scene.parameters;
       // Effects are what a scene switches on; incompressibility is the
       // material's (see Material above), not an effect.
       std::vector<std::string> on, off;
@@ -220,11 +199,9 @@ namespace palpate
           }
       for (const auto &effect : Effect::create_enabled(p.effects))
         on.push_back(effect->description(mesh, p));
-      if (a.tip == Tip::glued_nodes)
-        on.push_back("probe tip (" +
-                     std::to_string(1 + nodes.tip_vertices.size()) + " nodes)");
-      if (a.tip == Tip::sphere)
-        on.push_back("contact with a rigid sphere");
+      if (const std::string tip = ProbeTip::create(scene)->effect(nodes);
+          !tip.empty())
+        on.push_back(tip);
       (p.effects.shape_output ? on : off).push_back("shape output");
       (p.effects.vtu_export ? on : off).push_back("VTU export");
       (p.effects.force_log ? on : off).push_back("force log");
@@ -246,9 +223,9 @@ namespace palpate
     s << std::setprecision(4);
     report_command_line(s, scene);
     report_mesh(s, scene, mesh, nodes);
-    report_boundary_conditions(s, scene.parameters, mesh, nodes);
+    report_boundary_conditions(s, scene, mesh, nodes);
     report_material(s, scene.parameters);
-    report_effects(s, scene.parameters, mesh, nodes);
+    report_effects(s, scene, mesh, nodes);
     out << s.str();
   }
 } // namespace palpate

@@ -121,6 +121,7 @@ namespace palpate
     void
     print_outcome(std::ostream            &out,
                   const Scene             &scene,
+                  const NodeSelection     &nodes,
                   const State             &state,
                   const StopRequest       &stop,
                   const double             reached,
@@ -148,9 +149,7 @@ namespace palpate
                   " N): the device would clip it. Is the modulus in Pa, the "
                   "push in metres, the mesh's Scale factor right?\n" :
                 std::string())
-          << (Utilities::norm(state.force) == 0 &&
-                  scene.parameters.boundary_conditions.active_node.tip ==
-                    Parameters::ActiveNode::Tip::sphere ?
+          << (Utilities::norm(state.force) == 0 && nodes.sphere_tip ?
                 "  note:           the sphere does not touch the surface "
                 "there (0 N): the push moves it away from the organ or "
                 "along it. A push into the organ points against the "
@@ -332,7 +331,8 @@ namespace palpate
     const bool stopped = state.status == SolveStatus::stopped;
 
     print_newton_history(out, state);
-    print_outcome(out, scene, state, stop, reached, reached_at, reached_force);
+    print_outcome(
+      out, scene, nodes, state, stop, reached, reached_at, reached_force);
 
     print_costs(out, p, solver, state);
 

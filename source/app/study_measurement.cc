@@ -377,9 +377,8 @@ namespace palpate
       const auto      needed  = with_neighbours(grid, corners);
       // The stiffness for Hermite; with a sphere, each state's contact
       // patch too, for the contact patch beside them.
-      const bool sphere = p.boundary_conditions.active_node.tip ==
-                          Parameters::ActiveNode::Tip::sphere;
-      auto q = p;
+      const bool sphere = base->nodes.sphere_tip;
+      auto       q      = p;
       q.state_space.interpolation =
         sphere ? "contact patch" : "tricubic Hermite";
       q.nonlinear_solver.compute_stiffness = true;
@@ -487,14 +486,13 @@ namespace palpate
               Scene s           = variants[v];
               auto &active      = s.parameters.boundary_conditions.active_node;
               active.tip_radius = radius;
-              // The scene's sphere stays a sphere; otherwise a finite
-              // radius is a glued tip.
-              if (active.tip != Parameters::ActiveNode::Tip::sphere)
-                active.tip = radius > 0 ?
-                               Parameters::ActiveNode::Tip::glued_nodes :
-                               Parameters::ActiveNode::Tip::point;
-              else if (!(radius > 0))
-                active.tip = Parameters::ActiveNode::Tip::point;
+              // The study compares a point probe with a rigid tip: the
+              // scene's sphere stays a sphere, any other tip of a finite
+              // radius is a glued one.
+              if (!(radius > 0))
+                active.tip = "point";
+              else if (!base->nodes.sphere_tip)
+                active.tip = "glued nodes";
               const Body body(s);
               forces.push_back(direct_solves(
                 body,

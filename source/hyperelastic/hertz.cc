@@ -27,8 +27,7 @@ namespace palpate
                          const unsigned int               split)
     : parameters(p)
   {
-    using Tip = Parameters::ActiveNode::Tip;
-    parameters.boundary_conditions.active_node.tip        = Tip::sphere;
+    parameters.boundary_conditions.active_node.tip        = "sphere";
     parameters.boundary_conditions.active_node.tip_radius = R;
     parameters.boundary_conditions.fixed_nodes.treatment  = "elimination";
 
@@ -58,6 +57,7 @@ namespace palpate
         if (x[v][0] == 0 && x[v][1] == 0 && x[v][2] == 0)
           nodes.active_vertex = v;
       }
+    nodes.sphere_tip        = true;
     nodes.active_normal     = {{0, 0, 1}};
     nodes.sphere_center     = {{0, 0, R}};
     nodes.fixed_description = "the bottom face";

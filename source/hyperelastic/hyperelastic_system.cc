@@ -74,8 +74,7 @@ namespace palpate
     const std::vector<bool>   dof_fixed = find_fixed_and_active_dofs(tip_dofs);
     const bool                has_active =
       nodes.active_vertex != NodeSelection::no_active_node;
-    const bool sphere = has_active && p.boundary_conditions.active_node.tip ==
-                                        Parameters::ActiveNode::Tip::sphere;
+    const bool sphere = has_active && nodes.sphere_tip;
     if (sphere)
       find_contact_candidates(p, dof_fixed);
     const unsigned int n_eq =

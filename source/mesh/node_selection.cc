@@ -5,6 +5,7 @@
 #include <palpate/mesh/mesh.h>
 #include <palpate/mesh/node_selection.h>
 #include <palpate/mesh/node_selection_impl.h>
+#include <palpate/mesh/probe_tip.h>
 #include <palpate/scene/scene.h>
 
 #include <algorithm>
@@ -246,34 +247,6 @@ namespace palpate
           "choose an active node outside the fixed region, or "
           "shrink the region.");
     }
-
-
-
-    /**
-     * The surface nodes glued to the active node (Tip = glued nodes): those
-     * within the tip's radius, not fixed.
-     */
-    void
-    glue_tip_nodes(const Scene                  &scene,
-                   const Mesh                   &mesh,
-                   const std::set<unsigned int> &fixed,
-                   NodeSelection                &selection)
-    {
-      const auto &a       = scene.parameters.boundary_conditions.active_node;
-      const auto &x       = mesh.vertices();
-      const auto &surface = mesh.on_surface();
-      selection.tip_neighbour_distance = std::numeric_limits<double>::max();
-      for (unsigned int v = 0; v < x.size(); ++v)
-        if (v != selection.active_vertex && surface[v] && !fixed.count(v))
-          {
-            const double d =
-              Utilities::distance(x[v], x[selection.active_vertex]);
-            selection.tip_neighbour_distance =
-              std::min(selection.tip_neighbour_distance, d);
-            if (d <= a.tip_radius)
-              selection.tip_vertices.push_back(v);
-          }
-    }
   } // namespace
 
 
@@ -292,8 +265,6 @@ namespace palpate
                         const Mesh        &mesh,
                         const SphereTrial &trial)
   {
-    const auto &a = scene.parameters.boundary_conditions.active_node;
-
     NodeSelection        selection;
     const FixedSelection region = select_fixed(scene, mesh);
     check_fixed(scene, mesh, region);
@@ -305,10 +276,9 @@ namespace palpate
 
     internal::select_active_vertex(scene, mesh, selection);
     check_active_not_fixed(scene, mesh, region.fixed, selection);
-    if (a.tip == Parameters::ActiveNode::Tip::sphere)
-      internal::place_sphere_tip(scene, mesh, selection, trial);
-    if (a.tip == Parameters::ActiveNode::Tip::glued_nodes)
-      glue_tip_nodes(scene, mesh, region.fixed, selection);
+    // The tip puts itself at the active node: the nodes that move with it,
+    // or a sphere resting on the surface.
+    ProbeTip::create(scene)->place(scene, mesh, region.fixed, selection, trial);
     return selection;
   }
 

@@ -386,27 +386,10 @@ namespace palpate
           "Mode = static solve), in metres; `palpate solve --to x,y,z` "
           "overrides it. An interaction does not use it (the device moves "
           "the probe), but a sphere's size is checked against it.");
-        prm.declare_entry(
-          "Tip",
-          "point",
-          Patterns::Selection("point|glued nodes|sphere"),
-          "What touches the organ. point: the paper's probe, the active node "
-          "follows the haptic interaction point (HIP) and the force is its "
-          "multiplier; the force of a point load is a property of the mesh "
-          "(it tends to zero as the mesh is refined). glued nodes: every "
-          "free surface node within Tip radius of the active node follows "
-          "the HIP, and the force is the sum of their multipliers. sphere: "
-          "a rigid sphere of radius Tip radius, whose centre moves with the "
-          "HIP, in frictionless unilateral contact with the surface (no "
-          "node is glued to it; the force is the resultant of the contact "
-          "pressure, zero off the surface). At HIP = 0 the sphere touches "
-          "the surface from outside, along the outward normal, at the point "
-          "of the surface nearest to Point (Selection = nearest surface "
-          "node) or at the node (Selection = node id); palpate solve --to X "
-          "moves it by X. The contact acts at the surface nodes: a state "
-          "where the sphere went between them (its centre less than half "
-          "its radius from the deformed surface, as a sphere smaller than "
-          "the triangles it pushes does) is a failure point, not a force.");
+        // The tips are plug-ins (mesh/probe_tip.h): the choice comes from
+        // their declarations; Tip radius below is the built-in tips'.
+        internal::declare_plugin_choice(
+          prm, "probe tip", "Tip", "point", "What touches the organ.", "");
         prm.declare_entry(
           "Tip radius",
           "0",
@@ -445,11 +428,9 @@ namespace palpate
         node_id   = prm.get_integer("Node id");
         prescribed_displacement =
           internal::get_point(prm, "Prescribed displacement");
-        tip_radius          = prm.get_double("Tip radius");
-        const std::string t = prm.get("Tip");
-        tip                 = t == "sphere"      ? Tip::sphere :
-                              t == "glued nodes" ? Tip::glued_nodes :
-                                                   Tip::point;
+        tip        = prm.get("Tip");
+        own        = internal::own_entries(prm, "probe tip");
+        tip_radius = prm.get_double("Tip radius");
       }
       prm.leave_subsection();
     }

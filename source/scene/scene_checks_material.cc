@@ -4,9 +4,9 @@
 // The checks of a scene's material and plug-ins (Scene::validate()): the
 // material plug-in's constants (its own checks, then what they must satisfy
 // in the scene: check_material_scene()), the enabled effects' entries and
-// the own entries of the chosen device, trajectory and linear solver; and
-// Scene::displacement_degree(), the degree of the displacements that the
-// element pair fixes. Each plug-in is reached through its Declaration
+// the own entries of the chosen probe tip, device, trajectory and linear
+// solver; and Scene::displacement_degree(), the degree of the displacements
+// that the element pair fixes. Each plug-in is reached through its Declaration
 // (Plugins::declarations()), not its interface.
 
 #include <palpate/scene/scene_impl.h>
@@ -109,6 +109,10 @@ namespace palpate
           "Boundary conditions/Fixed nodes",
           p.boundary_conditions.fixed_nodes.selection,
           p.boundary_conditions.fixed_nodes.own);
+    check("probe tip",
+          "Boundary conditions/Active node",
+          p.boundary_conditions.active_node.tip,
+          p.boundary_conditions.active_node.own);
     check("device", "Haptics", p.haptics.device, p.haptics.own);
     check("trajectory",
           "Haptics/Trajectory",

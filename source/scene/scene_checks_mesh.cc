@@ -2,54 +2,21 @@
 // Copyright (C) 2026 the palpate authors
 
 // The checks of a scene's body and its boundary conditions
-// (Scene::validate()): the probe's tip and its radius, the mesh's scale, and
-// through their plug-ins the mesh source's entries (its file, the generated
-// beam's or blob's size) and the fixed-node region's.
+// (Scene::validate()): the mesh's scale, and through their plug-ins the
+// probe tip's entries (its radius), the mesh source's (its file, the
+// generated beam's or blob's size) and the fixed-node region's.
 
 #include <palpate/scene/scene_impl.h>
-
-#include <algorithm>
-#include <cmath>
 
 namespace palpate
 {
   void
   Scene::check_probe() const
   {
-    using namespace Limits;
-    const auto &p = parameters;
-
-    // The probe's tip: a radius means something only for a glued tip or a
-    // sphere (before Tip existed, Tip radius > 0 meant glued nodes).
-    {
-      using Tip     = Parameters::ActiveNode::Tip;
-      const auto &a = p.boundary_conditions.active_node;
-      if (a.tip == Tip::point && a.tip_radius > 0)
-        throw error("Boundary conditions/Active node/Tip radius",
-                    "Tip radius = " + Utilities::to_string(a.tip_radius, 4) +
-                      " m, but Tip = point has no radius",
-                    "set Tip = sphere (a rigid sphere in contact with the "
-                    "surface: a force that converges with the mesh) or Tip "
-                    "= glued nodes (the surface nodes within the radius "
-                    "follow the probe), or remove Tip radius.");
-      if (a.tip != Tip::point && !(a.tip_radius > 0))
-        throw error("Boundary conditions/Active node/Tip radius",
-                    "Tip = " +
-                      std::string(a.tip == Tip::sphere ? "sphere" :
-                                                         "glued nodes") +
-                      " needs a positive Tip radius",
-                    "set Tip radius in metres, e.g. 0.01 for a probe of "
-                    "1 cm radius.");
-      if (a.tip != Tip::point && a.tip_radius > max_sphere_radius)
-        throw error(
-          "Boundary conditions/Active node/Tip radius",
-          std::string(a.tip == Tip::sphere ? "a sphere" : "a glued tip") +
-            " of " +
-            Utilities::to_string_apart(a.tip_radius, max_sphere_radius) +
-            " m radius is no probe (at most " +
-            Utilities::to_string(max_sphere_radius, 3) + " m)",
-          "give the radius in metres (a 1 cm probe: 0.01).");
-    }
+    // The probe's tip checks the entries it reads (mesh/probe_tips/): a
+    // radius only where the tip has one, and a probe's size.
+    const auto &a = parameters.boundary_conditions.active_node;
+    Plugins::check_scene("probe tip", a.tip, *this);
   }
 
 

@@ -217,18 +217,6 @@ namespace palpate
                     "0.005 m gives 41^3 = 68921 points).",
                     {"State space/Grid spacing"});
     }
-    if (p.state_space.interpolation == "contact patch")
-      {
-        using Tip = Parameters::ActiveNode::Tip;
-        if (p.boundary_conditions.active_node.tip != Tip::sphere)
-          throw error("State space/Interpolation",
-                      "contact patch solves the contact of a sphere against "
-                      "each state's surface, but Boundary conditions / Active "
-                      "node / Tip is not sphere",
-                      "set Tip = sphere with a Tip radius, or Interpolation "
-                      "= tricubic Hermite.",
-                      {"Boundary conditions/Active node/Tip"});
-      }
     check_scheduler(*this);
     check_cores(*this);
   }

@@ -76,8 +76,7 @@ namespace palpate
       if (!nodes.tip_vertices.empty())
         a += ", tip of " + std::to_string(nodes.tip_vertices.size() + 1) +
              " nodes";
-      if (p.boundary_conditions.active_node.tip ==
-          Parameters::ActiveNode::Tip::sphere)
+      if (nodes.sphere_tip)
         a += ", sphere of radius " +
              Utilities::to_string(p.boundary_conditions.active_node.tip_radius,
                                   9) +

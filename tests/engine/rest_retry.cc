@@ -41,7 +41,7 @@ main(int argc, char **argv)
   auto          &a          = p.boundary_conditions.active_node;
   a.selection               = "node id";
   a.node_id                 = 47;
-  a.tip                     = palpate::Parameters::ActiveNode::Tip::sphere;
+  a.tip                     = "sphere";
   a.tip_radius              = 0.0249;
   a.prescribed_displacement = {{0, 0, 0}};
   p.state_space.store       = "";

@@ -124,8 +124,7 @@ main(int argc, char **argv)
         false);
   palpate::Scene tip = shipped_scene("beam.prm");
   tip.parameters.boundary_conditions.active_node.tip_radius = 0.011;
-  tip.parameters.boundary_conditions.active_node.tip =
-    palpate::Parameters::ActiveNode::Tip::glued_nodes;
+  tip.parameters.boundary_conditions.active_node.tip        = "glued nodes";
   check("beam, tip", tip, {{0.004, 0.002, -0.003}}, false);
 
   // A sphere in contact: the stiffness is d(contact resultant)/d(centre),
@@ -137,7 +136,7 @@ main(int argc, char **argv)
     {
       palpate::Scene sphere = shipped_scene("paper-stvk.prm");
       auto          &a      = sphere.parameters.boundary_conditions.active_node;
-      a.tip                 = palpate::Parameters::ActiveNode::Tip::sphere;
+      a.tip                 = "sphere";
       a.tip_radius          = 0.02;
       // The scene's own push (3 cm) is deeper than the sphere's radius, and
       // the sphere would then have to clear liver501's triangles by a

@@ -233,8 +233,7 @@ main(int argc, char **argv)
   // fixed nodes, beyond the depths a radius is offered for (below).
   {
     palpate::Scene liver = shipped_scene("liver-stvk.prm");
-    liver.parameters.boundary_conditions.active_node.tip =
-      palpate::Parameters::ActiveNode::Tip::sphere;
+    liver.parameters.boundary_conditions.active_node.tip        = "sphere";
     liver.parameters.boundary_conditions.active_node.tip_radius = 0.002;
     liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
       0, 0, -0.02};
@@ -474,7 +473,7 @@ main(int argc, char **argv)
   {
     palpate::Scene liver     = shipped_scene("liver-stvk.prm");
     auto          &a         = liver.parameters.boundary_conditions.active_node;
-    a.tip                    = palpate::Parameters::ActiveNode::Tip::sphere;
+    a.tip                    = "sphere";
     a.tip_radius             = 0.001;
     const palpate::Mesh mesh = palpate::Mesh::create(liver);
     const auto          offer = [&](const palpate::Scene &scene) {
@@ -510,7 +509,7 @@ main(int argc, char **argv)
             << ", the tried offer converges "
             << ok(pushed > 0 && converges(pushed, {{0.02, 0, 0}})) << std::endl;
     liver                     = shipped_scene("liver-stvk.prm");
-    a.tip                     = palpate::Parameters::ActiveNode::Tip::sphere;
+    a.tip                     = "sphere";
     a.tip_radius              = 0.001;
     a.prescribed_displacement = {{0, 0, 0}};
     const double at_rest      = offer(liver);

@@ -43,8 +43,7 @@ main(int argc, char **argv)
     {
       p.boundary_conditions.active_node.tip_radius = radius;
       p.boundary_conditions.active_node.tip =
-        radius > 0 ? palpate::Parameters::ActiveNode::Tip::glued_nodes :
-                     palpate::Parameters::ActiveNode::Tip::point;
+        radius > 0 ? "glued nodes" : "point";
       const palpate::NodeSelection nodes =
         palpate::NodeSelection::create(scene, mesh);
       palpate::StateSolver solver(mesh, nodes, p);

@@ -48,7 +48,15 @@ namespace palpate
     double tip_neighbour_distance = 0;
 
     /**
-     * With Tip = sphere: the outward unit normal of the surface where the
+     * Whether the probe's tip is a rigid sphere in frictionless contact
+     * with the surface (ProbeTip::is_sphere()): the solver then solves the
+     * contact instead of moving tip_vertices, and the members below place
+     * the sphere.
+     */
+    bool sphere_tip = false;
+
+    /**
+     * With a sphere tip: the outward unit normal of the surface where the
      * sphere touches it at HIP = 0 (the area-weighted mean over the
      * surface triangles within one radius), and the sphere's centre at
      * HIP = 0 (m). The sphere touches the surface at the point of it
@@ -95,7 +103,7 @@ namespace palpate
            const SphereTrial &trial = SphereTrial());
 
     /**
-     * Ask a sphere tip's checks (Tip = sphere: that it meets the surface
+     * Ask a sphere tip's checks (that it meets the surface
      * nodes, with a margin when pushed deeper than its radius, and is not
      * pushed deeper than the tissue lets it, nor too far towards the fixed
      * nodes) for the push @p push instead of the scene's Prescribed

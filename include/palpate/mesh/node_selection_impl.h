@@ -8,13 +8,16 @@
 // (NodeSelection), shared by its source files, one job each:
 //   node_selection.cc              NodeSelection::create() in order: the
 //                                  fixed nodes, the effects' checks of the
-//                                  mesh, the active node, a glued tip
+//                                  mesh, the active node, the probe tip's
+//                                  place()
 //   node_selection_sphere_fit.cc   where a sphere tip rests, and whether
 //                                  it meets the nodes for the scene's push
 //   node_selection_sphere_offer.cc a sphere that fails its checks: the
 //                                  refusal, and the radius it offers
 //                                  (tried by static solves)
-// Users of node selection include node_selection.h, never this header.
+// The sphere tip (probe_tips/sphere.cc) places itself through
+// place_sphere_tip(). Users of node selection include node_selection.h,
+// never this header.
 
 #include <palpate/base/utilities.h>
 #include <palpate/mesh/node_selection.h>
@@ -125,8 +128,8 @@ namespace palpate
                          NodeSelection &selection);
 
     /**
-     * Place the sphere (Tip = sphere), and check that it is large enough
-     * to meet a node.
+     * Place the sphere (probe_tips/sphere.cc), and check that it is large
+     * enough to meet a node.
      */
     void
     place_sphere_tip(const Scene                      &scene,

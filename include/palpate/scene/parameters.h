@@ -121,19 +121,13 @@ namespace palpate
       long node_id;
       /** Displacement of the active node for a static solve, metres. */
       Point3 prescribed_displacement;
-      /** What touches the organ (`Tip`). */
-      enum class Tip
-      {
-        /** The paper's probe: the active node follows the HIP. */
-        point,
-        /** Every free surface node within Tip radius of the active node is
-         * glued to the probe and follows the HIP. */
-        glued_nodes,
-        /** A rigid sphere of radius Tip radius whose centre follows the
-         * HIP, in frictionless unilateral contact with the surface. */
-        sphere
-      };
-      Tip tip;
+      /** The probe tip plug-in's name (ProbeTipRegistry,
+       * mesh/probe_tip.h): what touches the organ, e.g. "sphere". */
+      std::string tip;
+      /** Each probe tip plug-in's own entries (plug-in name -> its
+       * subsection's values); the built-in tips have none: they read
+       * Tip radius. */
+      std::map<std::string, Plugins::Entries> own;
       /** Radius of the glued tip or of the sphere (m). */
       double tip_radius;
 

@@ -183,12 +183,14 @@ namespace palpate
     /** validate(): each enabled effect plug-in's entries. */
     void
     check_effects() const;
-    /** The own entries of the chosen mesh source, fixed region, device,
-     * trajectory and linear solver plug-ins (Plugins::check_entries). */
+    /** The own entries of the chosen mesh source, fixed region, probe tip,
+     * device, trajectory and linear solver plug-ins
+     * (Plugins::check_entries). */
     void
     check_plugin_entries() const;
 
-    /** validate(): the probe's tip and its radius. */
+    /** validate(): the probe tip's entries, its radius and what it needs
+     * of the scene (Plugins::check_scene()). */
     void
     check_probe() const;
 
