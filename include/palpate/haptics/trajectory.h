@@ -31,7 +31,10 @@ namespace palpate
    *
    * where the class has `static void declare_parameters(ParameterHandler
    * &)` and `static std::unique_ptr<Trajectory> create(const
-   * ParameterHandler &own, const Scene &scene)`.
+   * ParameterHandler &own, const Scene &scene)`, and optionally `static
+   * void check_scene(const Scene &)`, which checks the shared entries it
+   * reads when the scene is read (TrajectoryChecks has those of the
+   * built-in ones: source/haptics/trajectories/, one file each).
    */
   class Trajectory
   {

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Copyright (C) 2026 the palpate authors
+
+// Haptics / Trajectory / Type = straight line: from rest along Direction at
+// Speed for Duration.
+
+#include <palpate/base/plugins.h>
+#include <palpate/haptics/trajectory.h>
+#include <palpate/haptics/trajectory_checks.h>
+#include <palpate/scene/scene.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+namespace palpate
+{
+  namespace
+  {
+    /** The plug-in: no entries of its own; it reads the shared ones. */
+    class StraightLineTrajectory
+    {
+    public:
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {}
+
+      static std::unique_ptr<Trajectory>
+      create(const dealii::ParameterHandler &, const Scene &scene)
+      {
+        const auto &t = scene.parameters.haptics.trajectory;
+        return std::make_unique<StraightLine>(t.direction, t.speed, t.duration);
+      }
+
+      static void
+      check_scene(const Scene &scene)
+      {
+        TrajectoryChecks::check_direction(scene);
+        TrajectoryChecks::check_timing(scene);
+        TrajectoryChecks::check_motion_length(scene);
+      }
+    };
+  } // namespace
+
+  PALPATE_REGISTER_TRAJECTORY(
+    StraightLineTrajectory,
+    "straight line",
+    "a straight line at constant speed along Direction")
+} // namespace palpate
