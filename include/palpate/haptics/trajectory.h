@@ -62,6 +62,17 @@ namespace palpate
     create(const Scene &scene);
   };
 
+  /**
+   * For a trajectory plug-in that reads only the shared entries of
+   * `Haptics / Trajectory`: its (empty) declaration of entries of its own.
+   */
+  struct SharedTrajectoryEntries
+  {
+    static void
+    declare_parameters(dealii::ParameterHandler &)
+    {}
+  };
+
   /** The trajectories, by the names scenes give them. */
   using TrajectoryRegistry = Plugins::Registry<Trajectory, Scene>;
   extern template class Plugins::Registry<Trajectory, Scene>;

@@ -16,15 +16,11 @@ namespace palpate
 {
   namespace
   {
-    /** The plug-in: no entries of its own; it reads File name. Speed and
+    /** The plug-in: it reads only the shared File name. Speed and
      * Duration are the recording's. */
-    class ReplayTrajectory
+    class ReplayTrajectory : public SharedTrajectoryEntries
     {
     public:
-      static void
-      declare_parameters(dealii::ParameterHandler &)
-      {}
-
       static std::unique_ptr<Trajectory>
       create(const dealii::ParameterHandler &, const Scene &scene)
       {

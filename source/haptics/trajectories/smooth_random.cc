@@ -15,14 +15,10 @@ namespace palpate
 {
   namespace
   {
-    /** The plug-in: no entries of its own; it reads the shared ones. */
-    class SmoothRandomTrajectory
+    /** The plug-in: it reads only the shared entries. */
+    class SmoothRandomTrajectory : public SharedTrajectoryEntries
     {
     public:
-      static void
-      declare_parameters(dealii::ParameterHandler &)
-      {}
-
       static std::unique_ptr<Trajectory>
       create(const dealii::ParameterHandler &, const Scene &scene)
       {
