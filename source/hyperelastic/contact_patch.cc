@@ -137,22 +137,36 @@ namespace palpate
 
   void
   contact_patch_nodes(const std::vector<HyperelasticSystem::ContactRow> &rows,
-                      const double                                       reach,
-                      std::vector<unsigned int>                         &nodes,
+                      const double               half_width,
+                      const double               reach,
+                      std::vector<unsigned int> &nodes,
                       std::vector<unsigned int> &unknowns)
   {
     nodes.clear();
     unknowns.clear();
     for (unsigned int k = 0; k < rows.size(); ++k)
-      if (rows[k].gap <= reach && std::any_of(rows[k].eq.begin(),
-                                              rows[k].eq.end(),
-                                              [](int e) { return e >= 0; }))
-        {
-          nodes.push_back(k);
-          for (const int e : rows[k].eq)
-            if (e >= 0)
-              unknowns.push_back(e);
-        }
+      {
+        const auto &r = rows[k];
+        // The node's distance from the box of centres (rho n is its
+        // position from the state's centre): the sphere meets it only
+        // from there, and a ball around the state as wide as the box's
+        // half-diagonal would hold about twice the surface nodes.
+        double d2 = 0;
+        for (unsigned int a = 0; a < 3; ++a)
+          {
+            const double out =
+              std::max(0.0, std::abs(r.rho * r.n[a]) - half_width);
+            d2 += out * out;
+          }
+        if (d2 <= reach * reach &&
+            std::any_of(r.eq.begin(), r.eq.end(), [](int e) { return e >= 0; }))
+          {
+            nodes.push_back(k);
+            for (const int e : r.eq)
+              if (e >= 0)
+                unknowns.push_back(e);
+          }
+      }
   }
 
 

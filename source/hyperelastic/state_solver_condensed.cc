@@ -202,7 +202,8 @@ namespace palpate
         schur_factors = std::make_unique<SchurFactors>(*inverse_block);
       }
     system->contact_rows(x, target, patch_rows);
-    contact_patch_nodes(patch_rows, patch_reach, patch_nodes, patch_unknowns);
+    contact_patch_nodes(
+      patch_rows, grid_spacing, patch_reach, patch_nodes, patch_unknowns);
     if (patch_nodes.empty())
       {
         // No node within reach: the state's patch is the empty one, and

@@ -133,7 +133,9 @@ namespace palpate
 
   /**
    * The nodes a contact patch holds, from the sphere's candidate @p rows
-   * at some unknowns: those whose gap is at most @p reach (m), less any a
+   * at some unknowns: those within @p reach (m) of the box of sphere
+   * centres that the grid cells around the state allow, the state's centre
+   * +- @p half_width (m) in each axis, less any a
    * boundary condition fixes in every direction (its compliance row would
    * be zero and the contact problem singular). Into @p nodes, and their
    * free DoFs in that order into @p unknowns: the block of the compliance
@@ -141,8 +143,9 @@ namespace palpate
    */
   void
   contact_patch_nodes(const std::vector<HyperelasticSystem::ContactRow> &rows,
-                      double                                             reach,
-                      std::vector<unsigned int>                         &nodes,
+                      double                     half_width,
+                      double                     reach,
+                      std::vector<unsigned int> &nodes,
                       std::vector<unsigned int> &unknowns);
 
   /**

@@ -69,12 +69,11 @@ namespace palpate
         settings.compute_stiffness ||
         p.state_space.interpolation == "tricubic Hermite";
       // The patch holds every node the sphere can touch from the cells
-      // around the state (their far corners are sqrt(3) h away), and a
-      // quarter radius more for the surface springing back towards the
-      // sphere when it is lifted.
+      // around the state (its centre within h of the state's in each
+      // axis), and a quarter radius more for the surface springing back
+      // towards the sphere when it is lifted.
       if (p.state_space.interpolation == "contact patch")
-        patch_reach = std::sqrt(3.0) * p.state_space.grid_spacing +
-                      0.25 * p.boundary_conditions.active_node.tip_radius;
+        patch_reach = 1.25 * p.boundary_conditions.active_node.tip_radius;
       grid_spacing     = p.state_space.grid_spacing;
       const auto start = std::chrono::steady_clock::now();
       system           = std::make_unique<HyperelasticSystem>(mesh, nodes, p);
@@ -552,8 +551,8 @@ namespace palpate
     std::vector<int>          schur_slot; // DoF -> row
 
     std::vector<HyperelasticSystem::ContactRow> patch_rows;
-    // With Interpolation = contact patch: how far from the sphere a
-    // patch's nodes may be (m); 0: no patches.
+    // With Interpolation = contact patch: how far a patch's nodes may be
+    // from the box of sphere centres around the state (m); 0: no patches.
     double patch_reach = 0;
     // The grid's spacing (m): where a patch tabulates its model's force.
     double grid_spacing = 0;
