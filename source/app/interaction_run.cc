@@ -389,7 +389,7 @@ namespace palpate
               interaction->nodes().check_sphere_push(scene,
                                                      interaction->mesh(),
                                                      point,
-                                                     sphere_trial(&std::cerr));
+                                                     sphere_sizing(&std::cerr));
             }
           catch (const InputError &e)
             {

@@ -47,7 +47,7 @@ namespace palpate
 
 
 
-  NodeSelection::SphereTrial
+  SphereTrial
   sphere_trial(std::ostream *progress)
   {
     if (progress == nullptr)
@@ -71,13 +71,5 @@ namespace palpate
                 << std::endl;
       return reached;
     };
-  }
-
-
-
-  NodeSelection
-  select_nodes(const Scene &scene, const Mesh &mesh, std::ostream *progress)
-  {
-    return NodeSelection::create(scene, mesh, sphere_trial(progress));
   }
 } // namespace palpate

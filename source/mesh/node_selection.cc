@@ -261,9 +261,9 @@ namespace palpate
 
 
   NodeSelection
-  NodeSelection::create(const Scene       &scene,
-                        const Mesh        &mesh,
-                        const SphereTrial &trial)
+  NodeSelection::create(const Scene        &scene,
+                        const Mesh         &mesh,
+                        const SphereSizing &sizing)
   {
     NodeSelection        selection;
     const FixedSelection region = select_fixed(scene, mesh);
@@ -278,7 +278,8 @@ namespace palpate
     check_active_not_fixed(scene, mesh, region.fixed, selection);
     // The tip puts itself at the active node: the nodes that move with it,
     // or a sphere resting on the surface.
-    ProbeTip::create(scene)->place(scene, mesh, region.fixed, selection, trial);
+    ProbeTip::create(scene)->place(
+      scene, mesh, region.fixed, selection, sizing);
     return selection;
   }
 
@@ -288,7 +289,7 @@ namespace palpate
   NodeSelection::check_sphere_push(const Scene             &scene,
                                    const Mesh              &mesh,
                                    const Utilities::Point3 &push,
-                                   const SphereTrial       &trial) const
+                                   const SphereSizing      &sizing) const
   {
     Scene pushed = scene;
     pushed.parameters.boundary_conditions.active_node.prescribed_displacement =
@@ -297,6 +298,6 @@ namespace palpate
     selection.fixed_vertices   = fixed_vertices;
     selection.fixed_components = fixed_components;
     internal::select_active_vertex(pushed, mesh, selection);
-    internal::place_sphere_tip(pushed, mesh, selection, trial);
+    internal::place_sphere_tip(pushed, mesh, selection, sizing);
   }
 } // namespace palpate

@@ -20,7 +20,7 @@ namespace palpate
                   const Mesh &,
                   const std::set<unsigned int> &,
                   NodeSelection &,
-                  const NodeSelection::SphereTrial &) const
+                  const NodeSelection::SphereSizing &) const
   {}
 
 

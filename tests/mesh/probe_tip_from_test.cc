@@ -89,7 +89,7 @@ namespace
           const palpate::Mesh          &mesh,
           const std::set<unsigned int> &fixed,
           palpate::NodeSelection       &selection,
-          const palpate::NodeSelection::SphereTrial &) const override
+          const palpate::NodeSelection::SphereSizing &) const override
     {
       const auto &x = mesh.vertices();
       for (unsigned int v = 0; v < x.size(); ++v)

@@ -74,19 +74,31 @@ namespace palpate
     /** One line describing how the fixed nodes were chosen. */
     std::string fixed_description;
 
+    /** What a refusal of a sphere's radius names beside the radius, from
+     * the sizing that tried it: the push to name with it ("" for the
+     * scene's own), and what the trials found. */
+    struct TriedOffer
+    {
+      std::string push, why;
+    };
+
     /**
-     * How far a static solve gets with a sphere: for @p scene (its Tip
-     * radius and Prescribed displacement those to try) and the nodes
-     * @p placed for it on @p mesh, the part of the push (0 - 1) reached
-     * by converged increments, 1 if the push converged. The
-     * hyperelastic layer, which can solve, gives one
-     * (hyperelastic/sphere_trial.h); a refusal of a sphere's radius then
-     * offers only a radius (and, if need be, a push) whose solve
-     * converged.
+     * The sizing of a refused sphere by static solves, which only a layer
+     * that can solve gives (hyperelastic/sphere_trial.h): the checks here
+     * are geometric and cannot foresee where the contact Newton stagnates.
+     * Called by the refusal with @p offer, a radius that passes the checks
+     * for @p scene on @p mesh at @p selection's active node, and
+     * @p first_passing, the first radius from r up that passes them. It
+     * sets @p offer to the radius to name (one whose solve converged) and
+     * returns what to name with it, or throws the refusal itself when
+     * nothing it tried converged.
      */
-    using SphereTrial = std::function<double(const Scene         &scene,
-                                             const Mesh          &mesh,
-                                             const NodeSelection &placed)>;
+    using SphereSizing = std::function<TriedOffer(
+      const Scene                         &scene,
+      const Mesh                          &mesh,
+      const NodeSelection                 &selection,
+      double                              &offer,
+      const std::function<double(double)> &first_passing)>;
 
     /**
      * Select the nodes a scene asks for on @p mesh. Throws an InputError,
@@ -95,12 +107,12 @@ namespace palpate
      * could rotate about it), if a node number does not exist, or if the
      * active node is fixed or not on the surface. With a sphere whose
      * radius fails its checks, the radius the refusal offers is tried by
-     * @p trial if one is given.
+     * @p sizing if one is given.
      */
     static NodeSelection
-    create(const Scene       &scene,
-           const Mesh        &mesh,
-           const SphereTrial &trial = SphereTrial());
+    create(const Scene        &scene,
+           const Mesh         &mesh,
+           const SphereSizing &sizing = SphereSizing());
 
     /**
      * Ask a sphere tip's checks (that it meets the surface
@@ -114,7 +126,7 @@ namespace palpate
     check_sphere_push(const Scene             &scene,
                       const Mesh              &mesh,
                       const Utilities::Point3 &push,
-                      const SphereTrial       &trial = SphereTrial()) const;
+                      const SphereSizing &sizing = SphereSizing()) const;
   };
 
 

@@ -14,7 +14,8 @@
 //                                  it meets the nodes for the scene's push
 //   node_selection_sphere_offer.cc a sphere that fails its checks: the
 //                                  refusal, and the radius it offers
-//                                  (tried by static solves)
+//                                  (tried by the SphereSizing a layer
+//                                  that solves gives)
 // The sphere tip (probe_tips/sphere.cc) places itself through
 // place_sphere_tip(). Users of node selection include node_selection.h,
 // never this header.
@@ -132,10 +133,10 @@ namespace palpate
      * enough to meet a node.
      */
     void
-    place_sphere_tip(const Scene                      &scene,
-                     const Mesh                       &mesh,
-                     NodeSelection                    &selection,
-                     const NodeSelection::SphereTrial &trial);
+    place_sphere_tip(const Scene                       &scene,
+                     const Mesh                        &mesh,
+                     NodeSelection                     &selection,
+                     const NodeSelection::SphereSizing &sizing);
   } // namespace internal
 } // namespace palpate
 

@@ -65,15 +65,15 @@ namespace palpate
      * nodes that move with it (tip_vertices; none of the @p fixed ones),
      * or the sphere's placement (sphere_center, active_normal,
      * sphere_lift), checked against the mesh; a sphere whose radius fails
-     * the checks is refused with the radius @p trial found to converge, if
-     * one is given. A point adds nothing: the default.
+     * the checks is refused with the radius @p sizing found to converge,
+     * if one is given. A point adds nothing: the default.
      */
     virtual void
-    place(const Scene                      &scene,
-          const Mesh                       &mesh,
-          const std::set<unsigned int>     &fixed,
-          NodeSelection                    &selection,
-          const NodeSelection::SphereTrial &trial) const;
+    place(const Scene                       &scene,
+          const Mesh                        &mesh,
+          const std::set<unsigned int>      &fixed,
+          NodeSelection                     &selection,
+          const NodeSelection::SphereSizing &sizing) const;
 
     /**
      * The scene report's line about the tip as @p nodes placed it (units

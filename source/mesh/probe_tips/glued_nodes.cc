@@ -51,7 +51,7 @@ namespace palpate
             const Mesh                   &mesh,
             const std::set<unsigned int> &fixed,
             NodeSelection                &selection,
-            const NodeSelection::SphereTrial &) const override
+            const NodeSelection::SphereSizing &) const override
       {
         const auto &x                    = mesh.vertices();
         const auto &surface              = mesh.on_surface();

@@ -53,11 +53,11 @@ namespace palpate
       place(const Scene &scene,
             const Mesh  &mesh,
             const std::set<unsigned int> &,
-            NodeSelection                    &selection,
-            const NodeSelection::SphereTrial &trial) const override
+            NodeSelection                     &selection,
+            const NodeSelection::SphereSizing &sizing) const override
       {
         selection.sphere_tip = true;
-        internal::place_sphere_tip(scene, mesh, selection, trial);
+        internal::place_sphere_tip(scene, mesh, selection, sizing);
       }
 
       /** Where the sphere rests, so that a user can see which way a push
