@@ -92,18 +92,16 @@ namespace palpate
       offer = first_passing(offer);
       // Not the smallest that passes but the first from 10 % above it: the
       // smallest just clears the spacing and can be a failure point where
-      // 1.1 times it converges (liver-stvk.prm, Node id 32, pushed (-2, 0,
-      // -2) cm: 0.0159 m fails; 0.0175, 0.02 and 0.024 m converge).
+      // 1.1 times it converges (doc/formulation.md, "The sphere's checks").
       if (offer <= largest)
         if (const double above =
               first_passing(std::ceil(offer * 1.1 * 1e4) / 1e4);
             above <= largest)
           offer = above;
-      // Tried by a static solve where one can be, so that what is offered
-      // has converged: the checks are geometric and cannot foresee where
-      // the contact Newton stagnates (about 2 % of the offers that pass
-      // them are failure points; at Node id 27 of liver-indenter.prm every
-      // radius from 0.9 to 2 times the offer stagnates at 0.4 of the push).
+      // Tried by the sizing's static solves where a layer that solves gave
+      // one, so that what is offered has converged: the checks are
+      // geometric and cannot foresee where the contact Newton stagnates
+      // (a few offers in a hundred that pass them are failure points).
       const NodeSelection::TriedOffer tried =
         offer <= largest && sizing ?
           sizing(scene, mesh, selection, offer, first_passing) :

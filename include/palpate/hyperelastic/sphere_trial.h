@@ -20,9 +20,8 @@ namespace palpate
    * @p placed for it on @p mesh, the part of the push (0 - 1) reached by
    * converged increments, 1 if the push converged.
    */
-  using SphereTrial = std::function<double(const Scene         &scene,
-                                           const Mesh          &mesh,
-                                           const NodeSelection &placed)>;
+  using SphereTrial = std::function<
+    double(const Scene &scene, const Mesh &mesh, const NodeSelection &placed)>;
 
   /**
    * The SphereTrial of a static solve from rest to @p scene's Prescribed

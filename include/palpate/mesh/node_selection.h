@@ -93,12 +93,12 @@ namespace palpate
      * returns what to name with it, or throws the refusal itself when
      * nothing it tried converged.
      */
-    using SphereSizing = std::function<TriedOffer(
-      const Scene                         &scene,
-      const Mesh                          &mesh,
-      const NodeSelection                 &selection,
-      double                              &offer,
-      const std::function<double(double)> &first_passing)>;
+    using SphereSizing = std::function<
+      TriedOffer(const Scene                         &scene,
+                 const Mesh                          &mesh,
+                 const NodeSelection                 &selection,
+                 double                              &offer,
+                 const std::function<double(double)> &first_passing)>;
 
     /**
      * Select the nodes a scene asks for on @p mesh. Throws an InputError,
@@ -126,7 +126,7 @@ namespace palpate
     check_sphere_push(const Scene             &scene,
                       const Mesh              &mesh,
                       const Utilities::Point3 &push,
-                      const SphereSizing &sizing = SphereSizing()) const;
+                      const SphereSizing      &sizing = SphereSizing()) const;
   };
 
 

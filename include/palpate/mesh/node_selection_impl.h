@@ -33,57 +33,36 @@ namespace palpate
 
   namespace internal
   {
+    // The three constants of the sphere's checks below were measured on the
+    // graded liver of liver-indenter.prm, pushing with the radius each
+    // refusal offers: doc/formulation.md, "The sphere's checks and what
+    // their constants rest on".
+
     /**
-     * How deep a sphere may be pushed, in radii: deeper, the tissue closes
-     * over it, its nodes pass behind it and the state is a failure point.
-     * The depth is the push's component along the surface's inward normal
-     * at the probe: on the graded liver of liver-indenter.prm the first
-     * failures come at 1.68 radii along the normal (a 6.1 mm sphere pushed
-     * 1.1 cm along -z at the Point), and 1.5 stays below them (deeper
-     * than a radius, the sphere must also clear the margin below). A
-     * push's sideways part only slides the frictionless sphere (2 cm along
-     * x, 4.3 mm in, converges at 0.308 N).
-     * Measured with `palpate solve parameters/liver-indenter.prm --to
-     * 0,0,-D` and the radius a refusal offers.
+     * How deep a sphere may be pushed, in radii, along the surface's
+     * inward normal at the probe: deeper, the tissue closes over it, its
+     * nodes pass behind it and the state is a failure point. A push's
+     * sideways part only slides the frictionless sphere, so it does not
+     * count.
      */
     constexpr double deepest_push = 1.5;
 
     /**
      * How many times a sphere pushed deeper than its radius must clear the
-     * node spacing the checks measure. The checks alone are what a sphere
-     * needs to meet the nodes at all (a 1 cm sphere pressed 2 mm between
-     * the beam's 14 mm edges renders Hertz's force); pushed that deep, one
-     * that just passes them still slips between the nodes. On the graded
-     * liver of liver-indenter.prm (edges up to 4.9 mm at Node ids 40 and
-     * 41), spheres clearing the spacing 1.7 and 1.84 times are failure
-     * points at 1.35 and 1.45 radii deep; 2.1 times holds at 1.45 radii,
-     * and larger spheres at 1.54. Dragged along the surface the sphere
-     * needs the margin from half a radius deep (margin_at()): a 4.2 mm
-     * sphere clearing the spacing once, dragged 2 cm at 0.94 radii deep,
-     * goes through the surface at Node id 37, while a 1 cm sphere 0.43
-     * radii deep converges (0.308 N).
-     * Measured with `palpate solve parameters/liver-indenter.prm`, pushes
-     * along the inward normal.
+     * node spacing the checks measure (from half a radius deep when
+     * dragged along the surface): one that just clears it meets the nodes
+     * when pressed, but slips between them when pushed that deep.
      */
     constexpr double margin = 2.2;
 
     /**
      * How far towards the fixed nodes a refusal still offers a radius, as
      * a part of the distance from the active node to the nearest of them.
-     * Deeper, the radius the checks find (at least the depth over 1.5)
-     * makes a contact patch so large that Newton stagnates as it grows, or
-     * the tissue is squeezed against the fixed nodes. On the graded liver
-     * of liver-indenter.prm, pushed with the radius each refusal offers,
-     * every push to 0.25 of the way converges (8 sites, 3 supports; and
-     * liver-stvk.prm's 3 cm, 0.255), and failure points begin at 0.26:
-     * 0.22 keeps a margin below them. Such a push asks 5 - 8 N there,
-     * about what a haptic device renders (deeper, 15 - 60 N). A radius of
-     * the user's own that passes the checks is not refused deeper: a 1 cm
-     * sphere pushed 1 cm into the beam, half the way to its fixed end,
-     * converges (the indenter tests), and a deeper push's failure point
-     * says where it failed.
-     * Measured 2026-11-27 (commit 6e87ee9; the table of every push is in
-     * that day's change note in git history, CHANGELOG.md has the rule).
+     * Deeper, the radius the checks find (at least the depth over
+     * deepest_push) makes a contact patch so large that Newton stagnates
+     * as it grows, or the tissue is squeezed against the fixed nodes. A
+     * radius of the user's own that passes the checks is not refused
+     * deeper: a deeper push's failure point says where it failed.
      */
     constexpr double towards_support = 0.22;
 
