@@ -247,7 +247,7 @@ namespace palpate
     }
 
     /** force(), a step: forget the contact, the hold and what the
-     * interpolation kept, as reset_contact() asked (a new interaction
+     * interpolation kept, as attach() asked (a new interaction
      * starts). */
     void
     apply_reset() noexcept

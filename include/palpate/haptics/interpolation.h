@@ -76,7 +76,7 @@ namespace palpate
                         std::array<double, 9>   &stiffness) noexcept;
 
     /**
-     * A new contact starts (Interaction::reset_contact()): forget what
+     * A new contact starts (Interaction::attach()): forget what
      * earlier ticks kept. Real-time safe; the default keeps nothing.
      */
     virtual void
