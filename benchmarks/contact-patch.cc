@@ -752,20 +752,20 @@ namespace
                   << grid_point_error << "\n";
         // Trilinear and Hermite: the force at each sample, as the haptic
         // loop interpolates it (no state of its own).
-        for (const Interpolation scheme :
-             {Interpolation::trilinear, Interpolation::hermite})
+        for (const auto &[scheme, interpolate] :
+             {std::pair<const char *, InterpolateFunction>{"trilinear",
+                                                           &interpolate_force},
+              {"hermite", &interpolate_hermite}})
           {
             Row row;
-            row.body = body;
-            row.interpolation =
-              scheme == Interpolation::trilinear ? "trilinear" : "hermite";
+            row.body          = body;
+            row.interpolation = scheme;
             row.spacing_mm    = 1e3 * h;
             row.states_per_cm = path_corners.size() / path_cm;
             std::vector<double> err;
             for (std::size_t i = 0; i < samples.size(); ++i)
               {
-                const ForceSample s =
-                  interpolate_force(grid, cache, samples[i], scheme);
+                const ForceSample s = interpolate(grid, cache, samples[i]);
                 if (!s.complete)
                   {
                     ++row.uncovered;

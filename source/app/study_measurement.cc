@@ -259,6 +259,30 @@ namespace palpate
           100 * *std::max_element(relative.begin(), relative.end());
       }
 
+      /** An interpolation the study measures: its row's name, the kernel
+       * that interpolates the forces, whether its states need their
+       * stiffness (its state time counts it) and whether the contact
+       * patches then give the force. */
+      struct Scheme
+      {
+        const char         *name;
+        InterpolateFunction interpolate;
+        bool                stiffness, patch;
+      };
+
+      /** The interpolations measured: trilinear and Hermite, and with a
+       * sphere (@p sphere) the contact patch. */
+      std::vector<Scheme>
+      schemes(const bool sphere)
+      {
+        std::vector<Scheme> all = {
+          {"trilinear", &interpolate_force, false, false},
+          {"Hermite", &interpolate_hermite, true, false}};
+        if (sphere)
+          all.push_back({"contact patch", &interpolate_force, false, true});
+        return all;
+      }
+
       /**
        * The force the haptic loop renders at @p x with Interpolation =
        * contact patch, into @p sample (whose cell is complete): the blend of
@@ -413,18 +437,13 @@ namespace palpate
       const std::vector<double> shape =
         shape_errors(grid, g, positions, reference, node_of_dof);
 
-      std::vector<std::pair<Interpolation, bool>> schemes = {
-        {Interpolation::trilinear, false}, {Interpolation::hermite, false}};
-      if (sphere)
-        schemes.emplace_back(Interpolation::trilinear, true);
-      for (const auto &[scheme, patch] : schemes)
+      for (const Scheme &scheme : schemes(sphere))
         {
-          StudyRow row;
+          const bool patch = scheme.patch;
+          StudyRow   row;
           row.knob               = knob;
           row.value              = value;
-          row.interpolation      = patch ? "contact patch" :
-                                   scheme == Interpolation::hermite ? "Hermite" :
-                                                                      "trilinear";
+          row.interpolation      = scheme.name;
           row.h_mm               = grid.spacing() * 1000;
           row.residual_tolerance = p.nonlinear_solver.residual_tolerance;
           row.max_increment      = p.nonlinear_solver.max_increment_length;
@@ -435,8 +454,7 @@ namespace palpate
               if (!reference[k].ok)
                 continue;
               ++row.samples;
-              ForceSample s =
-                interpolate_force(grid, cache, positions[k], scheme);
+              ForceSample s = scheme.interpolate(grid, cache, positions[k]);
               if (s.complete && patch)
                 s.complete = patch_force(g, positions[k], contact, s);
               if (!s.complete)
@@ -451,8 +469,7 @@ namespace palpate
             row.shape_err_mm =
               1000 * *std::max_element(shape.begin(), shape.end());
           row.state_ms =
-            1000 *
-            percentile(scheme == Interpolation::hermite ? with : plain, 0.5);
+            1000 * percentile(scheme.stiffness ? with : plain, 0.5);
           row.states            = g.times.size();
           row.failures          = g.failed.size();
           row.states_per_cm     = per_cm;

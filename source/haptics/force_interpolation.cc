@@ -102,6 +102,9 @@ namespace palpate
     // others may still be on their way.
     const auto          path       = simplex_corners(sample.local);
     const std::uint64_t generation = cache.generation();
+    sample.read                    = 0;
+    for (const unsigned int k : path)
+      sample.read |= 1u << k;
     for (const unsigned int k : path)
       if (cache.read_force(sample.corners[k],
                            generation,
@@ -134,16 +137,6 @@ namespace palpate
 
 
 
-  Interpolation
-  interpolation_from_name(const std::string &name)
-  {
-    return name == "tricubic Hermite" ? Interpolation::hermite :
-           name == "contact patch"    ? Interpolation::contact_patch :
-                                        Interpolation::trilinear;
-  }
-
-
-
   namespace
   {
     /** The 1-D cubic Hermite basis on [0, 1] and its derivative:
@@ -171,15 +164,10 @@ namespace palpate
 
 
   ForceSample
-  interpolate_force(const StateGrid         &grid,
-                    const StateCache        &cache,
-                    const Utilities::Point3 &x,
-                    const Interpolation      scheme) noexcept
+  interpolate_hermite(const StateGrid         &grid,
+                      const StateCache        &cache,
+                      const Utilities::Point3 &x) noexcept
   {
-    if (scheme == Interpolation::contact_patch)
-      return interpolate_on_tetrahedron(grid, cache, x);
-    if (scheme != Interpolation::hermite)
-      return interpolate_force(grid, cache, x);
     ForceSample sample;
     if (!locate(grid, x, sample))
       return sample;

@@ -124,8 +124,8 @@ namespace palpate
     const double dt     = s.tick();
     const bool   finite = s.track(position, dt);
 
-    // Interpolation from the 8 corners (and, for Hermite, their
-    // neighbours' stiffnesses), if all corners are there.
+    // The interpolation's force (State space / Interpolation), if the
+    // corners it reads are there.
     const bool  attached = s.is_attached.load(std::memory_order_relaxed);
     ForceSample sample;
     if (attached && finite)
@@ -189,11 +189,12 @@ namespace palpate
             render      = true;
             s.stiffness = s.hold.stiffness_matrix(position);
           }
-        // With contact patches the last complete cell's patches answer
-        // instead of the spring or the fade: the tissue there as last
-        // known, zero off its surface. Still an event of its kind.
-        if (s.patch_contact && s.in_contact && finite &&
-            s.render_last_patches(position, target, s.stiffness))
+        // An interpolation that kept the last complete cell's data (the
+        // contact patch: its patches) answers instead of the spring or the
+        // fade: the tissue there as last known, zero off its surface.
+        // Still an event of its kind.
+        if (s.in_contact && finite &&
+            s.interpolation->force_while_missing(position, target, s.stiffness))
           render = true;
         s.count_missing(cause, held, position, finite, dt);
       }

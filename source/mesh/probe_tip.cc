@@ -66,25 +66,6 @@ namespace palpate
 
 
   void
-  ProbeTip::check_any_tip(const Scene &scene)
-  {
-    const auto &p = scene.parameters;
-    // The contact patch is a sphere's contact solved against each state's
-    // surface: a tip that moves nodes has no such contact to render.
-    if (p.state_space.interpolation == "contact patch" &&
-        !create(scene)->is_sphere())
-      throw scene.error("State space/Interpolation",
-                        "contact patch solves the contact of a sphere against "
-                        "each state's surface, but Boundary conditions / "
-                        "Active node / Tip is not sphere",
-                        "set Tip = sphere with a Tip radius, or Interpolation "
-                        "= tricubic Hermite.",
-                        {"Boundary conditions/Active node/Tip"});
-  }
-
-
-
-  void
   ProbeTip::check_radius(const Scene &scene, const std::string &what)
   {
     using namespace Limits;

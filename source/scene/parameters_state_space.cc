@@ -6,9 +6,7 @@
 // (the cloud of states kept around the HIP) and Engine (who computes
 // states), each declared with its help text and read back into its struct.
 
-#include <palpate/scene/parameters.h>
-
-#include <deal.II/base/parameter_handler.h>
+#include <palpate/scene/parameters_impl.h>
 
 namespace palpate
 {
@@ -33,25 +31,16 @@ namespace palpate
                           Patterns::Double(0.),
                           "Half-width of the grid along each axis, centred "
                           "on the active node's rest position (m).");
-        prm.declare_entry(
+        // The interpolations are plug-ins (haptics/interpolation.h): the
+        // choice and each one's own subsection come from their
+        // declarations.
+        internal::declare_plugin_choice(
+          prm,
+          "interpolation",
           "Interpolation",
           "trilinear",
-          Patterns::Selection("trilinear|tricubic Hermite|contact patch"),
-          "How the haptic loop interpolates the force between grid points. "
-          "trilinear: the paper's, from the 8 corners' forces; continuous, "
-          "but the stiffness the hand feels jumps at every cell face. "
-          "tricubic Hermite: from the corners' forces and active-node "
-          "stiffnesses (three extra solves per state with the kept "
-          "factorisation) and the neighbours' stiffnesses; the force and "
-          "the stiffness are continuous, so a coarser grid gives the same "
-          "accuracy (doc/accuracy-vs-time.md). "
-          "contact patch (Tip = sphere): each state also keeps the "
-          "compliance of the surface nodes the sphere can touch from the "
-          "cells around it (one solve per node with the state's "
-          "factorisation), and the haptic loop solves the sphere's contact "
-          "against the corners' patches at every tick, for the sphere where "
-          "the hand is: zero force off the surface, the tissue's onset "
-          "between the states (doc/formulation.md).");
+          "How the haptic loop interpolates the force between grid points.",
+          "");
         prm.declare_entry(
           "Store",
           "",
@@ -77,9 +66,21 @@ namespace palpate
         grid_spacing  = prm.get_double("Grid spacing");
         extent        = prm.get_double("Extent");
         interpolation = prm.get("Interpolation");
+        own           = internal::own_entries(prm, "interpolation");
         store         = prm.get("Store");
       }
       prm.leave_subsection();
+    }
+
+
+
+    Plugins::StateContents
+    StateSpace::state_contents() const
+    {
+      const auto *plugin =
+        Plugins::find_declaration("interpolation", interpolation);
+      return plugin == nullptr ? Plugins::StateContents() :
+                                 plugin->state_contents;
     }
 
 
@@ -156,9 +157,9 @@ namespace palpate
           "their contact patches included; with Type = mpi, on each "
           "server and on the client (the states its shape output fetched, "
           "the contact patches the results carry). Beyond it, the states farthest from the HIP are "
-          "dropped with their patches; their forces stay (with "
-          "Interpolation = contact patch, a cell with such a corner is "
-          "interpolated trilinearly).");
+          "dropped with their patches; their forces stay (an interpolation "
+          "that renders the contact patches renders a cell with such a "
+          "corner from the corners' forces alone).");
         // At most an hour: the servers end only when the client (rank 0)
         // has been silent this long, so with 1e308 those of a killed
         // client would run on for good.

@@ -190,6 +190,7 @@ namespace palpate
     check_effects();
     check_plugin_entries();
     check_probe();
+    check_interpolation();
     check_mesh();
     check_fixed_nodes();
     check_solver_tolerances();

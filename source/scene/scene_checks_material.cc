@@ -4,10 +4,10 @@
 // The checks of a scene's material and plug-ins (Scene::validate()): the
 // material plug-in's constants (its own checks, then what they must satisfy
 // in the scene: check_material_scene()), the enabled effects' entries and
-// the own entries of the chosen probe tip, device, trajectory and linear
-// solver; and Scene::displacement_degree(), the degree of the displacements
-// that the element pair fixes. Each plug-in is reached through its Declaration
-// (Plugins::declarations()), not its interface.
+// the own entries of the chosen probe tip, interpolation, device,
+// trajectory and linear solver; and Scene::displacement_degree(), the degree of
+// the displacements that the element pair fixes. Each plug-in is reached
+// through its Declaration (Plugins::declarations()), not its interface.
 
 #include <palpate/scene/scene_impl.h>
 
@@ -113,6 +113,10 @@ namespace palpate
           "Boundary conditions/Active node",
           p.boundary_conditions.active_node.tip,
           p.boundary_conditions.active_node.own);
+    check("interpolation",
+          "State space",
+          p.state_space.interpolation,
+          p.state_space.own);
     check("device", "Haptics", p.haptics.device, p.haptics.own);
     check("trajectory",
           "Haptics/Trajectory",

@@ -185,6 +185,20 @@ namespace palpate
 
 
   void
+  Scene::check_interpolation() const
+  {
+    // The interpolation checks what it needs of the rest of the scene
+    // (haptics/interpolations/: a contact patch needs a sphere to render).
+    // Right after the probe's checks: what it asks of the tip is asked of
+    // a tip whose own entries hold.
+    Plugins::check_scene("interpolation",
+                         parameters.state_space.interpolation,
+                         *this);
+  }
+
+
+
+  void
   Scene::check_state_space() const
   {
     using namespace Limits;

@@ -116,14 +116,14 @@ namespace palpate
         e += "; density " + exact(p.material_model.density);
       f.fields.emplace_back("load effects", e.empty() ? "none" : e);
     }
-    // A store of states without their patches cannot serve Interpolation
-    // = contact patch (its cells would render without them), nor the
-    // reverse be told apart by the states alone.
+    // A store of states without their patches cannot serve an
+    // interpolation that renders them (its cells would render without
+    // them), nor the reverse be told apart by the states alone.
     // Layout 2: each patch with its model's force at the neighbours
     // (ContactPatch::neighbour_force); a store of layout 1 is another
     // store.
     f.fields.emplace_back("contact patches",
-                          p.state_space.interpolation == "contact patch" ?
+                          p.state_space.state_contents().contact_patch ?
                             "kept (layout 2)" :
                             "none");
     f.fields.emplace_back("palpate version", PALPATE_VERSION);

@@ -31,7 +31,6 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
   initlog();
-  using palpate::Interpolation;
   using palpate::Utilities::Point3;
 
   palpate::Scene scene        = small_beam_scene();
@@ -60,9 +59,8 @@ main(int argc, char **argv)
           << std::endl;
 
   // Settle the rate-limited force at the point.
-  const Point3 f = settled_force(interaction, inside);
-  const auto   sample =
-    palpate::interpolate_force(grid, cache, inside, Interpolation::hermite);
+  const Point3 f      = settled_force(interaction, inside);
+  const auto   sample = palpate::interpolate_hermite(grid, cache, inside);
   deallog << "cell interpolated by Hermite: " << ok(sample.hermite)
           << "; settled force = the Hermite interpolant: "
           << ok(palpate::Utilities::distance(f, sample.force) <=
@@ -79,10 +77,8 @@ main(int argc, char **argv)
       Point3 a = inside, b = inside;
       a[j] += e;
       b[j] -= e;
-      const auto fa =
-        palpate::interpolate_force(grid, cache, a, Interpolation::hermite);
-      const auto fb =
-        palpate::interpolate_force(grid, cache, b, Interpolation::hermite);
+      const auto fa = palpate::interpolate_hermite(grid, cache, a);
+      const auto fb = palpate::interpolate_hermite(grid, cache, b);
       for (unsigned int i = 0; i < 3; ++i)
         diff = std::max(diff,
                         std::abs(K[3 * i + j] +
@@ -92,15 +88,9 @@ main(int argc, char **argv)
           << ok(size > 0 && diff <= 1e-5 * size) << std::endl;
 
   // Across the face x = 0.
-  const auto jump = [&](const Interpolation scheme) {
-    const auto a = palpate::interpolate_force(grid,
-                                              cache,
-                                              {{-1e-6, -0.0003, -0.0011}},
-                                              scheme);
-    const auto b = palpate::interpolate_force(grid,
-                                              cache,
-                                              {{1e-6, -0.0003, -0.0011}},
-                                              scheme);
+  const auto jump = [&](const palpate::InterpolateFunction interpolate) {
+    const auto a = interpolate(grid, cache, {{-1e-6, -0.0003, -0.0011}});
+    const auto b = interpolate(grid, cache, {{1e-6, -0.0003, -0.0011}});
     double     j = 0, s = 0;
     for (unsigned int i = 0; i < 9; ++i)
       {
@@ -110,9 +100,10 @@ main(int argc, char **argv)
     return j / s;
   };
   deallog << "across a cell face the stiffness is continuous with Hermite: "
-          << ok(jump(Interpolation::hermite) < 1e-3)
+          << ok(jump(&palpate::interpolate_hermite) < 1e-3)
           << "; trilinear's jumps more: "
-          << ok(jump(Interpolation::trilinear) >= jump(Interpolation::hermite))
+          << ok(jump(&palpate::interpolate_force) >=
+                jump(&palpate::interpolate_hermite))
           << std::endl;
   interaction.detach();
 }

@@ -87,8 +87,7 @@ main(int argc, char **argv)
             << ok(largest > 0 && worst <= 1e-6 * largest) << std::endl;
 
     pressed_force     = settled_force(interaction, inside);
-    const auto sample = palpate::interpolate_force(
-      grid, cache, inside, palpate::Interpolation::trilinear);
+    const auto sample = palpate::interpolate_force(grid, cache, inside);
     deallog << "1.1 mm in: the force is the blend of its cell: "
             << ok(palpate::Utilities::distance(pressed_force, sample.force) <=
                   1e-12 * palpate::Utilities::norm(pressed_force))

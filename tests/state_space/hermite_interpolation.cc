@@ -31,6 +31,25 @@ namespace
   using palpate::Utilities::Point3;
   using Field = std::function<void(const Point3 &, Point3 &, double[9])>;
 
+  /** The two interpolations compared. */
+  enum class Scheme
+  {
+    hermite,
+    trilinear
+  };
+
+  /** The force at @p x by @p scheme. */
+  palpate::ForceSample
+  interpolate(const palpate::StateGrid  &grid,
+              const palpate::StateCache &cache,
+              const Point3              &x,
+              const Scheme               scheme)
+  {
+    return scheme == Scheme::hermite ?
+             palpate::interpolate_hermite(grid, cache, x) :
+             palpate::interpolate_force(grid, cache, x);
+  }
+
   /** A force field of total degree 3 (every monomial, random
    * coefficients), and its stiffness K = -df/dx, in units of 1 cm. */
   Field
@@ -121,12 +140,12 @@ namespace
    * stiffness (relative to the largest stiffness) at @p n random points
    * within @p radius of the origin. */
   std::pair<double, double>
-  errors(const palpate::StateGrid    &grid,
-         const palpate::StateCache   &cache,
-         const Field                 &field,
-         const palpate::Interpolation scheme,
-         const double                 radius,
-         const unsigned int           n = 2000)
+  errors(const palpate::StateGrid  &grid,
+         const palpate::StateCache &cache,
+         const Field               &field,
+         const Scheme               scheme,
+         const double               radius,
+         const unsigned int         n = 2000)
   {
     std::mt19937                           rng(7);
     std::uniform_real_distribution<double> u(-radius, radius);
@@ -137,7 +156,7 @@ namespace
         Point3       f;
         double       K[9];
         field(x, f, K);
-        const auto s = palpate::interpolate_force(grid, cache, x, scheme);
+        const auto s = interpolate(grid, cache, x, scheme);
         if (!s.complete)
           return {-1, -1};
         for (unsigned int i = 0; i < 3; ++i)
@@ -158,10 +177,10 @@ namespace
    * and z = -5 mm at 200 random points each, @p d either side of the face
    * (relative to the largest force / stiffness seen). */
   std::pair<double, double>
-  jumps(const palpate::StateGrid    &grid,
-        const palpate::StateCache   &cache,
-        const palpate::Interpolation scheme,
-        const double                 d)
+  jumps(const palpate::StateGrid  &grid,
+        const palpate::StateCache &cache,
+        const Scheme               scheme,
+        const double               d)
   {
     std::mt19937                           rng(11);
     std::uniform_real_distribution<double> u(-0.009, 0.009);
@@ -174,8 +193,8 @@ namespace
           Point3 b = a;
           a[axis] -= d;
           b[axis] += d;
-          const auto sa = palpate::interpolate_force(grid, cache, a, scheme);
-          const auto sb = palpate::interpolate_force(grid, cache, b, scheme);
+          const auto sa = interpolate(grid, cache, a, scheme);
+          const auto sb = interpolate(grid, cache, b, scheme);
           if (!sa.complete || !sb.complete)
             return {-1, -1};
           for (unsigned int i = 0; i < 3; ++i)
@@ -193,10 +212,9 @@ namespace
   }
 
   std::string
-  name(const palpate::Interpolation scheme)
+  name(const Scheme scheme)
   {
-    return scheme == palpate::Interpolation::hermite ? "Hermite  " :
-                                                       "trilinear";
+    return scheme == Scheme::hermite ? "Hermite  " : "trilinear";
   }
 } // namespace
 
@@ -205,7 +223,6 @@ main(int argc, char **argv)
 {
   palpate::Environment env(argc, argv);
   initlog();
-  using palpate::Interpolation;
 
   // Cubic fields: 5 mm grid of +-20 mm; points within 14 mm have all
   // neighbours of their cells.
@@ -215,8 +232,7 @@ main(int argc, char **argv)
       palpate::StateCache      cache(grid, 1 << 30);
       const Field              field = cubic(seed);
       fill(grid, cache, field);
-      for (const auto scheme :
-           {Interpolation::hermite, Interpolation::trilinear})
+      for (const auto scheme : {Scheme::hermite, Scheme::trilinear})
         {
           const auto [ef, ek] = errors(grid, cache, field, scheme, 0.014);
           deallog << "cubic field " << seed << ", " << name(scheme)
@@ -238,8 +254,7 @@ main(int argc, char **argv)
           std::abs(g[0]) <= 2 && std::abs(g[1]) <= 2 && std::abs(g[2]) <= 2;
         return holes && !near && p % 3 == 0;
       });
-      for (const auto scheme :
-           {Interpolation::hermite, Interpolation::trilinear})
+      for (const auto scheme : {Scheme::hermite, Scheme::trilinear})
         {
           const auto [f1, k1] = jumps(grid, cache, scheme, 1e-7);
           const auto [f2, k2] = jumps(grid, cache, scheme, 1e-9);
@@ -252,7 +267,7 @@ main(int argc, char **argv)
     }
 
   // Order of accuracy on the smooth field: h = 5, 2.5, 1.25 mm.
-  for (const auto scheme : {Interpolation::hermite, Interpolation::trilinear})
+  for (const auto scheme : {Scheme::hermite, Scheme::trilinear})
     {
       std::vector<double> e;
       for (const double h : {0.005, 0.0025, 0.00125})
@@ -264,19 +279,19 @@ main(int argc, char **argv)
         }
       const double rate = std::log2(e[1] / e[2]);
       deallog << name(scheme) << ": force error falls as h^"
-              << (scheme == Interpolation::hermite ?
+              << (scheme == Scheme::hermite ?
                     (rate > 3.5 ? "4" : "? (" + std::to_string(rate) + ")") :
                     (rate > 1.7 && rate < 2.3 ?
                        "2" :
                        "? (" + std::to_string(rate) + ")"))
               << "; error at h = 5 mm below trilinear's at 2.5 mm: ";
-      if (scheme == Interpolation::hermite)
+      if (scheme == Scheme::hermite)
         {
           const palpate::StateGrid grid(0.0025, 0.02);
           palpate::StateCache      cache(grid, 1 << 30);
           fill(grid, cache, smooth);
           const double trilinear =
-            errors(grid, cache, smooth, Interpolation::trilinear, 0.012).first;
+            errors(grid, cache, smooth, Scheme::trilinear, 0.012).first;
           deallog << ok(e[0] < trilinear) << std::endl;
         }
       else
@@ -291,14 +306,10 @@ main(int argc, char **argv)
     fill(grid, cache, smooth, nullptr, [&](const unsigned int p) {
       return p != origin;
     });
-    const auto a = palpate::interpolate_force(grid,
-                                              cache,
-                                              {{0.001, 0.002, 0.003}},
-                                              Interpolation::hermite);
-    const auto b = palpate::interpolate_force(grid,
-                                              cache,
-                                              {{0.006, 0.002, 0.003}},
-                                              Interpolation::hermite);
+    const auto a =
+      palpate::interpolate_hermite(grid, cache, {{0.001, 0.002, 0.003}});
+    const auto b =
+      palpate::interpolate_hermite(grid, cache, {{0.006, 0.002, 0.003}});
     deallog << "a cell with a corner without stiffness is trilinear: "
             << ok(a.complete && !a.hermite)
             << "; its neighbour is Hermite: " << ok(b.complete && b.hermite)

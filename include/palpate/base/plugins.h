@@ -62,6 +62,25 @@ namespace palpate
     /** The declarations of one plug-in's entries, as its own subsection. */
     using DeclareFunction = void (*)(dealii::ParameterHandler &prm);
 
+    /**
+     * What each precomputed state keeps besides its force and displacement
+     * field, because the interpolation that renders the states reads it:
+     * an interpolation plug-in declares it (haptics/interpolation.h). The
+     * solver that computes the states and the store that keeps them sit
+     * below the haptic side, so they read it from the Declaration
+     * (Parameters::StateSpace::state_contents()), never from the
+     * interpolation's name.
+     */
+    struct StateContents
+    {
+      /** The active node's stiffness K = -df/dx: three more solves per
+       * state with its kept factorisation. */
+      bool stiffness = false;
+      /** The contact patch: the compliance of the surface nodes a sphere
+       * can touch from the cells around the state, one solve per node. */
+      bool contact_patch = false;
+    };
+
     template <typename Class>
     constexpr auto
     has_check(int) -> decltype(&Class::check_parameters, bool())
@@ -112,6 +131,9 @@ namespace palpate
        * decides); nullptr for the other kinds. */
       unsigned int (*element_degree)(const dealii::ParameterHandler &own) =
         nullptr;
+      /** For an interpolation: what each state keeps for it; nothing for
+       * the other kinds. */
+      StateContents state_contents = {};
     };
 
     /** A plug-in class's `static void check_parameters(const

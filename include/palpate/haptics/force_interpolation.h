@@ -10,7 +10,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <string>
 
 namespace palpate
 {
@@ -29,25 +28,6 @@ namespace palpate
     /** The position is outside the state space (or not finite). */
     outside = 3
   };
-
-  /** How forces are interpolated between grid points. */
-  enum class Interpolation : std::uint8_t
-  {
-    /** The paper's: the 8 corners' forces, trilinear (C0: the stiffness
-     * jumps at every cell face). */
-    trilinear,
-    /** Tricubic Hermite (C1): the 8 corners' forces, their active-node
-     * stiffnesses and cross derivatives from the neighbours' stiffnesses. */
-    hermite,
-    /** The sphere's contact solved against the contact patches of the 4
-     * corners of the HIP's tetrahedron in its cell, for the actual HIP
-     * (PatchContact); complete once those 4 are computed. */
-    contact_patch
-  };
-
-  /** The Interpolation named by a `State space / Interpolation` entry. */
-  Interpolation
-  interpolation_from_name(const std::string &name);
 
   /** What the interpolation found for one position. */
   struct ForceSample
@@ -78,6 +58,10 @@ namespace palpate
     unsigned int hits = 0;
     /** The corners' grid numbers (valid if hits > 0 or complete). */
     std::array<unsigned int, 8> corners = {};
+    /** The corners the interpolation reads (bit k: corners[k]): all 8, or
+     * the 4 of the position's tetrahedron. The haptic loop counts them as
+     * read, and as used once the sample is complete. */
+    std::uint8_t read = 0xff;
     /** Whether the force is tricubic Hermite (Hermite asked for and every
      * corner had its stiffness); else trilinear. */
     bool hermite = false;
@@ -86,6 +70,13 @@ namespace palpate
      * local model between ticks. */
     std::array<double, 9> stiffness = {};
   };
+
+  /** One of the interpolations below: the force at a position from the
+   * states in a cache. */
+  using InterpolateFunction =
+    ForceSample (*)(const StateGrid &,
+                    const StateCache &,
+                    const Utilities::Point3 &) noexcept;
 
   /**
    * The force at @p x: trilinear interpolation of the cached forces at the
@@ -98,7 +89,7 @@ namespace palpate
                     const Utilities::Point3 &x) noexcept;
 
   /**
-   * The force at @p x by @p scheme. Tricubic Hermite is the tensor product
+   * The force at @p x, tricubic Hermite: the tensor product
    * of 1-D cubic Hermite interpolation: at each corner it takes the force,
    * its first derivatives (minus the corner's active-node stiffness) and
    * the cross derivatives d2f/dxdy, d2f/dxdz, d2f/dydz, d3f/dxdydz that
@@ -109,21 +100,20 @@ namespace palpate
    * any force field of total degree 3 exactly. A cell with a corner that
    * has no stiffness is interpolated trilinearly (sample.hermite false).
    * Real-time safe: 16 lock-free reads, about 300 flops, no allocation.
-   * Interpolation::contact_patch: interpolate_on_tetrahedron().
    */
   ForceSample
-  interpolate_force(const StateGrid         &grid,
-                    const StateCache        &cache,
-                    const Utilities::Point3 &x,
-                    const Interpolation      scheme) noexcept;
+  interpolate_hermite(const StateGrid         &grid,
+                      const StateCache        &cache,
+                      const Utilities::Point3 &x) noexcept;
 
   /**
    * The force at @p x linear on the tetrahedron of its cell's Kuhn
    * triangulation that holds it (simplex_weights()), from the forces of
    * its 4 corners: complete once those are computed, whatever the cell's
-   * other corners. What Interpolation::contact_patch starts from (its
-   * patches then give the force, PatchContact) and falls back to where a
-   * corner's patch was dropped. Real-time safe: 4 lock-free reads.
+   * other corners (sample.read names them). What the contact patch
+   * interpolation starts from (its patches then give the force,
+   * PatchContact) and falls back to where a corner's patch was dropped.
+   * Real-time safe: 4 lock-free reads.
    */
   ForceSample
   interpolate_on_tetrahedron(const StateGrid         &grid,

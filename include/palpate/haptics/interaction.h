@@ -42,17 +42,17 @@ namespace palpate
    * Positions are displacements of the active node from its rest position
    * (m, in the mesh's frame; a host maps its device frame onto it); forces
    * are what the device should render (N): the interpolation (State space
-   * / Interpolation: trilinear, or tricubic Hermite from the corners'
-   * stiffnesses too) of the states at the 8 corners of the position's
-   * grid cell, clamped to
+   * / Interpolation, a plug-in: haptics/interpolation.h) of the states at
+   * the corners of the position's grid cell, clamped to
    * Haptics / Force limit and changing by at most Haptics / Maximum force
    * change per call. Where a corner is missing (not computed yet, a failure
    * point, outside the grid, detached) the force fades to zero at that
    * rate, or is held (a failure region, outside the grid: ForceHold), and
-   * the event is counted and reported (poll_events(), summary()). With
-   * Interpolation = contact patch the last complete cell's contact patches
-   * answer instead, wherever data are missing while in contact: the sphere
-   * against the surface and compliance last known there, zero off it.
+   * the event is counted and reported (poll_events(), summary()). An
+   * interpolation that keeps the last complete cell's data answers
+   * instead, wherever data are missing while in contact (contact patch:
+   * the sphere against the surface and compliance last known there, zero
+   * off it).
    *
    * force() may be called from exactly one thread at a time. It never
    * blocks, never allocates and never returns NaN. Everything else is for

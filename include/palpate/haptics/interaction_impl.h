@@ -18,7 +18,7 @@
 #include <palpate/engine/hip_channel.h>
 #include <palpate/haptics/force_interpolation.h>
 #include <palpate/haptics/interaction.h>
-#include <palpate/hyperelastic/patch_contact.h>
+#include <palpate/haptics/interpolation.h>
 #include <palpate/hyperelastic/sphere_trial.h>
 #include <palpate/hyperelastic/state.h>
 #include <palpate/mesh/mesh.h>
@@ -61,10 +61,10 @@ namespace palpate
     {
       for (unsigned int p = 0; p < grid.size(); ++p)
         used[p].store(0, std::memory_order_relaxed);
-      // Work space for the largest patch there can be (every surface
-      // node), so that the haptic thread never allocates.
-      if (interpolation == Interpolation::contact_patch)
-        patch_contact = std::make_unique<PatchContact>(mesh.n_vertices(), 256);
+      // The interpolation with the work space its ticks need (a contact
+      // patch's: every surface node), so that the haptic thread never
+      // allocates.
+      interpolation       = Interpolation::create(scene, mesh, grid, cache);
       const double radius = scene.parameters.scheduler.cloud_radius;
       const int    reach =
         std::min<int>(grid.half_width(), std::floor(radius / grid.spacing()));
@@ -178,19 +178,9 @@ namespace palpate
     ForceFilter           filter;
     ForceHold             hold;
     std::array<double, 9> stiffness = {}; // of the last force()
-    const Interpolation   interpolation =
-      interpolation_from_name(scene.parameters.state_space.interpolation);
-    std::unique_ptr<PatchContact> patch_contact;
-    // With contact patches, the cache's read section stays open from one
-    // complete cell to the next, so that the last complete cell's patches
-    // stay alive (the cache frees a patch it lets go of only once no
-    // section can hold it) and answer while data are missing.
-    bool                                patch_section_open = false;
-    bool                                last_patches_valid = false;
-    std::array<const ContactPatch *, 8> last_patches       = {};
-    Utilities::Point3                   last_origin        = {{0, 0, 0}};
-    std::uint64_t                       last_generation    = 0;
-    MissingCause                        previous_cause     = MissingCause::none;
+    // State space / Interpolation: force() asks it for each tick's force.
+    std::unique_ptr<Interpolation> interpolation;
+    MissingCause                   previous_cause = MissingCause::none;
     // Whether the last tick's missing data was held (a held stretch that
     // turns into a fade, when a server's trouble ends before its states
     // came, is a new event: the summary counts fades and holds apart).
@@ -217,87 +207,6 @@ namespace palpate
     std::atomic<double>        event_position[3] = {};
     std::uint64_t              reported_events   = 0;
     Clock::time_point          attach_time;
-
-    /**
-     * With Interpolation = contact patch: the force of the complete
-     * @p sample at @p position from its corners' contact patches, solved
-     * for the sphere there (PatchContact), in place of the force linear
-     * on the HIP's tetrahedron that interpolate_on_tetrahedron() gave. A
-     * corner of that tetrahedron without a patch (dropped for the memory
-     * budget) leaves the sample's linear force. Real-time safe.
-     */
-    void
-    render_contact_patch(const Utilities::Point3 &position,
-                         ForceSample             &sample) noexcept
-    {
-      const std::uint64_t                 generation = cache.generation();
-      std::array<const ContactPatch *, 8> patches;
-      // The section of the last complete cell ends here: its patches are
-      // not read again.
-      if (patch_section_open)
-        cache.end_patch_reads();
-      cache.begin_patch_reads();
-      patch_section_open = true;
-      // The cell's patches that are there (those of the other tetrahedra
-      // keep answering for missing data beyond this one's face); those of
-      // the HIP's tetrahedron are needed.
-      for (unsigned int c = 0; c < 8; ++c)
-        patches[c] = cache.read_patch(sample.corners[c], generation);
-      bool all = true;
-      for (const unsigned int c : simplex_corners(sample.local))
-        all = all && patches[c];
-      last_patches_valid = all;
-      if (all)
-        {
-          patch_contact->blend(patches,
-                               simplex_weights(sample.local),
-                               position,
-                               sample.force,
-                               &sample.stiffness);
-          last_patches    = patches;
-          last_origin     = grid.position(sample.corners[0]);
-          last_generation = generation;
-        }
-    }
-
-    /**
-     * While data are missing, with contact patches: the force at
-     * @p position from the last complete cell's patches, the sphere's
-     * contact against the surface and compliance last known there
-     * (weights of the position clamped to that cell, so that the force is
-     * continuous as the HIP leaves it). False, and the section ended, if
-     * there are none or the parameters changed since. Real-time safe.
-     */
-    bool
-    render_last_patches(const Utilities::Point3 &position,
-                        Utilities::Point3       &force,
-                        std::array<double, 9>   &stiffness) noexcept
-    {
-      if (last_patches_valid && cache.generation() != last_generation)
-        {
-          cache.end_patch_reads();
-          patch_section_open = false;
-          last_patches_valid = false;
-        }
-      if (!last_patches_valid)
-        return false;
-      std::array<double, 3> local;
-      for (unsigned int d = 0; d < 3; ++d)
-        local[d] =
-          std::clamp((position[d] - last_origin[d]) / grid.spacing(), 0.0, 1.0);
-      // The tetrahedron of the clamped position, less a corner whose patch
-      // was not there (the last cell was complete for another tetrahedron).
-      auto   weights = simplex_weights(local);
-      double total   = 0;
-      for (unsigned int c = 0; c < 8; ++c)
-        total += last_patches[c] ? weights[c] : (weights[c] = 0);
-      if (!(total > 0))
-        return false;
-      for (double &w : weights)
-        w /= total;
-      patch_contact->blend(last_patches, weights, position, force, &stiffness);
-      return true;
-    }
 
     /** Seconds since the last force() call (1 ms at the first). */
     double
@@ -337,8 +246,9 @@ namespace palpate
       return true;
     }
 
-    /** force(), a step: forget the contact, the hold and the patches
-     * read, as reset_contact() asked (a new interaction starts). */
+    /** force(), a step: forget the contact, the hold and what the
+     * interpolation kept, as attach() asked (a new interaction
+     * starts). */
     void
     apply_reset() noexcept
     {
@@ -347,34 +257,26 @@ namespace palpate
       previous_cause = MissingCause::none;
       previous_held  = false;
       hold.reset();
-      if (patch_section_open)
-        cache.end_patch_reads();
-      patch_section_open = false;
-      last_patches_valid = false;
+      interpolation->reset();
     }
 
-    /** force(), a step: the force at @p position interpolated from the 8
-     * corners (with contact patches, solved against them), and the corners
-     * counted as read and used. */
+    /** force(), a step: the force at @p position by the interpolation,
+     * and the corners it read (sample.read) counted as read and, once
+     * complete, used. */
     ForceSample
     sample_at(const Utilities::Point3 &position) noexcept
     {
-      ForceSample sample =
-        interpolate_force(grid, cache, position, interpolation);
-      if (sample.complete && patch_contact)
-        render_contact_patch(position, sample);
+      const ForceSample sample = interpolation->force(position);
       if (sample.hits > 0 || sample.complete)
         {
-          corner_reads.fetch_add(patch_contact ? 4 : 8,
+          corner_reads.fetch_add(__builtin_popcount(sample.read),
                                  std::memory_order_relaxed);
           corner_hits.fetch_add(sample.hits, std::memory_order_relaxed);
         }
-      if (sample.complete && patch_contact)
-        for (const unsigned int c : simplex_corners(sample.local))
-          used[sample.corners[c]].store(1, std::memory_order_relaxed);
-      else if (sample.complete)
-        for (const unsigned int c : sample.corners)
-          used[c].store(1, std::memory_order_relaxed);
+      if (sample.complete)
+        for (unsigned int c = 0; c < 8; ++c)
+          if ((sample.read >> c) & 1)
+            used[sample.corners[c]].store(1, std::memory_order_relaxed);
       return sample;
     }
 

@@ -65,14 +65,15 @@ namespace palpate
       : settings(p.nonlinear_solver)
       , anderson(p.nonlinear_solver.anderson_depth)
     {
-      settings.compute_stiffness =
-        settings.compute_stiffness ||
-        p.state_space.interpolation == "tricubic Hermite";
+      // What each state keeps beside its force is what the interpolation
+      // that renders the states reads, as its plug-in declares it.
+      const Plugins::StateContents kept = p.state_space.state_contents();
+      settings.compute_stiffness = settings.compute_stiffness || kept.stiffness;
       // The patch holds every node the sphere can touch from the cells
       // around the state (its centre within h of the state's in each
       // axis), and a quarter radius more for the surface springing back
       // towards the sphere when it is lifted.
-      if (p.state_space.interpolation == "contact patch")
+      if (kept.contact_patch)
         patch_reach = 1.25 * p.boundary_conditions.active_node.tip_radius;
       grid_spacing     = p.state_space.grid_spacing;
       const auto start = std::chrono::steady_clock::now();

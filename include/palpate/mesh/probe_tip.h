@@ -97,14 +97,6 @@ namespace palpate
     static std::unique_ptr<ProbeTip>
     create(const Scene &scene);
 
-    /**
-     * The checks every tip's check_scene() runs after its own
-     * (PALPATE_REGISTER_PROBE_TIP): the State space / Interpolation that
-     * renders a sphere's contact needs a tip that is_sphere().
-     */
-    static void
-    check_any_tip(const Scene &scene);
-
   protected:
     /**
      * That Tip radius, which the tip reads, is a probe's: positive, and at
@@ -119,38 +111,12 @@ namespace palpate
   using ProbeTipRegistry = Plugins::Registry<ProbeTip, Scene>;
   extern template class Plugins::Registry<ProbeTip, Scene>;
 
-  /** A tip class's check_scene() (if it has one), then the checks of
-   * every tip (ProbeTip::check_any_tip()): the Declaration's check_scene
-   * that PALPATE_REGISTER_PROBE_TIP registers. */
-  template <typename Class>
-  void
-  check_probe_tip_scene(const Scene &scene)
-  {
-    if constexpr (Plugins::has_scene_check<Class>(0))
-      Class::check_scene(scene);
-    ProbeTip::check_any_tip(scene);
-  }
-
 /** Register the probe tip @p classname as @p name (PALPATE_REGISTER_PLUGIN,
  * plus its declaration for the scene's Active node / Tip, its
- * check_parameters() and its check_scene() followed by the checks of every
- * tip). */
-#define PALPATE_REGISTER_PROBE_TIP(classname, name, description)           \
-  namespace                                                                \
-  {                                                                        \
-    [[maybe_unused]] const bool palpate_probe_tip_registered_##classname = \
-      ::palpate::ProbeTipRegistry::add({name,                              \
-                                        description,                       \
-                                        &classname::declare_parameters,    \
-                                        &classname::create}) &&            \
-      ::palpate::Plugins::add_declaration(                                 \
-        "probe tip",                                                       \
-        {name,                                                             \
-         description,                                                      \
-         &classname::declare_parameters,                                   \
-         ::palpate::Plugins::check_function<classname>(),                  \
-         &::palpate::check_probe_tip_scene<classname>});                   \
-  }
+ * check_parameters() and its check_scene()). */
+#define PALPATE_REGISTER_PROBE_TIP(classname, name, description) \
+  PALPATE_REGISTER_DECLARED_PLUGIN(                              \
+    ::palpate::ProbeTipRegistry, "probe tip", classname, name, description)
 } // namespace palpate
 
 #endif

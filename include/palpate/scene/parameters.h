@@ -367,12 +367,21 @@ namespace palpate
       double grid_spacing;
       /** Half-width of the grid along each axis, metres. */
       double extent;
-      /** How the haptic loop interpolates the force between grid points:
-       * "trilinear" (the paper's, C0) or "tricubic Hermite" (C1, from the
-       * corners' forces and stiffnesses). */
+      /** The interpolation plug-in's name (InterpolationRegistry,
+       * haptics/interpolation.h): how the haptic loop interpolates the
+       * force between grid points, e.g. "trilinear". */
       std::string interpolation;
+      /** Each interpolation plug-in's own entries (plug-in name -> its
+       * subsection's values); the built-in ones have none. */
+      std::map<std::string, Plugins::Entries> own;
       /** The HDF5 state store ("" for none). */
       std::string store;
+
+      /** What each state keeps for the interpolation (the stiffness, a
+       * contact patch), as its plug-in declares it; nothing if no
+       * interpolation has that name. */
+      Plugins::StateContents
+      state_contents() const;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);

@@ -184,7 +184,7 @@ namespace palpate
     void
     check_effects() const;
     /** The own entries of the chosen mesh source, fixed region, probe tip,
-     * device, trajectory and linear solver plug-ins
+     * interpolation, device, trajectory and linear solver plug-ins
      * (Plugins::check_entries). */
     void
     check_plugin_entries() const;
@@ -193,6 +193,11 @@ namespace palpate
      * of the scene (Plugins::check_scene()). */
     void
     check_probe() const;
+
+    /** validate(): what the interpolation needs of the scene (a contact
+     * patch: a sphere to render; Plugins::check_scene()). */
+    void
+    check_interpolation() const;
 
     /** validate(): the mesh source's entries (Plugins::check_scene()), and
      * the scale. */
