@@ -261,10 +261,10 @@ main()
   }
 
   // A stop in the initial cloud does not wait for the states being
-  // computed: they give up at their next Newton iteration (a SIGTERM in
-  // the graded liver's cloud waited 6 s for them, the thirteenth re-run).
-  // Here each state takes seconds (increments of 0.1 mm), so two are
-  // running when the signal comes, and the summary counts them given up.
+  // computed: they give up at their next Newton iteration (on a large
+  // organ a state takes seconds, too long to wait for at a stop). Here
+  // each state takes seconds (increments of 0.1 mm), so two are running
+  // when the signal comes, and the summary counts them given up.
   {
     start_afresh();
     std::vector<std::string> slow = interaction;
@@ -530,8 +530,8 @@ main()
                                     err);
     const bool        listening = wait_for_text(out, "Live view: open");
     // A second live view of the scene into the same directory, on another
-    // port: refused, naming the first (two overwrote each other's force
-    // log and summary, the seventh re-run).
+    // port: refused, naming the first (two would overwrite each other's
+    // force log and summary).
     const std::string second_out = dir + "/second-serve.txt";
     const pid_t       second =
       start_palpate({"serve",
