@@ -200,8 +200,8 @@ main(int argc, char **argv)
           "subsection Haptics\n  subsection Trajectory\n"
           "    set Type = replay\n    set File name = mm.csv\n  end\nend\n");
   {
-    // A 99 ms stroke written in milliseconds, a line per ms: it ran as a
-    // 99 s motion (the thirteenth re-run).
+    // A 99 ms stroke written in milliseconds, a line per ms: read as
+    // seconds it would run as a 99 s motion, so the unit is questioned.
     std::string ms = "t, x, y, z\n";
     for (unsigned int k = 0; k < 100; ++k)
       ms += std::to_string(k) + ", 0, 0, " + std::to_string(-0.0002 * k) + "\n";

@@ -136,12 +136,14 @@ main(int argc, char **argv)
       "precompute good.prm --set 'State space/Store=" + std::string(247, 's') +
         ".h5'");
 
-  // The sixth re-run (issue 26).
+  // Values a run would accept and then render nothing with (no motion,
+  // no force, exit 0): refused before the run.
   scene("Haptics / Trajectory / Duration = 0 (no motion, 0 N, exit 0)",
         "duration-zero.prm",
         beam + "subsection Haptics\n  subsection Trajectory\n"
                "    set Duration = 0\n  end\nend\n");
-  // The ninth re-run (issue 26).
+  // Poisson's ratios inside their pattern but so near its ends that the
+  // elements lock or the states fail to converge: refused with the bound.
   scene("St.Venant-Kirchhoff nu = 0.4999999 (3,817 N for a 1.6 N push)",
         "nu-locking.prm",
         beam + "subsection Material model\n  subsection St.Venant-Kirchhoff\n"
@@ -151,7 +153,8 @@ main(int argc, char **argv)
         beam + "subsection Material model\n  set Model name = Neo-Hookean\n"
                "  subsection Neo-Hookean\n"
                "    set Poisson's ratio = -0.9999999\n  end\nend\n");
-  // The tenth re-run: -0.9 to -0.7 passed that bound and Newton failed.
+  // Neo-Hookean's lower bound is 0, not -0.9: with nu < 0 its energy has
+  // no minimum once an element is crushed, so Newton fails well above -0.9.
   scene("Neo-Hookean nu = -0.8 (failure points: no energy minimum)",
         "nu-neo-hookean-negative.prm",
         beam + "subsection Material model\n  set Model name = Neo-Hookean\n"
@@ -223,7 +226,8 @@ main(int argc, char **argv)
   // live view (Utilities::parse_whole_number).
   run("study --samples 12x (not a whole number)",
       "study good.prm --samples 12x");
-  // The eighth re-run (issue 26).
+  // More settings that run and render nothing (the probe at rest, no
+  // frame, no limit at all): refused, or said.
   scene("Haptics / Trajectory / Speed = 0 (the probe held at rest, 0 N)",
         "speed-zero.prm",
         beam + "subsection Haptics\n  subsection Trajectory\n"
@@ -253,29 +257,30 @@ main(int argc, char **argv)
         "/parameters/liver-stvk.prm' --set 'Boundary conditions/Active "
         "node/Tip=sphere' --set 'Boundary conditions/Active node/Tip "
         "radius=0.01' --to 0,0,-0.01");
-  // The eleventh re-run: the depth check weighed the scene's push, not
-  // solve's --to (a 5 mm sphere pushed 2 cm was accepted, then failed).
+  // The depth check weighs the push that will be made: solve's --to, not
+  // the scene's own prescribed displacement.
   run("a 5 mm sphere on the graded liver, pushed 2 cm by solve --to",
       "solve '" + palpate_source_dir +
         "/parameters/liver-indenter.prm' --set 'Boundary conditions/Active "
         "node/Tip radius=0.005' --set 'Boundary conditions/Active "
         "node/Prescribed displacement=0,0,-0.004' --to 0,0,-0.02");
-  // The fifteenth re-run's S4: pushed 10 cm, the radius offered (6.47
-  // cm) stagnated at 8.4 cm; beyond 0.22 of the way to the fixed nodes
-  // the push is what to change.
+  // Pushed 10 cm, no sphere radius converges: beyond 0.22 of the way to
+  // the fixed nodes the message names the push as what to change, not the
+  // radius.
   run("a 1 mm sphere on the graded liver, pushed 10 cm by solve --to",
       "solve '" + palpate_source_dir +
         "/parameters/liver-indenter.prm' --set 'Boundary conditions/Active "
         "node/Tip radius=0.001' --to 0,0,-0.1");
-  // The sixteenth re-run: a stiff modulus blamed the untouched Poisson's
-  // ratio; a look-ahead of 1e9 s was taken; an output directory that is a
-  // link to nowhere said "File exists".
+  // A stiff modulus is blamed, not the Poisson's ratio it is combined
+  // with; a look-ahead of 1e9 s is refused; an output directory that is a
+  // link to nowhere is named as such, not as "File exists".
   run("St.Venant-Kirchhoff's Young's modulus 1e12 Pa with nu = 0.49",
       "solve good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' "
       "--set \"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.49\" "
       "--set \"Material model/St.Venant-Kirchhoff/Young's modulus=1e12\"");
-  // The modulus it names is accepted: rounded to nearest, 6.006e10 was
-  // named 6.01e10 and refused again (the seventeenth re-run).
+  // The modulus it names is accepted: the limit is rounded down when
+  // printed (to nearest, a limit of 6.006e10 would be named 6.01e10, which
+  // is refused again).
   run("St.Venant-Kirchhoff's Young's modulus 1e12 Pa with nu = 0.499",
       "good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' --set "
       "\"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.499\" --set "
@@ -286,9 +291,9 @@ main(int argc, char **argv)
       "\"Material model/St.Venant-Kirchhoff/Young's modulus=6e10\"");
   run("a look-ahead of 1e9 s",
       "good.prm --set 'Scheduler/Look-ahead time=1e9'");
-  // Just over a limit, a value must not read as the limit (the seventeenth
-  // re-run: "1e+13 Pa, more than 1e+13 Pa"; a circle of radius 0.05000001
-  // "goes 0.1 m" from rest, as if it fitted an extent of 0.1 m).
+  // Just over a limit, a value must not read as the limit (not "1e+13 Pa,
+  // more than 1e+13 Pa"; a circle of radius 0.05000001 must not "go 0.1 m"
+  // from rest, as if it fitted an extent of 0.1 m).
   run("a modulus that makes lambda just over 1e13 Pa",
       "good.prm --set 'Material model/Model name=St.Venant-Kirchhoff' --set "
       "\"Material model/St.Venant-Kirchhoff/Poisson's ratio=0.49\" --set "
@@ -306,8 +311,8 @@ main(int argc, char **argv)
       "export=true' --to 0,0,-0.001");
   run("study --csv into a directory that does not exist",
       "study good.prm --quick --csv no-such-dir/study.csv");
-  // Links to nowhere (the thirteenth re-run): "does not exist, mkdir -p"
-  // was the wrong fix, and a store that was such a link was replaced.
+  // Links to nowhere: "does not exist, mkdir -p" would be the wrong fix,
+  // and a store that is such a link must not be replaced by a new file.
   make_link("no-such-target-dir", "gone-dir");
   make_link("no-such-target.csv", "gone.csv");
   make_link("no-such-target.h5", "gone.h5");
@@ -331,19 +336,18 @@ main(int argc, char **argv)
       "study good.prm --quick --csv beside.csv");
   run("study --csv naming a directory with a trailing slash",
       "study good.prm --quick --csv new.csv/");
-  // The nineteenth re-run's B9 and B10: a value just over its limit read
-  // as the limit ("0.1 m radius ... at most 0.1 m").
+  // A value just over its limit must not read as the limit ("0.1 m
+  // radius ... at most 0.1 m").
   run("a sphere of 0.1000001 m radius, just over the largest",
       "solve good.prm --set 'Boundary conditions/Active node/Tip=sphere' "
       "--set 'Boundary conditions/Active node/Tip radius=0.1000001'");
   run("a push just longer than liver501 is across",
       "solve '" + palpate_source_dir +
         "/parameters/liver-stvk.prm' --to 0,0,-0.35677");
-  // The twentieth re-run's W2: at rest a radius failing the checks at one
-  // of the 26 grid points around rest was dropped unsolved and, the 10 s
-  // spent, "no sphere found here: radii that pass the checks ( m) ..."
-  // came with no radius, though the scene's own 0.01 m converges there.
-  // Now the first radius tried passes the checks at all 26.
+  // At rest a sphere radius is offered only if it passes the checks at
+  // all 26 grid points around rest: the first radius tried does, so the
+  // message names a radius (the scene's own 0.01 m converges there)
+  // rather than none.
   run("a 1 mm sphere at rest at Node id 38 of the graded liver",
       "'" + palpate_source_dir +
         "/parameters/liver-indenter.prm' --set 'State space/Store=' --set "

@@ -20,8 +20,8 @@ main(int argc, char **argv)
   write_file("good.prm", beam);
   write_file("unclosed.prm", "subsection Mesh\n  set Source = beam\n");
 
-  // The fifth re-run (issue 26): extremes that blamed the wrong thing or
-  // ran with nonsense.
+  // Extremes inside each entry's pattern: each must be refused by its own
+  // entry's check, not blamed on another entry or run with nonsense.
   scene("a beam 1e-300 m wide (blamed a flat generated element)",
         "beam-thin.prm",
         beam + "subsection Mesh\n  subsection Beam\n"
@@ -128,8 +128,8 @@ main(int argc, char **argv)
         "density.prm",
         beam + "subsection Material model\n"
                "  set Density = 1e9\nend\n");
-  // The third re-run's bounds (issue 26): each made a run render no force
-  // with exit 0.
+  // Values that would let a run render no force and still exit 0: each is
+  // refused before the run.
   scene("Scheduler / Rate = 1e-9 Hz",
         "scheduler-rate.prm",
         beam + "subsection Scheduler\n  set Rate = 1e-9\nend\n");

@@ -719,8 +719,8 @@ main(int argc, char **argv)
   }
   {
     // 300 clients that ask for three.js 20 times at once and never read
-    // the answers: every thread blocked in a write until its timeout, and
-    // the page's /frame waited 9.5 s (the sixth re-run). A connection
+    // the answers would hold every thread blocked in a write until its
+    // timeout, and the page's /frame would wait for one. A connection
     // whose answer has not been taken for 1 s is closed when a new one
     // needs its thread.
     std::vector<int> greedy;

@@ -38,10 +38,9 @@ main()
                 " --set 'Boundary conditions/Active node/Tip=sphere'"
                 " --set 'Boundary conditions/Active node/Tip radius=0.01'"
                 " --to 0.005,0,0.005");
-  // Asking for help after a command (`palpate solve --help` read --help
-  // as the scene, the sixteenth re-run) or as `palpate help` (`help solve`:
-  // the seventeenth re-run said "unknown command"): the usage,
-  // exit 0.
+  // Asking for help after a command (`palpate solve --help`, where --help
+  // must not be read as the scene) or as a command of its own (`palpate
+  // help`, `help solve`): the usage, exit 0.
   for (const std::string arguments :
        {"solve --help", "study -h", "mesh --help", "help", "help solve"})
     {

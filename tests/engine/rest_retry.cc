@@ -2,14 +2,14 @@
 // Copyright (C) 2026 the palpate authors
 
 // The 26 grid points around rest converge in the engine as they do from
-// rest (the twentieth re-run): a sphere's offered radius is tried by
+// rest: a sphere's offered radius is tried by
 // static solves from rest to those 26 points (select_nodes()), but the
 // engine solves a point from a computed neighbour, and on a nonlinear
 // model the path matters. On liver-stvk.prm at Node id 47 with a
 // 0.0249 m sphere every one of the 26 converges from rest, while some
-// points fail from a neighbour one step nearer rest; the interaction then
-// had a failure point at a corner of the cell the probe starts in, and its
-// force was lost there. Checked:
+// points fail from a neighbour one step nearer rest; without a retry from
+// rest the interaction would have a failure point at a corner of the cell
+// the probe starts in, and its force would be lost there. Checked:
 // - the 26 from rest: each converges or the sphere does not touch;
 // - the path dependence is real: at least one point fails from such a
 //   neighbour (else this test would not test the engine's retry);

@@ -6,9 +6,9 @@
 // corners of every cell that touches it), not for the whole initial cloud
 // (515 points on the paper's liver); the rest of the cloud is computed
 // during the motion. Through the palpate program on the paper's liver,
-// a 6 s stroke at 5 mm/s (at 10 mm/s, under CI's load beside a re-run's
-// solves, the scheduler once fell 0.087 s behind; the check is of what it
-// plans first, not of the machine's speed):
+// a 6 s stroke at 5 mm/s (slow enough that a machine loaded by other
+// tests' solves keeps ahead of the probe: the check is of what the
+// scheduler plans first, not of the machine's speed):
 // - the report says what the motion waits for, and when it starts it says
 //   the 27 are there, with fewer states computed than the cloud has (at
 //   least the 27);

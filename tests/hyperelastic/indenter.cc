@@ -200,18 +200,18 @@ main(int argc, char **argv)
 
   // --- A sphere much smaller than the surface triangles: on the shipped
   // liver (liver-stvk.prm, triangles of 1-2 cm), a 2 mm sphere at a node.
-  // Pushed 1 cm in along the normal, one increment once carried it past
+  // Pushed 1 cm in along the normal, one increment can carry it past
   // every node (0 N, "converged"); with increments no longer than its
-  // radius the node it pushes slipped past it after 6-8 mm and the state
-  // was a failure point (sphere through the surface). Moved along the
-  // surface it sinks between the nodes at once: every grid point beside
-  // rest was a failure point and an interaction rendered 0 N with exit 0
-  // (the sixth re-run). Such a sphere is now refused when the scene is
-  // read, with the radius the triangles around the contact need.
+  // radius the node it pushes slips past it after 6-8 mm and the state is
+  // a failure point (sphere through the surface). Moved along the surface
+  // it sinks between the nodes at once: every grid point beside rest is a
+  // failure point and an interaction would render 0 N with exit 0. So such
+  // a sphere is refused when the scene is read, with the radius the
+  // triangles around the contact need.
   // Each refusal names a radius; that radius must then pass both checks
   // (the nearest node's distance and the triangles around the contact): a
-  // suggestion rounded down, or passing one check only, was refused again
-  // (the seventh and eighth re-runs).
+  // suggestion rounded down, or one that passes one check only, would be
+  // refused again.
   const auto refusal = [](const palpate::Scene &scene) -> std::string {
     try
       {
@@ -251,11 +251,11 @@ main(int argc, char **argv)
             << std::endl;
   }
   // Pushed 10 cm into the graded liver (0.7 of the way to its fixed
-  // nodes), the radius offered (6.47 cm) stagnated at 8.4 cm (the
-  // fifteenth re-run's S4); 4.1 cm at Node id 30 (0.26 of the way) failed
-  // too. Beyond 0.22 of the way no radius is offered: the push is what to
-  // change, and the depth it names (along the inward normal) gets a
-  // radius that is accepted.
+  // nodes), the radius the checks give (6.47 cm) stagnates at 8.4 cm;
+  // 4.1 cm at Node id 30 (0.26 of the way) fails too. So beyond 0.22 of
+  // the way no radius is offered: the push is what to change, and the
+  // depth it names (along the inward normal) gets a radius that is
+  // accepted.
   {
     palpate::Scene liver = shipped_scene("liver-indenter.prm");
     auto          &a     = liver.parameters.boundary_conditions.active_node;
@@ -298,10 +298,10 @@ main(int argc, char **argv)
             << ok(suggested(refused) > 0 && refusal(liver).empty())
             << std::endl;
   }
-  // Between the two: 4 - 5.5 mm passed both checks on the graded liver,
-  // and its 1 cm push was then a failure point (the tenth re-run). Pushed
-  // deeper than its radius a sphere must clear them by the margin; pushed
-  // less deep (4 mm) the same sphere is accepted.
+  // Between the two: 4 - 5.5 mm pass both checks on the graded liver, yet
+  // its 1 cm push is a failure point. Pushed deeper than its radius a
+  // sphere must clear them by the margin; pushed less deep (4 mm) the same
+  // sphere is accepted.
   {
     palpate::Scene liver = shipped_scene("liver-indenter.prm");
     liver.parameters.boundary_conditions.active_node.tip_radius = 0.005;
@@ -320,9 +320,9 @@ main(int argc, char **argv)
       {0, 0, -0.004}};
     deallog << "; pushed 4 mm: accepted " << ok(refusal(liver).empty())
             << std::endl;
-    // A pull away from the surface presses it no deeper (the twelfth
-    // re-run's 3 cm pull was refused as "pushed 0.03 m deep"); the same
-    // length pushed in is refused.
+    // A pull away from the surface presses it no deeper (it must not be
+    // refused as "pushed 0.03 m deep"); the same length pushed in is
+    // refused.
     liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
       {0, 0, 0.03}};
     deallog << "  the same sphere pulled 3 cm away: accepted "
@@ -334,9 +334,9 @@ main(int argc, char **argv)
                   std::string::npos)
             << std::endl;
     // Only the push's inward part is its depth: the scene's 1 cm sphere
-    // moved 2 cm along x (4.3 mm in) was refused as "pushed 0.02 m deep",
-    // and solves at 0.308 N (the thirteenth re-run); 3 cm nearly along
-    // the surface, 0.09 mm in, was refused as closing the tissue over it.
+    // moved 2 cm along x (4.3 mm in) solves at 0.308 N and must not be
+    // refused as "pushed 0.02 m deep"; nor 3 cm nearly along the surface,
+    // 0.09 mm in, as closing the tissue over it.
     liver.parameters.boundary_conditions.active_node.tip_radius = 0.01;
     liver.parameters.boundary_conditions.active_node.prescribed_displacement = {
       {0.02, 0, 0}};
@@ -377,7 +377,7 @@ main(int argc, char **argv)
   }
   // Taylor-Hood has quadratic displacements whatever Polynomial degree
   // says: its edge midpoints are contact nodes, and the refusal must not
-  // advise "Polynomial degree = 2" (the tenth re-run).
+  // advise "Polynomial degree = 2", which would change nothing.
   {
     palpate::Scene liver = shipped_scene("liver-indenter.prm");
     liver.parameters.material_model.models["Mooney-Rivlin"]["Element"] =
@@ -397,10 +397,9 @@ main(int argc, char **argv)
             << std::endl;
   }
   // At Node id 27 of the graded liver, pushed (-2, 0, -2) cm, the radius
-  // the checks alone offered (2.62 cm) stagnated at 0.44 of the push, and
-  // so did 0.9 - 2 times it (the seventeenth re-run's N1: 8 of 372 offers
-  // were failure points). The offer is now tried by a static solve
-  // (select_nodes()), and what it names converges.
+  // the checks alone give (2.62 cm) stagnates at 0.44 of the push, and so
+  // do 0.9 - 2 times it. So the offer is tried by a static solve
+  // (select_nodes()) before it is named, and what it names converges.
   {
     palpate::Scene liver = shipped_scene("liver-indenter.prm");
     auto          &a     = liver.parameters.boundary_conditions.active_node;
@@ -464,12 +463,12 @@ main(int argc, char **argv)
                   palpate::Utilities::norm(named.force) > 0.1)
             << std::endl;
   }
-  // The eighteenth re-run: on liver-stvk.prm a trial whose increments all
-  // converged but whose end was refused (the sphere through the surface)
-  // said "converged" (F1: Node id 36 pushed 2 cm along x, 0.0189 m); and
-  // at rest nothing was tried, while the offer (0.0175 m) was a failure
-  // point one grid spacing beside rest (F3). Each offer must converge: to
-  // the push, or at rest at the six grid points beside it.
+  // A trial counts as converged only if its end is accepted too, not when
+  // its increments all converged but the sphere ends through the surface
+  // (liver-stvk.prm, Node id 36 pushed 2 cm along x, 0.0189 m); and an
+  // offer at rest (0.0175 m there) can be a failure point one grid spacing
+  // beside rest. Each offer must converge: to the push, or at rest at the
+  // grid points around it.
   {
     palpate::Scene liver     = shipped_scene("liver-stvk.prm");
     auto          &a         = liver.parameters.boundary_conditions.active_node;
@@ -514,8 +513,8 @@ main(int argc, char **argv)
     a.prescribed_displacement = {{0, 0, 0}};
     const double at_rest      = offer(liver);
     const double h            = liver.parameters.state_space.grid_spacing;
-    // All 26 around rest: the six along the axes once passed while (0.01,
-    // 0, -0.01) failed (the nineteenth re-run's R1, Node id 36).
+    // All 26 around rest, not only the six along the axes: at Node id 36
+    // those six pass while (0.01, 0, -0.01) fails.
     const auto around = [&](const double R) {
       bool all = R > 0;
       for (int i = -1; i <= 1; ++i)

@@ -2,12 +2,12 @@
 // Copyright (C) 2026 the palpate authors
 
 // METIS must leave palpate's stop handler as it was. GKlib (METIS's
-// library) set SIGTERM to its own handler during every call and put the
+// library) sets SIGTERM to its own handler during every call and puts the
 // previous one back with System V signal(), as a one-shot (SA_RESETHAND):
 // a second SIGTERM within the 0.5 s that palpate takes for one stop
-// delivered twice (`timeout` signals a process and its group) then killed
-// `palpate precompute` before it wrote its summary and released the
-// store's lock (the tenth re-run's L1). Here: with a StopRequest living,
+// delivered twice (`timeout` signals a process and its group) would then
+// kill `palpate precompute` before it wrote its summary and released the
+// store's lock. Here: with a StopRequest living,
 // MUMPS analyses a 400-unknown five-point pattern with the METIS ordering
 // (palpate's own call of METIS_NodeND), and the SIGTERM disposition must be
 // unchanged (handler and flags); then two SIGTERMs raised back to back

@@ -5,7 +5,7 @@
 // 3 palpate parameters/liver-stvk-mpi.prm` with each rank on a host of its
 // own (network namespaces joined by a switch with a 1 ms one-way delay,
 // Open MPI's TCP transport; benchmarks/netns_cluster.h), a slow stroke
-// (2.5 mm/s for 30 s), and 1 s into the motion the link of solver server 2
+// (2.5 mm/s for 15 s), and 1 s into the motion the link of solver server 2
 // goes down. Nothing dies: the server runs on, cut off. The client must
 // handle it as a lost server (doc/architecture.md, "Faults"):
 // - within Engine / Server timeout (1 s here) the summary names server 2
@@ -13,9 +13,11 @@
 // - the interaction goes on with server 1 to the end of the motion, and
 //   the force at its end is there (neither held nor faded: the engine is
 //   no longer degraded 3 s after the loss, so a force there comes from
-//   states server 1 computed). The stroke is long because server 1 may
-//   itself wait for a state server 2 held: up to 10 s per task
-//   (mpi_server.cc), two tasks queued;
+//   states server 1 computed). The stroke goes on for 14 s after the cut:
+//   the loss is declared within about 2 s (Server timeout 1 s), server 1
+//   is then told at once that the states it asked of server 2 will not
+//   come (mpi_server.cc, Kind::peer_lost), and the rest of the stroke is
+//   server 1's alone;
 // - no force is non-finite;
 // - palpate (rank 0) exits with status 5 and says so; server 1 ends with 0.
 // The partitioned server never hears that the run is over, so mpirun
@@ -24,7 +26,7 @@
 //
 // It needs root and network namespaces: where they are not permitted it
 // fails, saying why (tests/network/CMakeLists.txt leaves it out unless
-// PALPATE_NETWORK_TEST is ON or AUTO finds them). It takes about 35 s.
+// PALPATE_NETWORK_TEST is ON or AUTO finds them). It takes about 25 s.
 
 #include <palpate/app/application.h>
 
@@ -49,7 +51,7 @@ main()
       return 1;
     }
 
-  const int   motion = 30; // s, at 2.5 mm/s: 7.5 cm
+  const int   motion = 15; // s, at 2.5 mm/s: 3.75 cm
   std::string prefix;
   {
     netns_cluster::Cluster cluster({3, 1e-3, 0});
