@@ -103,7 +103,14 @@ namespace palpate
     action.sa_flags = SA_RESTART;
     for (unsigned int i = 0; i < 3; ++i)
       {
-        sigaction(stop_signals[i], nullptr, &previous[i]);
+        struct sigaction current
+        {};
+        sigaction(stop_signals[i], nullptr, &current);
+        // The handler a stopped StopRequest left behind (see the destructor)
+        // is not the caller's: the one saved before it stays the one to
+        // restore.
+        if (current.sa_handler != on_stop_signal)
+          previous[i] = current;
         // A signal the caller ignores (nohup ignores SIGHUP) stays ignored.
         if (previous[i].sa_handler != SIG_IGN)
           sigaction(stop_signals[i], &action, nullptr);
@@ -115,6 +122,13 @@ namespace palpate
   StopRequest::~StopRequest()
   {
     alive.store(false);
+    // After a stop the process is on its way out with 128 + the signal. The
+    // same signal delivered again (to the process and its group) may land
+    // after this destructor, in the exit's teardown: with the previous
+    // (default) action restored it would kill the process and replace that
+    // exit status. The handler stays, and keeps its half-second rule.
+    if (received.load() != 0)
+      return;
     for (unsigned int i = 0; i < 3; ++i)
       sigaction(stop_signals[i], &previous[i], nullptr);
   }
