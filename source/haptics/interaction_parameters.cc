@@ -36,9 +36,15 @@ namespace palpate
       const char *fixed = nullptr;
       if (o.mesh != parameters.mesh)
         fixed = "Mesh";
+      // The interpolation too: it was made for the scene the interaction
+      // started with, and it decides what each state keeps (a stiffness, a
+      // contact patch), so the solvers and the haptic loop would disagree.
       else if (o.state_space.grid_spacing !=
                  parameters.state_space.grid_spacing ||
-               o.state_space.extent != parameters.state_space.extent)
+               o.state_space.extent != parameters.state_space.extent ||
+               o.state_space.interpolation !=
+                 parameters.state_space.interpolation ||
+               o.state_space.own != parameters.state_space.own)
         fixed = "State space";
       else if (o.engine.type != parameters.engine.type ||
                o.engine.workers != parameters.engine.workers ||

@@ -189,6 +189,24 @@ main(int argc, char **argv)
                     "DOES NOT NAME Mesh")
               << std::endl;
     }
+  // The interpolation decides what each state keeps: another one would
+  // leave the haptic loop reading what the solvers no longer compute.
+  palpate::Parameters::AllParameters other_interpolation = changed;
+  other_interpolation.state_space.interpolation          = "tricubic Hermite";
+  try
+    {
+      interaction.change_parameters(other_interpolation);
+      deallog << "interpolation change ACCEPTED" << std::endl;
+    }
+  catch (const std::invalid_argument &e)
+    {
+      deallog << "interpolation change refused: "
+              << (std::string(e.what()).find("'State space'") !=
+                      std::string::npos ?
+                    "names State space" :
+                    "DOES NOT NAME State space")
+              << std::endl;
+    }
   palpate::Parameters::AllParameters no_fixed_nodes           = changed;
   no_fixed_nodes.boundary_conditions.fixed_nodes.boundary_ids = {7};
   try

@@ -273,6 +273,21 @@ main(int argc, char **argv)
           << refusal("radius.prm",
                      scene_text(ring_tip + "    set Tip radius = 0.01\n"))
           << std::endl;
+  // The point's refusal of a radius offers the tips that take one, asked
+  // of each registered tip: the ring, which has radii of its own, is not.
+  try
+    {
+      write_file("point.prm",
+                 scene_text("    set Tip = point\n"
+                            "    set Tip radius = 0.01\n"));
+      palpate::Scene::read("point.prm");
+      deallog << "a point with a radius: ACCEPTED" << std::endl;
+    }
+  catch (const palpate::InputError &e)
+    {
+      deallog << "a point with a radius: " << e.problem()
+              << "; fix: " << e.fix() << std::endl;
+    }
   deallog << "contact patch: "
           << refusal("patch.prm",
                      scene_text(ring_tip,

@@ -4,6 +4,8 @@
 // Active node / Tip = point: the paper's probe, the active node alone
 // follows the haptic interaction point and the force is its multiplier.
 
+#include <palpate/base/exceptions.h>
+#include <palpate/base/plugins.h>
 #include <palpate/mesh/probe_tip.h>
 #include <palpate/scene/scene.h>
 
@@ -34,15 +36,32 @@ namespace palpate
       check_scene(const Scene &scene)
       {
         const auto &a = scene.parameters.boundary_conditions.active_node;
-        if (a.tip_radius > 0)
-          throw scene.error(
-            "Boundary conditions/Active node/Tip radius",
-            "Tip radius = " + Utilities::to_string(a.tip_radius, 4) +
-              " m, but Tip = point has no radius",
-            "set Tip = sphere (a rigid sphere in contact with the "
-            "surface: a force that converges with the mesh) or Tip "
-            "= glued nodes (the surface nodes within the radius "
-            "follow the probe), or remove Tip radius.");
+        if (!(a.tip_radius > 0))
+          return;
+        // The fix offers the registered tips that take this radius: each
+        // one's own check_scene() says so, a tip added later included (a
+        // tip with radii of its own refuses Tip radius).
+        std::string others;
+        Scene       trial = scene;
+        for (const auto &tip : ProbeTipRegistry::plugins())
+          if (tip.name != "point")
+            try
+              {
+                trial.parameters.boundary_conditions.active_node.tip = tip.name;
+                Plugins::check_scene("probe tip", tip.name, trial);
+                others += (others.empty() ? "Tip = " : " or Tip = ") + tip.name;
+              }
+            catch (const InputError &)
+              {}
+        throw scene.error("Boundary conditions/Active node/Tip radius",
+                          "Tip radius = " +
+                            Utilities::to_string(a.tip_radius, 4) +
+                            " m, but Tip = point has no radius",
+                          others.empty() ?
+                            std::string("remove Tip radius.") :
+                            "set " + others +
+                              " (palpate --print-parameters describes each "
+                              "tip), or remove Tip radius.");
       }
     };
   } // namespace
