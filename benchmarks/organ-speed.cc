@@ -669,8 +669,9 @@ run_benchmark(int argc, char **argv)
      "Anderson acceleration of the quasi-Newton steps on kept factors "
      "(Anderson depth = 4)",
      [](Parameters::AllParameters &p) {
-       p.nonlinear_solver.anderson_depth        = 4;
-       p.nonlinear_solver.patch_factor_residual = 0;
+       p.nonlinear_solver.anderson_depth                  = 4;
+       p.nonlinear_solver.patch_factor_residual           = 0;
+       p.nonlinear_solver.anderson_across_contact_changes = false;
      },
      false},
     {"+free start",
@@ -692,6 +693,13 @@ run_benchmark(int argc, char **argv)
      "solver's error",
      [](Parameters::AllParameters &p) {
        p.nonlinear_solver.residual_tolerance = 1e-3;
+     },
+     false},
+    {"+history across contacts",
+     "Anderson's history kept while the contact set changes, a step it "
+     "fails retried plain before new factors",
+     [](Parameters::AllParameters &p) {
+       p.nonlinear_solver.anderson_across_contact_changes = true;
      },
      false},
     // Run only when --levers names it (it replaces the factorisation).

@@ -460,6 +460,7 @@ namespace palpate
     factors_of_state    = false;
     patch_of_state      = false;
     patch_factors_tried = false;
+    plain_retried       = false;
     anderson.reset();
   }
 
@@ -533,9 +534,23 @@ namespace palpate
                                          const State             &state,
                                          bool                    &refactorize,
                                          double                  &previous_rate,
-                                         unsigned int &steps_on_factors) const
+                                         unsigned int &steps_on_factors)
   {
     steps_on_factors = record.factorized ? 0 : steps_on_factors + 1;
+    // An accelerated step that did not cut the residual by a tenth: its
+    // history combined steps from before the contact set moved that no
+    // longer fit. The factors are not to blame yet: one plain step from a
+    // new history (once a Newton solve), judged afresh, before new ones.
+    if (settings.anderson_across_contact_changes && record.accelerated &&
+        !record.factorized &&
+        record.residual_after >= 0.9 * record.residual_before && !plain_retried)
+      {
+        plain_retried = true;
+        anderson.reset();
+        previous_rate = 0;
+        refactorize   = patch_factors_due(record.residual_after, target, state);
+        return;
+      }
     refactorize =
       worth_refactorizing(record, previous_rate, steps_on_factors) ||
       patch_factors_due(record.residual_after, target, state);

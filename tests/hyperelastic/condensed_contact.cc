@@ -41,7 +41,8 @@ namespace
   compare(const std::string         &name,
           palpate::Scene             scene,
           const std::vector<Point3> &path,
-          const unsigned int         anderson_depth = 0)
+          const unsigned int         anderson_depth         = 0,
+          const bool                 across_contact_changes = true)
   {
     scene.parameters.nonlinear_solver.residual_tolerance = 1e-10;
     scene.parameters.nonlinear_solver.compute_stiffness  = true;
@@ -49,6 +50,8 @@ namespace
     palpate::StateSolver reference(body.mesh, body.nodes, scene.parameters);
     scene.parameters.nonlinear_solver.condensed_contact = true;
     scene.parameters.nonlinear_solver.anderson_depth    = anderson_depth;
+    scene.parameters.nonlinear_solver.anderson_across_contact_changes =
+      across_contact_changes;
     palpate::StateSolver condensed(body.mesh, body.nodes, scene.parameters);
 
     palpate::State from_reference = reference.rest_state(),
@@ -161,6 +164,12 @@ main(int argc, char **argv)
                                           {{0, 0.005, -0.005}}};
   compare("liver", liver, liver_path);
   compare("liver, Anderson depth 4", liver, liver_path, 4);
+  // The benchmark's path before the history spanned contact changes.
+  compare("liver, Anderson depth 4, a new history at each contact change",
+          liver,
+          liver_path,
+          4,
+          false);
 
   // A 2 mm slide of the pressed sphere on the liver moves the contact set;
   // the kept factors of the state before solve it (those the pressed

@@ -157,14 +157,15 @@ namespace palpate
 
     /** On the condensed path after @p record: whether the next iteration
      * is to @p refactorize, with @p previous_rate and @p steps_on_factors
-     * brought up to date. */
+     * brought up to date (or, after an accelerated step that failed, a
+     * plain step first: anderson restarts). */
     void
     plan_next_condensed(const NewtonIteration   &record,
                         const Utilities::Point3 &target,
                         const State             &state,
                         bool                    &refactorize,
                         double                  &previous_rate,
-                        unsigned int            &steps_on_factors) const;
+                        unsigned int            &steps_on_factors);
 
     /** Assemble the residual and tangent at the accepted iterate @p x
      * (its force scale into @p scale, the time into @p assembly_time);
@@ -527,10 +528,13 @@ namespace palpate
     std::function<bool()>                      stop_check;
     // The condensed path's acceleration, the plain step it started from,
     // and which candidates' rows were in contact after the last step (a
-    // change restarts it).
+    // change restarts it unless settings.anderson_across_contact_changes);
+    // whether this Newton solve has retried a failed accelerated step
+    // plain (plan_next_condensed()).
     AndersonAcceleration anderson;
     std::vector<double>  plain_step;
     std::vector<char>    in_contact, was_in_contact;
+    bool                 plain_retried = false;
     // The contact patches' compliance (made when the first is wanted),
     // its factors as a solver, and whether they are the kept factors.
     std::unique_ptr<InverseBlock> inverse_block;

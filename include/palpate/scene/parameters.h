@@ -283,6 +283,12 @@ namespace palpate
        * state walks from its neighbour, the path benchmarks/run
        * organ-speed compares against). */
       bool free_start = true;
+      /** With Anderson depth > 0: the acceleration's history spans changes
+       * of the set of nodes touching the sphere, and a step it fails is
+       * retried plain before new factors are made (not an entry; false: a
+       * new history at every change of that set, the path
+       * benchmarks/run organ-speed compares against). */
+      bool anderson_across_contact_changes = true;
 
       /** Fix reuse_factorization to @p on (no choice by size). */
       void
