@@ -193,10 +193,11 @@ namespace palpate
         // contact patch: its patches) answers instead of the spring or the
         // fade: the tissue there as last known, zero off its surface.
         // Still an event of its kind.
-        if (s.in_contact && finite &&
-            s.interpolation->force_while_missing(position, target, s.stiffness))
-          render = true;
-        s.count_missing(cause, held, position, finite, dt);
+        const bool patched =
+          s.in_contact && finite &&
+          s.interpolation->force_while_missing(position, target, s.stiffness);
+        render = render || patched;
+        s.count_missing(cause, held, patched, position, dt, finite);
       }
     s.previous_held  = held;
     s.previous_cause = event ? cause : MissingCause::none;

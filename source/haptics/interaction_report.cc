@@ -81,6 +81,7 @@ namespace palpate
     const auto         cause = static_cast<MissingCause>(code & 0x0f);
     const bool         held  = code & 0x10;
     const bool         nothing_held = code & 0x20; // no complete cell before it
+    const bool         patched      = code & 0x40; // the last cell's patches
     const std::string  why =
       cause == MissingCause::failure_region ?
          "the HIP is in a failure region (no equilibrium was found for a "
@@ -94,6 +95,9 @@ namespace palpate
               "or was lost, and its work is planned again" :
               "the states of the HIP's cell are not computed yet";
     const std::string what =
+      patched ?
+        std::string("the force comes from the last complete cell's contact "
+                    "patches (the tissue there as last known)") :
       held ? "the force is held from the last computed cell, " +
                Utilities::to_string(
                  s.event_stiffness.load(std::memory_order_relaxed) / 1000, 3) +
@@ -167,19 +171,20 @@ namespace palpate
     r.worker_busy_fraction     = span > 0 ? e.busy_time / (span * workers) : 0;
     for (unsigned int p = 0; p < s.grid.size(); ++p)
       r.states_used += s.used[p].load(std::memory_order_relaxed);
-    r.corner_reads           = s.corner_reads.load();
-    r.corner_hits            = s.corner_hits.load();
-    r.missing_events         = s.missing_events.load();
-    r.missing_seconds        = 1e-9 * s.missing_nanoseconds.load();
-    r.failure_region_events  = s.held_events[0].load();
-    r.failure_region_seconds = 1e-9 * s.held_nanoseconds[0].load();
-    r.outside_events         = s.held_events[1].load();
-    r.outside_seconds        = 1e-9 * s.held_nanoseconds[1].load();
-    r.server_hold_events     = s.held_events[2].load();
-    r.server_hold_seconds    = 1e-9 * s.held_nanoseconds[2].load();
-    r.non_finite_forces      = s.non_finite.load();
-    r.largest_force          = s.largest_force.load();
-    r.largest_force_change   = s.largest_change.load();
+    r.corner_reads            = s.corner_reads.load();
+    r.corner_hits             = s.corner_hits.load();
+    r.missing_events          = s.missing_events.load();
+    r.missing_seconds         = 1e-9 * s.missing_nanoseconds.load();
+    r.missing_patched_seconds = 1e-9 * s.patched_nanoseconds.load();
+    r.failure_region_events   = s.held_events[0].load();
+    r.failure_region_seconds  = 1e-9 * s.held_nanoseconds[0].load();
+    r.outside_events          = s.held_events[1].load();
+    r.outside_seconds         = 1e-9 * s.held_nanoseconds[1].load();
+    r.server_hold_events      = s.held_events[2].load();
+    r.server_hold_seconds     = 1e-9 * s.held_nanoseconds[2].load();
+    r.non_finite_forces       = s.non_finite.load();
+    r.largest_force           = s.largest_force.load();
+    r.largest_force_change    = s.largest_change.load();
     return r;
   }
 } // namespace palpate

@@ -136,6 +136,7 @@ namespace palpate
               count("corner_hits", s.corner_hits),
               count("missing_data_events", s.missing_events),
               real("missing_data_seconds", s.missing_seconds),
+              real("missing_data_patched_seconds", s.missing_patched_seconds),
               count("failure_region_events", s.failure_region_events),
               real("failure_region_seconds", s.failure_region_seconds),
               count("outside_events", s.outside_events),
@@ -190,9 +191,16 @@ namespace palpate
       << "  cache:             " << corner_hits << " of " << corner_reads
       << " corner reads found a state\n"
       << "  missing data:      " << missing_events << " events, "
-      << missing_seconds << " s in total"
-      << (missing_events > 0 ? "  <-- the force faded to zero then" : "")
-      << "\n";
+      << missing_seconds << " s in total";
+    // The contact patches may have rendered the force while the states
+    // were missing: then it did not fade, and the line says so.
+    if (missing_patched_seconds > 0)
+      s << " (" << missing_patched_seconds
+        << " s of it rendered from the last complete cell's contact "
+           "patches)";
+    if (missing_events > 0 && missing_seconds - missing_patched_seconds > 1e-3)
+      s << "  <-- the force faded to zero then";
+    s << "\n";
     if (failure_region_events + outside_events > 0)
       s << "  held force:        " << failure_region_events
         << " times in failure regions (" << failure_region_seconds << " s), "

@@ -196,7 +196,8 @@ namespace palpate
     std::atomic<bool>         is_attached{false}, complete{false}, reset{false};
     mutable std::atomic<bool> initial_done{false};
     std::atomic<std::uint64_t> corner_reads{0}, corner_hits{0},
-      missing_events{0}, missing_nanoseconds{0}, non_finite{0};
+      missing_events{0}, missing_nanoseconds{0}, patched_nanoseconds{0},
+      non_finite{0};
     // Held force: [0] in failure regions, [1] outside the state space,
     // [2] while a solver server was silent or lost (PrecomputationEngine::
     // degraded()).
@@ -281,14 +282,17 @@ namespace palpate
     }
 
     /** force(), a step: a tick with data missing for @p cause counted,
-     * held or not (@p held), over @p dt s; a change of cause or hold is a
-     * new event, reported with the (finite or not) @p position. */
+     * held or not (@p held), over @p dt s, its force rendered from the
+     * last complete cell's contact patches or not (@p patched); a change
+     * of cause or hold is a new event, reported with the (finite or not)
+     * @p position. */
     void
     count_missing(const MissingCause       cause,
                   const bool               held,
+                  const bool               patched,
                   const Utilities::Point3 &position,
-                  const bool               finite,
-                  const double             dt) noexcept
+                  const double             dt,
+                  const bool               finite) noexcept
     {
       const unsigned int slot = cause == MissingCause::failure_region ? 0 :
                                 cause == MissingCause::outside        ? 1 :
@@ -299,7 +303,8 @@ namespace palpate
             event_position[d].store(finite ? position[d] : 0.0,
                                     std::memory_order_relaxed);
           event_cause.store(static_cast<std::uint8_t>(cause) |
-                              (held ? 0x10 : 0) | (hold.valid() ? 0 : 0x20),
+                              (held ? 0x10 : 0) | (hold.valid() ? 0 : 0x20) |
+                              (patched ? 0x40 : 0),
                             std::memory_order_relaxed);
           event_stiffness.store(hold.held_stiffness(),
                                 std::memory_order_relaxed);
@@ -314,6 +319,8 @@ namespace palpate
                                          std::memory_order_relaxed);
       else
         missing_nanoseconds.fetch_add(nanoseconds, std::memory_order_relaxed);
+      if (patched && !held)
+        patched_nanoseconds.fetch_add(nanoseconds, std::memory_order_relaxed);
     }
 
     /** force(), a step: @p target (rendered or faded, @p render) through

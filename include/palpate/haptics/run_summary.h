@@ -47,6 +47,10 @@ namespace palpate
      * to zero. */
     std::uint64_t missing_events  = 0;
     double        missing_seconds = 0;
+    /** Of missing_seconds, the time the contact patch interpolation
+     * rendered the force from the last complete cell's patches (the tissue
+     * there as last known) instead of fading it. */
+    double missing_patched_seconds = 0;
     /** Where no state can come, the force was held (ForceHold): in failure
      * regions, and outside the state space. */
     std::uint64_t failure_region_events = 0, outside_events = 0;
