@@ -880,7 +880,8 @@ namespace palpate
             current_t  = t1;
             return true;
           }
-        x = saved;
+        const std::string cause = impl->failure_cause(x, point(t1), o);
+        x                       = saved;
         if (depth < s.max_cutbacks &&
             o.status != SolveStatus::inverted_element &&
             o.status != SolveStatus::stopped)
@@ -891,7 +892,8 @@ namespace palpate
           }
         failure = o;
         failure.message +=
-          " (increment to " + Utilities::to_string(point(t1), 4) + " m)";
+          " (increment to " + Utilities::to_string(point(t1), 4) + " m)" +
+          cause;
         return false;
       };
 

@@ -159,6 +159,24 @@ namespace palpate
 
 
 
+  namespace
+  {
+    // What to change when the sphere goes, or is going, between the
+    // surface nodes.
+    std::string
+    through_surface_fix()
+    {
+      return "The contact acts at nodes, and a sphere smaller than the "
+             "surface triangles where it pushes slips past the node it "
+             "pushes, so its force would be the mesh's. Use a larger Tip "
+             "radius, a mesh finer near the probe (Mesh / Source = surface "
+             "with Refinement size about a third of the radius), or "
+             "Polynomial degree = 2";
+    }
+  } // namespace
+
+
+
   bool
   StateSolver::Impl::acceptable_end(const std::vector<double> &x,
                                     State                     &state,
@@ -196,16 +214,42 @@ namespace palpate
               (d < 0 ? "inside the deformed surface" :
                held  ? "from the deformed surface, less than half its radius" :
                        "from the deformed surface and no node touches it") +
-              ". The contact acts at nodes, and a sphere smaller than the "
-              "surface triangles where it pushes slips past the node it "
-              "pushes, so its force would be the mesh's. Use a larger Tip "
-              "radius, a mesh finer near the probe (Mesh / Source = surface "
-              "with Refinement size about a third of the radius), or "
-              "Polynomial degree = 2";
+              ". " + through_surface_fix();
             return false;
           }
       }
     return true;
+  }
+
+
+
+  std::string
+  StateSolver::Impl::failure_cause(const std::vector<double> &x,
+                                   const Utilities::Point3   &target,
+                                   const Outcome             &o) const
+  {
+    if (!system->has_contact() || o.status != SolveStatus::max_iterations)
+      return "";
+    // Pressed past the mesh's limit the nodes under the sphere slide
+    // round it towards its equator and the node-to-sphere contact has no
+    // state to converge to: Newton stagnates just before the depth at
+    // which a converged state is refused (acceptable_end()). A box of
+    // 5 mm tetrahedra under a 10 mm sphere: converged at 8 mm deep,
+    // stagnated at 8.5 mm with the centre 0.75 R from the deformed
+    // surface, converged with the contact in the matrix at 9 mm and
+    // refused there (0.40 R). Held by nodes a sphere is R less the sag of
+    // the triangles between them, h^2 / 8R, away: 0.875 R at h = R.
+    const double R = system->sphere_radius();
+    const double d = system->sphere_center_distance(x, target);
+    if (!std::isfinite(d) || d >= 0.8 * R)
+      return "";
+    return "; at its last iterate the sphere was sinking between the "
+           "surface nodes: its centre was " +
+           Utilities::to_string(1000 * d, 3) +
+           " mm from the deformed surface, " + Utilities::to_string(d / R, 2) +
+           " of its radius (held by the nodes a sphere is about one radius "
+           "away). " +
+           through_surface_fix() + ", or press less deep";
   }
 
 

@@ -399,6 +399,15 @@ namespace palpate
                    State                     &state,
                    Outcome                   &failure) const;
 
+    /** Why an increment to @p target that did not converge (@p o) may
+     * have failed, read from its last iterate @p x, as a clause to append
+     * to its message (empty if nothing is known): a sphere near the end
+     * acceptable_end() refuses. */
+    std::string
+    failure_cause(const std::vector<double> &x,
+                  const Utilities::Point3   &target,
+                  const Outcome             &o) const;
+
     /** The Newton step K dx = -R into `step` (from `residual`), exactly or
      * by GMRES on a kept factorisation; fills @p record's solver fields.
      * False if the linear solver failed. */
