@@ -167,18 +167,19 @@ namespace palpate
       (s.engine->degraded() ||
        (s.previous_held && s.previous_cause == MissingCause::not_computed));
     bool held = false;
-    // Missing data is an event while in contact; a failure region or the
-    // state space's edge also before it (the HIP got there before any cell
-    // was complete: zero force, with nothing to hold, is reported too); and
-    // data not computed yet once the HIP has left its rest position, where
-    // the force is no longer zero (Start = immediately: the hand can push
-    // 7 mm into the liver at 0 N before the first cell is complete, and
-    // that must be counted). At rest the zero force is the right one.
+    // Missing data is an event while in contact (since the first complete
+    // cell), and before it once the HIP has left its rest position: in a
+    // failure region or at the state space's edge (zero force, with
+    // nothing to hold, is reported too), or where data is not computed yet
+    // and the force is no longer zero (Start = immediately: the hand can
+    // push 7 mm into the liver at 0 N before the first cell is complete,
+    // and that must be counted). At rest before any cell was complete the
+    // hand has felt nothing yet and has not moved: not an event, whatever
+    // the corners of the cell around rest (the motion may start seconds
+    // later, once the initial cloud is done).
     const bool moved =
       finite && Utilities::norm(position) > 1e-3 * s.grid.spacing();
-    const bool event =
-      cause != MissingCause::none &&
-      (s.in_contact || moved || cause != MissingCause::not_computed);
+    const bool event = cause != MissingCause::none && (s.in_contact || moved);
     if (event)
       {
         held = (cause != MissingCause::not_computed || server_trouble) &&
