@@ -122,8 +122,12 @@ namespace palpate
                             "move the region onto the body, whose bounding box "
                             "is [" +
                               Utilities::to_string(box.first, 4) + "] - [" +
-                              Utilities::to_string(box.second, 4) +
-                              "] m, or set Surface nodes only = false.");
+                              Utilities::to_string(box.second, 4) + "] m" +
+                              // Inner nodes help only if the region has
+                              // some, and only if they are excluded now.
+                              (in_region > 0 ?
+                                 ", or set Surface nodes only = false." :
+                                 "."));
         }
 
       {
