@@ -236,6 +236,12 @@ namespace palpate
       bool
       ready_to_move() const;
 
+      /** move(), a step: the initial cloud's line as the motion starts
+       * @p t s after attaching (@p neighbourhood: Start = after rest
+       * neighbourhood), and what the summary keeps of it. */
+      void
+      announce_motion_start(double t, bool neighbourhood);
+
       /** The VTU export of the states the haptic loop used, and its
        * index. */
       void
@@ -422,6 +428,42 @@ namespace palpate
 
 
     void
+    InteractionRun::announce_motion_start(const double t,
+                                          const bool   neighbourhood)
+    {
+      const auto counts = interaction->cache().counts();
+      cloud_states      = counts.first;
+      cloud_complete    = t <= wait_limit;
+      // The engine is idle with points of the cloud neither computed nor
+      // failed: no converged neighbour to start from.
+      const unsigned int unreached = cloud_complete && !neighbourhood ?
+                                       interaction->initial_cloud_missing() :
+                                       0;
+      out << "  initial cloud: " << counts.first << " states computed, "
+          << counts.second << " failure points, in " << std::setprecision(3)
+          << t << " s"
+          << (unreached > 0 ?
+                " (" + std::to_string(unreached) + " of its " +
+                  std::to_string(interaction->initial_cloud_size()) +
+                  " points not computed: failure points lie between them "
+                  "and rest, and a state starts from a converged "
+                  "neighbour)" :
+                std::string())
+          << (neighbourhood && t <= wait_limit ?
+                " (the 27 grid points around rest are there; the rest of "
+                "the cloud is computed during the motion)" :
+                std::string())
+          << (t > wait_limit ?
+                " (not complete after Initial cloud time limit = " +
+                  Utilities::to_string(wait_limit, 4) + " s: starting anyway)" :
+                std::string())
+          << "; motion starts\n"
+          << std::flush;
+    }
+
+
+
+    void
     InteractionRun::move()
     {
       // From here on a stop signal ends the run through the path below, and
@@ -499,23 +541,7 @@ namespace palpate
             }
           if (!moving && (ready_to_move() || t > wait_limit))
             {
-              const auto counts = interaction->cache().counts();
-              cloud_states      = counts.first;
-              cloud_complete    = t <= wait_limit;
-              out << "  initial cloud: " << counts.first << " states computed, "
-                  << counts.second << " failure points, in "
-                  << std::setprecision(3) << t << " s"
-                  << (neighbourhood && t <= wait_limit ?
-                        " (the 27 grid points around rest are there; the "
-                        "rest of the cloud is computed during the motion)" :
-                        std::string())
-                  << (t > wait_limit ?
-                        " (not complete after Initial cloud time limit = " +
-                          Utilities::to_string(wait_limit, 4) +
-                          " s: starting anyway)" :
-                        std::string())
-                  << "; motion starts\n"
-                  << std::flush;
+              announce_motion_start(t, neighbourhood);
               loop->start_motion();
               moving = true;
             }

@@ -301,6 +301,18 @@ namespace palpate
 
 
 
+  unsigned int
+  Interaction::initial_cloud_missing() const
+  {
+    const Impl  &s      = *impl;
+    unsigned int absent = 0;
+    for (const unsigned int p : s.cloud_points)
+      absent += s.cache.status(p) == PointStatus::missing;
+    return absent;
+  }
+
+
+
   const Scene &
   Interaction::scene() const
   {

@@ -891,9 +891,8 @@ namespace palpate
                    increment(middle, t1, depth + 1);
           }
         failure = o;
-        failure.message +=
-          " (increment to " + Utilities::to_string(point(t1), 4) + " m)" +
-          cause;
+        failure.message += " (increment to " +
+                           Utilities::to_string(point(t1), 4) + " m)" + cause;
         return false;
       };
 

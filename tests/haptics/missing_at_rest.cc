@@ -8,9 +8,13 @@
 // - held at rest after the initial cloud, the HIP sees that cause, yet no
 //   missing-data event and no missing time is counted (the hand has felt
 //   nothing and the zero force at rest is the body's);
-// - moved 1 mm into that cell, the missing data is an event at once.
+// - moved 1 mm into that cell, the missing data is an event at once;
+// - the cloud's points beyond the failed ring around rest are neither
+//   computed nor failure points (no converged neighbour to start from),
+//   and Interaction::initial_cloud_missing() counts them.
 
 #include <palpate/haptics/interaction.h>
+#include <palpate/state_space/state_cache.h>
 
 #include <chrono>
 #include <thread>
@@ -71,6 +75,14 @@ main(int argc, char **argv)
           << (events() >= 1 ? "yes" : "NO") << ", with missing time: "
           << (after.missing_seconds + after.failure_region_seconds > 0 ? "yes" :
                                                                          "NO")
+          << std::endl;
+  const auto         counts  = interaction.cache().counts();
+  const unsigned int missing = interaction.initial_cloud_missing();
+  deallog << "the cloud's points neither computed nor failed: "
+          << (missing > 0 && missing + counts.first + counts.second ==
+                               interaction.initial_cloud_size() ?
+                "counted" :
+                "NOT counted")
           << std::endl;
   interaction.detach();
 }

@@ -158,6 +158,12 @@ namespace palpate
     unsigned int
     initial_cloud_size() const noexcept;
 
+    /** The number of those grid points that are neither computed nor
+     * failure points now: once the engine is idle, the points it could
+     * not reach (every way to them from rest passes failure points). */
+    unsigned int
+    initial_cloud_missing() const;
+
     /**
      * Change the material, the fixed nodes, the active node, the effects or
      * the solver settings: only while detached (std::logic_error

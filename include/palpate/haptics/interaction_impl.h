@@ -71,8 +71,10 @@ namespace palpate
       for (int i = -reach; i <= reach; ++i)
         for (int j = -reach; j <= reach; ++j)
           for (int k = -reach; k <= reach; ++k)
-            cloud_size +=
-              Utilities::norm(grid.position(GridIndex{{i, j, k}})) <= radius;
+            if (const GridIndex g{{i, j, k}};
+                Utilities::norm(grid.position(g)) <= radius)
+              cloud_points.push_back(grid.linear(g));
+      cloud_size = cloud_points.size();
       check_memory_budget();
       // The store's states go into the cache before the engine starts, so
       // that it computes only what is missing.
@@ -149,7 +151,9 @@ namespace palpate
             " (MiB) or more, or make Scheduler / Cloud radius smaller.");
     }
 
-    unsigned int                                 cloud_size = 0;
+    unsigned int cloud_size = 0;
+    /** The grid points of the initial cloud. */
+    std::vector<unsigned int>                    cloud_points;
     Scene                                        scene;
     Mesh                                         mesh;
     NodeSelection                                nodes;
