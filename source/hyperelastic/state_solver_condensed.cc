@@ -152,14 +152,18 @@ namespace palpate
     // restarting at each leaves plain steps contracting by 0.75-0.98 while
     // the set settles, and new factors to follow (organ-speed.md); a step
     // the history fails is retried plain (plan_next_condensed()).
-    in_contact.resize(rows.size());
-    for (unsigned int k = 0; k < rows.size(); ++k)
-      in_contact[k] =
-        x[rows[k].multiplier_eq] + step[rows[k].multiplier_eq] > 0;
-    if (factorized_now || (!settings.anderson_across_contact_changes &&
-                           in_contact != was_in_contact))
+    bool contact_set_changed = false;
+    if (!settings.anderson_across_contact_changes)
+      {
+        in_contact.resize(rows.size());
+        for (unsigned int k = 0; k < rows.size(); ++k)
+          in_contact[k] =
+            x[rows[k].multiplier_eq] + step[rows[k].multiplier_eq] > 0;
+        contact_set_changed = in_contact != was_in_contact;
+        was_in_contact.swap(in_contact);
+      }
+    if (factorized_now || contact_set_changed)
       anderson.reset();
-    was_in_contact.swap(in_contact);
     plain_step = step;
     return anderson.accelerate(x, step);
   }
