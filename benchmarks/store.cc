@@ -88,7 +88,7 @@ run_benchmark(int argc, char **argv)
                "the store (s) | write (states/s) | read (states/s) | bytes "
                "per state |\n|---|---|---|---|---|---|---|\n";
   std::ostringstream results;
-  for (const std::string mesh :
+  for (const std::string &mesh :
        quick ? std::vector<std::string>{"liver501"} :
                std::vector<std::string>{"liver501", "liver2k"})
     {

@@ -133,7 +133,8 @@ namespace palpate
     const bool complete = sample.complete;
     if (complete)
       {
-        s.in_contact = true;
+        s.in_contact             = true;
+        s.last_complete_position = position;
         s.hold.update(position, sample);
       }
 
@@ -198,6 +199,15 @@ namespace palpate
           s.in_contact && finite &&
           s.interpolation->force_while_missing(position, target, s.stiffness);
         render = render || patched;
+        // (Off the surface the patches answer zero, as they should: no
+        // extrapolation to speak of.)
+        if (patched && Utilities::norm(target) > 0)
+          {
+            const double d =
+              Utilities::distance(position, s.last_complete_position);
+            if (d > s.patched_farthest.load(std::memory_order_relaxed))
+              s.patched_farthest.store(d, std::memory_order_relaxed);
+          }
         s.count_missing(cause, held, patched, position, dt, finite);
       }
     s.previous_held  = held;

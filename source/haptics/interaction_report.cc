@@ -176,6 +176,7 @@ namespace palpate
     r.missing_events          = s.missing_events.load();
     r.missing_seconds         = 1e-9 * s.missing_nanoseconds.load();
     r.missing_patched_seconds = 1e-9 * s.patched_nanoseconds.load();
+    r.patched_farthest        = s.patched_farthest.load();
     r.failure_region_events   = s.held_events[0].load();
     r.failure_region_seconds  = 1e-9 * s.held_nanoseconds[0].load();
     r.outside_events          = s.held_events[1].load();

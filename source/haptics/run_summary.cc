@@ -137,6 +137,7 @@ namespace palpate
               count("missing_data_events", s.missing_events),
               real("missing_data_seconds", s.missing_seconds),
               real("missing_data_patched_seconds", s.missing_patched_seconds),
+              real("patched_farthest_m", s.patched_farthest),
               count("failure_region_events", s.failure_region_events),
               real("failure_region_seconds", s.failure_region_seconds),
               count("outside_events", s.outside_events),
@@ -206,6 +207,12 @@ namespace palpate
         << " times in failure regions (" << failure_region_seconds << " s), "
         << outside_events << " times outside the state space ("
         << outside_seconds << " s)  <-- no state can exist there\n";
+    if (patched_farthest > 0)
+      s << "  patches beyond:    the last complete cell's contact patches "
+           "answered for missing data up to "
+        << 1000 * patched_farthest
+        << " mm from where the data were last complete (their linear "
+           "contact models, extrapolated)\n";
     if (server_hold_events > 0)
       s << "  held force:        " << server_hold_events
         << " times while a solver server was silent or lost ("

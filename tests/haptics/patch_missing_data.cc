@@ -12,7 +12,10 @@
 // - the force changes continuously across the edge (no jump beyond the
 //   filter's own limit);
 // - lifted off the surface outside the grid, the force is exactly 0;
-// - the time outside is still reported, as an outside event.
+// - the time outside is still reported, as an outside event, and the
+//   summary says how far beyond the last complete cell the patches
+//   answered (the 1.5 mm from the edge; not the lift off the surface,
+//   where they answer zero).
 
 #include <palpate/haptics/interaction.h>
 #include <palpate/hyperelastic/state_solver.h>
@@ -108,5 +111,9 @@ main(int argc, char **argv)
   const auto summary = interaction.summary();
   deallog << "the time outside is reported as an outside event: "
           << ok(summary.outside_events >= 1 && summary.outside_seconds > 0)
+          << "; the patches answered up to 1-2 mm from where the data were "
+             "last complete: "
+          << ok(summary.patched_farthest > 0.001 &&
+                summary.patched_farthest < 0.002)
           << std::endl;
 }

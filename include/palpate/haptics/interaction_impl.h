@@ -192,6 +192,9 @@ namespace palpate
     Utilities::Point3 previous_position{{0, 0, 0}}, velocity{{0, 0, 0}};
     Clock::time_point previous_call;
     bool first_call = true, was_complete = false, in_contact = false;
+    // Where the HIP was at the last complete cell: how far the contact
+    // patches extrapolate while data are missing is measured from here.
+    Utilities::Point3 last_complete_position{{0, 0, 0}};
     // Whether track() has seen a finite position (the first has no
     // velocity).
     bool velocity_known = false;
@@ -209,9 +212,12 @@ namespace palpate
     std::atomic<std::uint8_t>  event_cause{0}, last_cause{0};
     std::atomic<double>        event_stiffness{0};
     std::atomic<double>        largest_force{0}, largest_change{0};
-    std::atomic<double>        event_position[3] = {};
-    std::uint64_t              reported_events   = 0;
-    Clock::time_point          attach_time;
+    // The farthest (m) from last_complete_position that the interpolation
+    // rendered missing data from the last complete cell (its patches).
+    std::atomic<double> patched_farthest{0};
+    std::atomic<double> event_position[3] = {};
+    std::uint64_t       reported_events   = 0;
+    Clock::time_point   attach_time;
 
     /** Seconds since the last force() call (1 ms at the first). */
     double

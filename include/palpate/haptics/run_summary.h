@@ -51,6 +51,10 @@ namespace palpate
      * rendered the force from the last complete cell's patches (the tissue
      * there as last known) instead of fading it. */
     double missing_patched_seconds = 0;
+    /** The farthest (m) from where the data were last complete that the
+     * last complete cell's contact patches rendered missing data (held or
+     * not): their linear contact models, extrapolated that far. */
+    double patched_farthest = 0;
     /** Where no state can come, the force was held (ForceHold): in failure
      * regions, and outside the state space. */
     std::uint64_t failure_region_events = 0, outside_events = 0;
