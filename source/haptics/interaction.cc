@@ -199,15 +199,8 @@ namespace palpate
           s.in_contact && finite &&
           s.interpolation->force_while_missing(position, target, s.stiffness);
         render = render || patched;
-        // (Off the surface the patches answer zero, as they should: no
-        // extrapolation to speak of.)
-        if (patched && Utilities::norm(target) > 0)
-          {
-            const double d =
-              Utilities::distance(position, s.last_complete_position);
-            if (d > s.patched_farthest.load(std::memory_order_relaxed))
-              s.patched_farthest.store(d, std::memory_order_relaxed);
-          }
+        if (patched)
+          s.note_extrapolation(position, target);
         s.count_missing(cause, held, patched, position, dt, finite);
       }
     s.previous_held  = held;

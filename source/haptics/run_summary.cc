@@ -167,6 +167,37 @@ namespace palpate
               count("shape_frames", s.shape_frames),
               text("stopped_by", s.stopped_by)};
     }
+
+
+
+    // RunSummary::print(), a step: the missing-data and held-force lines.
+    void
+    print_missing_data(const RunSummary &r, std::ostream &s)
+    {
+      s << "  missing data:      " << r.missing_events << " events, "
+        << r.missing_seconds << " s in total";
+      // The contact patches may have rendered the force while the states
+      // were missing: then it did not fade, and the line says so.
+      if (r.missing_patched_seconds > 0)
+        s << " (" << r.missing_patched_seconds
+          << " s of it rendered from the last complete cell's contact "
+             "patches)";
+      if (r.missing_events > 0 &&
+          r.missing_seconds - r.missing_patched_seconds > 1e-3)
+        s << "  <-- the force faded to zero then";
+      s << "\n";
+      if (r.failure_region_events + r.outside_events > 0)
+        s << "  held force:        " << r.failure_region_events
+          << " times in failure regions (" << r.failure_region_seconds
+          << " s), " << r.outside_events << " times outside the state space ("
+          << r.outside_seconds << " s)  <-- no state can exist there\n";
+      if (r.patched_farthest > 0)
+        s << "  patches beyond:    the last complete cell's contact patches "
+             "answered for missing data up to "
+          << 1000 * r.patched_farthest
+          << " mm from where the data were last complete (their linear "
+             "contact models, extrapolated)\n";
+    }
   } // namespace
 
 
@@ -190,29 +221,8 @@ namespace palpate
          "corner on its path, or a stop signal), "
       << results_discarded << " results discarded (parameters changed)\n"
       << "  cache:             " << corner_hits << " of " << corner_reads
-      << " corner reads found a state\n"
-      << "  missing data:      " << missing_events << " events, "
-      << missing_seconds << " s in total";
-    // The contact patches may have rendered the force while the states
-    // were missing: then it did not fade, and the line says so.
-    if (missing_patched_seconds > 0)
-      s << " (" << missing_patched_seconds
-        << " s of it rendered from the last complete cell's contact "
-           "patches)";
-    if (missing_events > 0 && missing_seconds - missing_patched_seconds > 1e-3)
-      s << "  <-- the force faded to zero then";
-    s << "\n";
-    if (failure_region_events + outside_events > 0)
-      s << "  held force:        " << failure_region_events
-        << " times in failure regions (" << failure_region_seconds << " s), "
-        << outside_events << " times outside the state space ("
-        << outside_seconds << " s)  <-- no state can exist there\n";
-    if (patched_farthest > 0)
-      s << "  patches beyond:    the last complete cell's contact patches "
-           "answered for missing data up to "
-        << 1000 * patched_farthest
-        << " mm from where the data were last complete (their linear "
-           "contact models, extrapolated)\n";
+      << " corner reads found a state\n";
+    print_missing_data(*this, s);
     if (server_hold_events > 0)
       s << "  held force:        " << server_hold_events
         << " times while a solver server was silent or lost ("

@@ -333,6 +333,21 @@ namespace palpate
         patched_nanoseconds.fetch_add(nanoseconds, std::memory_order_relaxed);
     }
 
+    /** force(), a step: the interpolation answered missing data at
+     * @p position with @p force from the last complete cell: keep the
+     * farthest from where the data were last complete. Off the surface
+     * the patches answer zero, which extrapolates nothing. */
+    void
+    note_extrapolation(const Utilities::Point3 &position,
+                       const Utilities::Point3 &force) noexcept
+    {
+      if (!(Utilities::norm(force) > 0))
+        return;
+      const double d = Utilities::distance(position, last_complete_position);
+      if (d > patched_farthest.load(std::memory_order_relaxed))
+        patched_farthest.store(d, std::memory_order_relaxed);
+    }
+
     /** force(), a step: @p target (rendered or faded, @p render) through
      * the filter, with the largest force and change it made. */
     Utilities::Point3
