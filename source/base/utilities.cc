@@ -129,8 +129,10 @@ namespace palpate
     std::string
     to_string(const double x, const unsigned int precision)
     {
+      // x + 0 turns -0 into 0: a coordinate that is zero reads "0", not
+      // "-0" (a HIP at rest along an axis, a mirrored point).
       std::ostringstream s;
-      s << std::setprecision(precision) << x;
+      s << std::setprecision(precision) << x + 0.0;
       return s.str();
     }
 
@@ -173,9 +175,8 @@ namespace palpate
     std::string
     to_string(const Point3 &p, const unsigned int precision)
     {
-      std::ostringstream s;
-      s << std::setprecision(precision) << p[0] << ", " << p[1] << ", " << p[2];
-      return s.str();
+      return to_string(p[0], precision) + ", " + to_string(p[1], precision) +
+             ", " + to_string(p[2], precision);
     }
 
 
