@@ -116,7 +116,9 @@ namespace palpate
           return InputError(
             filename,
             line,
-            "subsection " + rest + " (in " + path_to_string(path) + ")",
+            "subsection " + rest +
+              (path.empty() ? std::string(" (at the top level)") :
+                              " (in " + path_to_string(path) + ")"),
             "there is no subsection '" + rest + "' here",
             suggestion(rest, here->subsection_names()) +
               "The subsections here are: " +
