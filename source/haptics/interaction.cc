@@ -299,7 +299,7 @@ namespace palpate
   unsigned int
   Interaction::initial_cloud_size() const noexcept
   {
-    return impl->cloud_size;
+    return impl->cloud_points.size();
   }
 
 

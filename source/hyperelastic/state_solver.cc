@@ -880,11 +880,15 @@ namespace palpate
             current_t  = t1;
             return true;
           }
-        const std::string cause = impl->failure_cause(x, point(t1), o);
-        x                       = saved;
-        if (depth < s.max_cutbacks &&
-            o.status != SolveStatus::inverted_element &&
-            o.status != SolveStatus::stopped)
+        const bool cut_back = depth < s.max_cutbacks &&
+                              o.status != SolveStatus::inverted_element &&
+                              o.status != SolveStatus::stopped;
+        // Read from the failed iterate, before it is set back; only for
+        // the increment that ends the solve.
+        const std::string cause =
+          cut_back ? std::string() : impl->failure_cause(x, point(t1), o);
+        x = saved;
+        if (cut_back)
           {
             const double middle = 0.5 * (t0 + t1);
             return increment(t0, middle, depth + 1) &&

@@ -74,7 +74,6 @@ namespace palpate
             if (const GridIndex g{{i, j, k}};
                 Utilities::norm(grid.position(g)) <= radius)
               cloud_points.push_back(grid.linear(g));
-      cloud_size = cloud_points.size();
       check_memory_budget();
       // The store's states go into the cache before the engine starts, so
       // that it computes only what is missing.
@@ -135,11 +134,11 @@ namespace palpate
       // (Mooney-Rivlin's pressures and quadratic elements add more).
       const double state_bytes = sizeof(State) + 3. * mesh.n_vertices() * 8;
       const double budget = scene.parameters.engine.memory_budget * 1048576.0;
-      const double needed = 1.25 * cloud_size * state_bytes;
+      const double needed = 1.25 * cloud_points.size() * state_bytes;
       if (needed > budget)
         throw scene.error(
           "Engine/Memory budget",
-          "the initial cloud's " + std::to_string(cloud_size) +
+          "the initial cloud's " + std::to_string(cloud_points.size()) +
             " states of this mesh (" + std::to_string(mesh.n_vertices()) +
             " nodes, at least " + Utilities::to_string(state_bytes / 1024, 3) +
             " KiB each) need at least " +
@@ -151,7 +150,6 @@ namespace palpate
             " (MiB) or more, or make Scheduler / Cloud radius smaller.");
     }
 
-    unsigned int cloud_size = 0;
     /** The grid points of the initial cloud. */
     std::vector<unsigned int>                    cloud_points;
     Scene                                        scene;
